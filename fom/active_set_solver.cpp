@@ -1,0 +1,166 @@
+#include "fom/active_set_solver.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <chrono>
+
+namespace contactrom::fom {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+SparseMatrix free_block(const SparseMatrix& k, const std::vector<int>& free, const std::vector<int>& free_index) {
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(k.nonZeros());
+  for (int col = 0; col < k.outerSize(); ++col) {
+    if (free_index[col] < 0) continue;
+    for (SparseMatrix::InnerIterator it(k, col); it; ++it)
+      if (free_index[it.row()] >= 0) trip.emplace_back(free_index[it.row()], free_index[col], it.value());
+  }
+  const int n = static_cast<int>(free.size());
+  SparseMatrix kff(n, n);
+  kff.setFromTriplets(trip.begin(), trip.end());
+  return kff;
+}
+
+}  // namespace
+
+bool condense(const Problem& problem, const Param& mu, Condensation& out) {
+  const std::vector<int>& free = problem.free_dofs();
+  const int n = problem.num_dofs(), nf = static_cast<int>(free.size());
+  std::vector<int> free_index(n, -1);
+  for (int i = 0; i < nf; ++i) free_index[free[i]] = i;
+  const SparseMatrix k = problem.stiffness(mu);
+  Eigen::CholmodSupernodalLLT<SparseMatrix> llt(free_block(k, free, free_index));
+  if (llt.info() != Eigen::Success) return false;
+
+  const std::vector<int>& surf = problem.contact().surface_dofs();
+  const int ns = static_cast<int>(surf.size()), nt = problem.num_load_terms();
+  // Right-hand sides: unit loads on free surface dofs, then the load terms.
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(nf, ns + nt);
+  for (int j = 0; j < ns; ++j)
+    if (free_index[surf[j]] >= 0) rhs(free_index[surf[j]], j) = 1.0;
+  for (int t = 0; t < nt; ++t) {
+    const Eigen::VectorXd r = problem.external_load_terms()[t] - k * problem.lifting_terms()[t];
+    for (int i = 0; i < nf; ++i) rhs(i, ns + t) = r(free[i]);
+  }
+  const Eigen::MatrixXd x = llt.solve(rhs);
+  if (!x.allFinite()) return false;
+  out.z_surface = Eigen::MatrixXd::Zero(n, ns);
+  out.z_load = Eigen::MatrixXd::Zero(n, nt);
+  for (int i = 0; i < nf; ++i) {
+    out.z_surface.row(free[i]) = x.row(i).head(ns);
+    out.z_load.row(free[i]) = x.row(i).tail(nt);
+  }
+  for (int t = 0; t < nt; ++t) out.z_load.col(t) += problem.lifting_terms()[t];
+  out.s.resize(ns, ns);
+  for (int a = 0; a < ns; ++a) out.s.row(a) = out.z_surface.row(surf[a]);
+  return true;
+}
+
+ActiveSetSolver::ActiveSetSolver(const Problem& problem, ActiveSetOptions options)
+    : m_problem(problem), m_options(options) {
+  if (!problem.stiffness_is_constant()) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  m_constant = std::make_unique<Condensation>();
+  Param mid = 0.5 * (problem.param_lower() + problem.param_upper());
+  m_constant_ok = condense(problem, mid, *m_constant);
+  m_setup_time = seconds_since(t0);
+}
+
+FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) const {
+  m_problem.check_param(mu);
+  if (m_constant) {
+    if (!m_constant_ok) {
+      FomSolution s;
+      s.mu = mu;
+      s.status = Status::NumericalIssue;
+      s.message = "Cholesky factorisation of the stiffness failed (matrix not positive definite)";
+      return s;
+    }
+    return solve_with(*m_constant, mu, warm);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  Condensation cond;
+  if (!condense(m_problem, mu, cond)) {
+    FomSolution s;
+    s.mu = mu;
+    s.status = Status::NumericalIssue;
+    s.message = "Cholesky factorisation of the stiffness failed (matrix not positive definite)";
+    return s;
+  }
+  FomSolution s = solve_with(cond, mu, warm);
+  s.time_s = seconds_since(t0);  // includes the per-parameter factorisation
+  return s;
+}
+
+FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& mu, const FomSolution* warm) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  const ContactModel& contact = m_problem.contact();
+  const std::vector<int>& surf = contact.surface_dofs();
+  const int nc = contact.num_constraints();
+  FomSolution sol;
+  sol.mu = mu;
+
+  const Eigen::VectorXd u0 = cond.z_load * m_problem.load_coefficients(mu);
+  Eigen::VectorXd u0_s(surf.size());
+  for (size_t j = 0; j < surf.size(); ++j) u0_s(j) = u0(surf[j]);
+
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(nc);
+  Pairing pairing;
+  if (warm && warm->lambda.size() == nc) {
+    lambda = warm->lambda;
+    pairing = warm->pairing;
+  }
+  if (!warm || pairing.segment.size() != static_cast<size_t>(nc)) pairing = contact.search(u0_s);
+
+  DualQpSolver qp(m_options.qp);
+  ConstraintMatrix c;
+  Eigen::VectorXd g, u_s = u0_s;
+  bool converged = false;
+  for (int it = 0; it < m_options.max_pairing_iterations; ++it) {
+    ++sol.pairing_iterations;
+    contact.assemble(pairing, c, g);
+    const Eigen::MatrixXd cs = c * cond.s;           // n_c x n_s
+    const Eigen::MatrixXd delassus = cs * c.transpose();
+    const Eigen::VectorXd h = c * u0_s - g;
+    std::vector<char> eligible(nc, 1);
+    for (int s = 0; s < nc; ++s)
+      if (contact.has_pairing() && pairing.segment[s] < 0) eligible[s] = 0;
+    lambda = qp.solve(delassus, h, eligible, lambda);
+    sol.iterations += qp.iterations();
+    if (qp.info() != Status::Success) {
+      sol.status = qp.info();
+      sol.message = "dual active-set QP failed: " + std::string(to_string(qp.info()));
+      break;
+    }
+    u_s = u0_s - cs.transpose() * lambda;
+    if (!contact.has_pairing()) {
+      converged = true;
+      break;
+    }
+    Pairing next = contact.search(u_s);
+    const bool same = next.same_as(pairing, m_options.pairing_tolerance);
+    pairing = std::move(next);
+    if (same) {
+      converged = true;
+      break;
+    }
+  }
+  if (!converged && sol.status == Status::Success) {
+    sol.status = Status::NoConvergence;
+    sol.message = "contact pairing did not settle in " + std::to_string(m_options.max_pairing_iterations) +
+                  " fixed-point iterations";
+  }
+  // The constraint operator of the returned solution is the one λ was solved with;
+  // on convergence the pairing recomputed from u agrees with it to the tolerance.
+  sol.u = u0 - cond.z_surface * (c.transpose() * lambda);
+  sol.lambda = lambda;
+  sol.pairing = pairing;
+  sol.active = static_cast<int>((lambda.array() > 0.0).count());
+  sol.time_s = seconds_since(t0);
+  return sol;
+}
+
+}  // namespace contactrom::fom

@@ -1,0 +1,133 @@
+#include "fom/contact_model.hpp"
+
+#include <cmath>
+#include <limits>
+#include <map>
+
+namespace contactrom::fom {
+
+bool Pairing::same_as(const Pairing& other, double tol) const {
+  if (segment != other.segment || xi.size() != other.xi.size()) return false;
+  for (size_t s = 0; s < xi.size(); ++s) {
+    if (segment[s] < 0) continue;
+    if (std::abs(xi[s] - other.xi[s]) > tol) return false;
+    if ((normal.col(s) - other.normal.col(s)).cwiseAbs().maxCoeff() > tol) return false;
+  }
+  return true;
+}
+
+Eigen::VectorXd ContactModel::restrict_to_surface(const Eigen::VectorXd& u_full) const {
+  Eigen::VectorXd out(m_surface_dofs.size());
+  for (size_t i = 0; i < m_surface_dofs.size(); ++i) out(i) = u_full(m_surface_dofs[i]);
+  return out;
+}
+
+// Surface dof layout: slave node k -> columns 2k, 2k+1; master node j -> 2(n_s+j), 2(n_s+j)+1.
+NodeToSegmentContact::NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const std::vector<int>& slave_chain,
+                                           const std::vector<int>& master_chain,
+                                           const std::vector<Eigen::Vector2d>& master_inside)
+    : m_slave(slave_chain), m_master(master_chain) {
+  const int ns = static_cast<int>(m_slave.size()), nm = static_cast<int>(m_master.size());
+  m_slave_x.resize(2, ns);
+  m_master_x.resize(2, nm);
+  for (int k = 0; k < ns; ++k) m_slave_x.col(k) = nodes.col(m_slave[k]);
+  for (int j = 0; j < nm; ++j) m_master_x.col(j) = nodes.col(m_master[j]);
+  for (int node : m_slave) m_surface_dofs.insert(m_surface_dofs.end(), {2 * node, 2 * node + 1});
+  for (int node : m_master) m_surface_dofs.insert(m_surface_dofs.end(), {2 * node, 2 * node + 1});
+  m_points = m_slave_x;
+
+  // Tributary lengths: half of each adjacent slave segment.
+  m_weights = Eigen::VectorXd::Zero(ns);
+  for (int k = 0; k + 1 < ns; ++k) {
+    const double len = (m_slave_x.col(k + 1) - m_slave_x.col(k)).norm();
+    m_weights(k) += 0.5 * len;
+    m_weights(k + 1) += 0.5 * len;
+  }
+
+  // Outward orientation of each master segment: the normal must point away from
+  // the interior point(s) of the master body nearest to the segment.
+  m_orientation.resize(std::max(nm - 1, 0));
+  for (int j = 0; j + 1 < nm; ++j) {
+    const Eigen::Vector2d a = m_master_x.col(j), b = m_master_x.col(j + 1);
+    const Eigen::Vector2d t = b - a, mid = 0.5 * (a + b);
+    const Eigen::Vector2d n(t.y(), -t.x());
+    double best = std::numeric_limits<double>::max();
+    Eigen::Vector2d inside = master_inside.front();
+    for (const auto& p : master_inside)
+      if ((p - mid).norm() < best) best = (p - mid).norm(), inside = p;
+    m_orientation[j] = n.dot(inside - mid) < 0 ? 1.0 : -1.0;
+  }
+}
+
+Pairing NodeToSegmentContact::search(const Eigen::VectorXd& u_surface) const {
+  const int ns = static_cast<int>(m_slave.size()), nm = static_cast<int>(m_master.size());
+  Eigen::Matrix2Xd xs = m_slave_x, xm = m_master_x;
+  for (int k = 0; k < ns; ++k) xs.col(k) += u_surface.segment<2>(2 * k);
+  for (int j = 0; j < nm; ++j) xm.col(j) += u_surface.segment<2>(2 * (ns + j));
+
+  Pairing p;
+  p.segment.assign(ns, -1);
+  p.xi.assign(ns, 0.0);
+  p.normal = Eigen::Matrix2Xd::Zero(2, ns);
+  for (int k = 0; k < ns; ++k) {
+    double best = std::numeric_limits<double>::max();
+    int best_seg = -1;
+    double best_xi = 0.0, best_raw = 0.0;
+    for (int j = 0; j + 1 < nm; ++j) {
+      const Eigen::Vector2d a = xm.col(j), t = xm.col(j + 1) - a;
+      const double raw = (xs.col(k) - a).dot(t) / t.squaredNorm();
+      const double xi = std::clamp(raw, 0.0, 1.0);
+      const double dist = (xs.col(k) - a - xi * t).norm();
+      if (dist < best - 1e-14) best = dist, best_seg = j, best_xi = xi, best_raw = raw;
+    }
+    // A projection beyond either end of the master chain is no contact pair.
+    if (best_seg < 0 || (best_seg == 0 && best_raw < 0.0) || (best_seg == nm - 2 && best_raw > 1.0)) continue;
+    const Eigen::Vector2d t = xm.col(best_seg + 1) - xm.col(best_seg);
+    p.segment[k] = best_seg;
+    p.xi[k] = best_xi;
+    p.normal.col(k) = m_orientation[best_seg] * Eigen::Vector2d(t.y(), -t.x()).normalized();
+  }
+  return p;
+}
+
+void NodeToSegmentContact::assemble(const Pairing& p, ConstraintMatrix& c, Eigen::VectorXd& g) const {
+  const int ns = static_cast<int>(m_slave.size());
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(6 * ns);
+  g = Eigen::VectorXd::Zero(ns);
+  for (int k = 0; k < ns; ++k) {
+    const int j = p.segment[k];
+    if (j < 0) continue;
+    const double w = m_weights(k), xi = p.xi[k];
+    const Eigen::Vector2d n = p.normal.col(k);
+    const Eigen::Vector2d xm = (1.0 - xi) * m_master_x.col(j) + xi * m_master_x.col(j + 1);
+    g(k) = w * n.dot(m_slave_x.col(k) - xm);
+    for (int d = 0; d < 2; ++d) {
+      trip.emplace_back(k, 2 * k + d, -w * n(d));
+      trip.emplace_back(k, 2 * (ns + j) + d, w * (1.0 - xi) * n(d));
+      trip.emplace_back(k, 2 * (ns + j + 1) + d, w * xi * n(d));
+    }
+  }
+  c.resize(ns, static_cast<int>(m_surface_dofs.size()));
+  c.setFromTriplets(trip.begin(), trip.end());
+}
+
+ObstacleContact::ObstacleContact(const Eigen::VectorXd& x, const Eigen::VectorXd& psi,
+                                 const Eigen::VectorXd& weights)
+    : m_psi(psi) {
+  m_weights = weights;
+  m_points = Eigen::Matrix2Xd::Zero(2, x.size());
+  m_points.row(0) = x.transpose();
+  for (int i = 0; i < x.size(); ++i) m_surface_dofs.push_back(i);
+}
+
+void ObstacleContact::assemble(const Pairing&, ConstraintMatrix& c, Eigen::VectorXd& g) const {
+  const int n = static_cast<int>(m_psi.size());
+  c.resize(n, n);
+  std::vector<Eigen::Triplet<double>> trip;
+  for (int i = 0; i < n; ++i) trip.emplace_back(i, i, -m_weights(i));
+  c.setFromTriplets(trip.begin(), trip.end());
+  g = -m_weights.cwiseProduct(m_psi);
+}
+
+}  // namespace contactrom::fom

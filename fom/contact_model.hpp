@@ -1,0 +1,105 @@
+#pragma once
+/// \file contact_model.hpp
+/// \brief Linearised non-penetration constraints \f$ \mathbf{C}(u)\,u - \mathbf{g}(u) \le 0 \f$.
+///
+/// A ContactModel owns the geometry of the potential contact surface. It works on
+/// the *surface dofs* only (the displacement dofs that constraint rows may touch),
+/// so that a reduced model can rebuild \f$ \mathbf{C} \f$ from the contact-surface
+/// rows of its basis at a cost independent of the mesh size.
+///
+/// Row s is the constraint of slave node (or obstacle node) s, weighted by its
+/// tributary length \f$ w_s \f$, so the multiplier \f$ \lambda_s \f$ is a
+/// pressure. The number of rows is fixed: an unpaired slave node keeps a zero row
+/// and \f$ g_s = 0 \f$ and can never be active.
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <string>
+#include <vector>
+
+namespace contactrom::fom {
+
+/// Row-major sparse matrix: the constraint operator restricted to surface dofs.
+using ConstraintMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+
+/// \brief Contact pairing: for every constraint row, the master segment it is
+/// projected on (-1: unpaired), the local coordinate ξ ∈ [0,1] on it and the
+/// master's outward unit normal, all in the deformed configuration.
+/// Empty vectors for models without pairing (obstacles).
+struct Pairing {
+  std::vector<int> segment;
+  std::vector<double> xi;
+  Eigen::Matrix2Xd normal;
+  /// True when both pairings use the same segments and ξ, n agree to `tol`.
+  bool same_as(const Pairing& other, double tol) const;
+};
+
+/// \brief Abstract contact model; see the file comment.
+class ContactModel {
+ public:
+  virtual ~ContactModel() = default;
+
+  /// Number of constraint rows n_c (fixed).
+  int num_constraints() const { return static_cast<int>(m_weights.size()); }
+  /// Global dof indices the constraint rows may touch, in the column order of C.
+  const std::vector<int>& surface_dofs() const { return m_surface_dofs; }
+  /// Tributary length \f$ w_s \f$ of each row (reference configuration).
+  const Eigen::VectorXd& weights() const { return m_weights; }
+  /// Reference coordinates of the constrained nodes (2 x n_c; rope: x and 0).
+  const Eigen::Matrix2Xd& constraint_points() const { return m_points; }
+  /// Whether C and g depend on the displacement through a pairing.
+  virtual bool has_pairing() const = 0;
+
+  /// \brief Contact search in the deformed configuration.
+  /// \param u_surface full displacement restricted to surface_dofs()
+  virtual Pairing search(const Eigen::VectorXd& u_surface) const = 0;
+
+  /// \brief Constraint operator for a pairing: C (n_c x surface dofs) and g (n_c).
+  virtual void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const = 0;
+
+  /// Gather a full dof vector onto the surface dofs.
+  Eigen::VectorXd restrict_to_surface(const Eigen::VectorXd& u_full) const;
+
+ protected:
+  std::vector<int> m_surface_dofs;
+  Eigen::VectorXd m_weights;
+  Eigen::Matrix2Xd m_points;
+};
+
+/// \brief Two-body node-to-segment contact (slave nodes against master segments).
+class NodeToSegmentContact final : public ContactModel {
+ public:
+  /// \param nodes reference coordinates of the mesh (2 x n_nodes)
+  /// \param slave_chain slave node ids in chain order
+  /// \param master_chain master node ids in chain order
+  /// \param master_inside a point inside the master body (orients normals outward)
+  NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const std::vector<int>& slave_chain,
+                       const std::vector<int>& master_chain, const std::vector<Eigen::Vector2d>& master_inside);
+
+  bool has_pairing() const override { return true; }
+  Pairing search(const Eigen::VectorXd& u_surface) const override;
+  void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const override;
+
+  const std::vector<int>& slave_nodes() const { return m_slave; }
+  const std::vector<int>& master_nodes() const { return m_master; }
+
+ private:
+  std::vector<int> m_slave, m_master;
+  Eigen::Matrix2Xd m_slave_x, m_master_x;  // reference coordinates
+  std::vector<double> m_orientation;       // +1/-1 per master segment: outward normal sign
+};
+
+/// \brief Scalar obstacle constraint \f$ u_i \ge \psi(x_i) \f$ on 1D nodes (rope).
+class ObstacleContact final : public ContactModel {
+ public:
+  /// \param x node coordinates, \param psi obstacle height at the nodes,
+  /// \param weights tributary lengths (the dof of node i is i).
+  ObstacleContact(const Eigen::VectorXd& x, const Eigen::VectorXd& psi, const Eigen::VectorXd& weights);
+  bool has_pairing() const override { return false; }
+  Pairing search(const Eigen::VectorXd&) const override { return {}; }
+  void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const override;
+
+ private:
+  Eigen::VectorXd m_psi;
+};
+
+}  // namespace contactrom::fom

@@ -1,0 +1,136 @@
+#include "fom/dual_qp.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace contactrom::fom {
+
+bool DualQpSolver::solve_on(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<int>& set,
+                            Eigen::VectorXd& z) const {
+  const int m = static_cast<int>(set.size());
+  Eigen::MatrixXd gs(m, m);
+  Eigen::VectorXd hs(m);
+  for (int a = 0; a < m; ++a) {
+    hs(a) = h(set[a]);
+    for (int b = 0; b < m; ++b) gs(a, b) = g(set[a], set[b]);
+  }
+  Eigen::LLT<Eigen::MatrixXd> llt(gs);
+  if (llt.info() == Eigen::Success) {
+    z = llt.solve(hs);
+  } else {
+    // Semi-definite on this set (dependent rows): least-norm solution.
+    z = gs.completeOrthogonalDecomposition().solve(hs);
+  }
+  return z.allFinite();
+}
+
+Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::VectorXd& h,
+                                    const std::vector<char>& eligible_in, const Eigen::VectorXd& warm_start) {
+  const int n = static_cast<int>(h.size());
+  m_iterations = 0;
+  m_fallback = false;
+  m_info = Status::Success;
+  std::vector<char> eligible = eligible_in.empty() ? std::vector<char>(n, 1) : eligible_in;
+  if (g.rows() != n || g.cols() != n || static_cast<int>(eligible.size()) != n || !g.allFinite() || !h.allFinite()) {
+    m_info = Status::InvalidInput;
+    return Eigen::VectorXd::Zero(n);
+  }
+  for (int i = 0; i < n; ++i)
+    if (!(g(i, i) > 0.0)) eligible[i] = 0;
+  const double scale = std::max(h.cwiseAbs().maxCoeff(), 1e-300);
+  const double tol = m_options.relative_tolerance * scale;
+
+  // Initial active set: warm start support, else rows penetrating at λ = 0.
+  std::vector<char> active(n, 0);
+  for (int i = 0; i < n; ++i) {
+    const bool seed = warm_start.size() == n ? warm_start(i) > 0.0 : h(i) > tol;
+    active[i] = eligible[i] && seed;
+  }
+  std::set<std::vector<char>> seen;
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
+  while (m_iterations < m_options.max_iterations) {
+    ++m_iterations;
+    seen.insert(active);
+    std::vector<int> set;
+    for (int i = 0; i < n; ++i)
+      if (active[i]) set.push_back(i);
+    Eigen::VectorXd z;
+    lambda.setZero();
+    if (!set.empty()) {
+      if (!solve_on(g, h, set, z)) {
+        m_info = Status::NumericalIssue;
+        return lambda;
+      }
+      for (size_t a = 0; a < set.size(); ++a) lambda(set[a]) = z(a);
+    }
+    const Eigen::VectorXd w = g * lambda - h;
+    std::vector<char> next(n, 0);
+    for (int i = 0; i < n; ++i) next[i] = eligible[i] && (active[i] ? lambda(i) > -tol : w(i) < -tol);
+    if (next == active) {
+      // Converged: clean round-off negatives (|λ_i| <= tol) on the active set.
+      lambda = lambda.cwiseMax(0.0);
+      return lambda;
+    }
+    if (seen.count(next)) {
+      m_fallback = true;
+      return lawson_hanson(g, h, eligible, tol);
+    }
+    active = next;
+  }
+  m_info = Status::NoConvergence;
+  return lambda;
+}
+
+// Lawson–Hanson active-set method on the QP form (Lawson & Hanson 1974, ch. 23),
+// started from λ = 0. Terminates for positive semi-definite G.
+Eigen::VectorXd DualQpSolver::lawson_hanson(const Eigen::MatrixXd& g, const Eigen::VectorXd& h,
+                                            const std::vector<char>& eligible, double tol) {
+  const int n = static_cast<int>(h.size());
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
+  std::vector<char> passive(n, 0);
+  while (m_iterations < m_options.max_iterations) {
+    const Eigen::VectorXd descent = h - g * lambda;  // minus the gradient
+    int j = -1;
+    double best = tol;
+    for (int i = 0; i < n; ++i)
+      if (eligible[i] && !passive[i] && descent(i) > best) best = descent(i), j = i;
+    if (j < 0) return lambda;
+    passive[j] = 1;
+    while (m_iterations < m_options.max_iterations) {
+      ++m_iterations;
+      std::vector<int> set;
+      for (int i = 0; i < n; ++i)
+        if (passive[i]) set.push_back(i);
+      Eigen::VectorXd z;
+      if (!solve_on(g, h, set, z)) {
+        m_info = Status::NumericalIssue;
+        return lambda;
+      }
+      if (z.minCoeff() > 0.0) {
+        for (size_t a = 0; a < set.size(); ++a) lambda(set[a]) = z(a);
+        break;
+      }
+      // Step towards z until the first passive multiplier reaches zero; it leaves.
+      double alpha = 2.0;  // some z(a) <= 0, so the minimum below is <= 1
+      int blocking = -1;
+      for (size_t a = 0; a < set.size(); ++a) {
+        if (z(a) > 0.0) continue;
+        const double step = lambda(set[a]) / (lambda(set[a]) - z(a));
+        if (step < alpha) alpha = step, blocking = set[a];
+      }
+      for (size_t a = 0; a < set.size(); ++a) {
+        const int i = set[a];
+        lambda(i) += alpha * (z(a) - lambda(i));
+        if (i == blocking || lambda(i) <= 0.0) {
+          lambda(i) = 0.0;
+          passive[i] = 0;
+        }
+      }
+    }
+  }
+  m_info = Status::NoConvergence;
+  return lambda;
+}
+
+}  // namespace contactrom::fom

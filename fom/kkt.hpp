@@ -1,0 +1,61 @@
+#pragma once
+/// \file kkt.hpp
+/// \brief Full-order KKT residuals and solution comparisons (DESIGN §2, §3).
+///
+/// For a candidate (u, λ) at parameter μ, the pairing is recomputed from u in the
+/// deformed configuration and C(u), g(u) assembled. Residuals, all relative:
+///  - stationarity: \f$ \|K u_0 - f + C^T\lambda\|_2 / \|f\|_2 \f$ on free dofs,
+///  - penetration: \f$ \max_s (C u - g)_s^+ / (w_s\, U) \f$ (gap per node in units
+///    of the problem's displacement scale U),
+///  - negative pressure: \f$ \max_s (-\lambda_s)^+ / \|\lambda\|_\infty \f$,
+///  - complementarity: \f$ |\lambda^T (C u - g)| / (U \sum_s w_s |\lambda_s|) \f$.
+#include <Eigen/Dense>
+#include <vector>
+
+#include "fom/problem.hpp"
+
+namespace contactrom::fom {
+
+/// \brief The four relative KKT residuals; see the file comment.
+struct KktResiduals {
+  double stationarity = 0.0;
+  double penetration = 0.0;
+  double negative_pressure = 0.0;
+  double complementarity = 0.0;
+  /// Largest of the four.
+  double max() const;
+};
+
+/// \brief Gap of every constraint row in length units, \f$ -(Cu-g)_s / w_s \f$, with
+/// the pairing recomputed from `u` (unpaired rows: +infinity).
+Eigen::VectorXd normal_gaps(const Problem& problem, const Eigen::VectorXd& u);
+
+/// \brief KKT residuals of (u, λ) at μ; `u` is the full displacement (lifting included).
+KktResiduals kkt_residuals(const Problem& problem, const Param& mu, const Eigen::VectorXd& u,
+                           const Eigen::VectorXd& lambda);
+
+/// \brief Differences between a candidate and a reference solution.
+struct SolutionErrors {
+  double primal_h1 = 0.0;  ///< \f$ \|u-u_{ref}\|_{H^1} / \|u_{ref}\|_{H^1} \f$
+  double dual_l2 = 0.0;    ///< \f$ \|\lambda-\lambda_{ref}\|_{L^2(\Gamma_c)} / \|\lambda_{ref}\|_{L^2(\Gamma_c)} \f$ (absolute if λ_ref = 0)
+  int active_set_differences = 0;  ///< rows active in one and not the other, ignoring rows where
+                                   ///< both pressure and gap are below `degenerate_tol`
+};
+
+/// \brief Relative errors of (u, λ) against (u_ref, λ_ref).
+/// \param degenerate_tol threshold (relative to max λ_ref and the displacement scale) below which a
+///   row with both small pressure and small gap is not counted as an active-set difference (default 1e-8)
+SolutionErrors compare_solutions(const Problem& problem, const Eigen::VectorXd& u, const Eigen::VectorXd& lambda,
+                                 const Eigen::VectorXd& u_ref, const Eigen::VectorXd& lambda_ref,
+                                 double degenerate_tol = 1e-8);
+
+/// \brief Relative H¹ error of a full displacement against a reference.
+double relative_h1_error(const Problem& problem, const Eigen::VectorXd& u, const Eigen::VectorXd& u_ref);
+/// \brief Relative L²(Γc) error of pressures (absolute if the reference is zero).
+double relative_l2_pressure_error(const Problem& problem, const Eigen::VectorXd& lambda,
+                                  const Eigen::VectorXd& lambda_ref);
+
+/// \brief Total contact force \f$ \sum_s w_s \lambda_s \f$ (per unit thickness).
+double contact_force(const Problem& problem, const Eigen::VectorXd& lambda);
+
+}  // namespace contactrom::fom

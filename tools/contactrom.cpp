@@ -1,0 +1,45 @@
+// contactrom — command-line driver. Subcommands (see README and ../shared/DESIGN.md §5):
+//   contactrom fom     --problem hertz --param 0.1 --json
+//   contactrom offline --problem hertz --train 30 --out hertz30.h5
+//   contactrom online  --db hertz30.h5 --method greedy --validation --json
+//   contactrom sparse  --method omp --dictionary D.csv --signal x.csv --json
+//   contactrom bench   --problem hertz --json
+//   contactrom demo
+// Bad input ends with one line on stderr ("contactrom: error: ...") and exit code 2;
+// numerical non-convergence is reported in the output with a status instead.
+#include <algorithm>
+#include <iostream>
+
+#include "fom/errors.hpp"
+#include "tools/cli.hpp"
+
+namespace contactrom::cli {
+std::vector<CommandEntry>& command_table() {
+  static std::vector<CommandEntry> table;
+  return table;
+}
+}  // namespace contactrom::cli
+
+int main(int argc, char** argv) {
+  using namespace contactrom;
+  CLI::App app{"contactrom: sparse dictionary reduced-order models for frictionless contact"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "contactrom 0.1.0");
+  auto& table = cli::command_table();
+  std::sort(table.begin(), table.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+  for (auto& entry : table) entry.setup(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "contactrom: error: " << e.what() << "\n";
+    return 2;
+  } catch (const InputError& e) {
+    std::cerr << "contactrom: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "contactrom: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
