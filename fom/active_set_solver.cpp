@@ -24,6 +24,28 @@ SparseMatrix free_block(const SparseMatrix& k, const std::vector<int>& free, con
   return kff;
 }
 
+/// S Cᵀ (n_s x n_c) for the sparse constraint rows: column a is the sum of the
+/// columns of the symmetric S picked by row a's (at most six) entries.
+void delassus_parts(const ConstraintMatrix& c, const Eigen::MatrixXd& s, Eigen::MatrixXd& sct) {
+  sct.setZero(s.rows(), c.rows());
+  for (int a = 0; a < c.outerSize(); ++a)
+    for (ConstraintMatrix::InnerIterator it(c, a); it; ++it) sct.col(a).noalias() += it.value() * s.col(it.col());
+}
+
+bool pairing_settled(const ConstraintMatrix& c, const Eigen::VectorXd& g, const ConstraintMatrix& c_next,
+                     const Eigen::VectorXd& g_next, const Eigen::VectorXd& u_s, const Eigen::VectorXd& lambda,
+                     const Eigen::VectorXd& w, double u_scale, double tol) {
+  const Eigen::VectorXd force = c.transpose() * lambda;
+  const double force_scale = std::max(force.norm(), 1e-300);
+  if ((c_next.transpose() * lambda - force).norm() > tol * force_scale) return false;
+  const Eigen::VectorXd v = (c * u_s - g).cwiseQuotient(w), v_next = (c_next * u_s - g_next).cwiseQuotient(w);
+  for (int s = 0; s < v.size(); ++s) {
+    if (v_next(s) > tol * u_scale) return false;  // penetration under the new pairing
+    if ((lambda(s) > 0.0 || v(s) > -tol * u_scale) && std::abs(v_next(s) - v(s)) > tol * u_scale) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool condense(const Problem& problem, const Param& mu, Condensation& out) {
@@ -108,22 +130,28 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
   for (size_t j = 0; j < surf.size(); ++j) u0_s(j) = u0(surf[j]);
 
   Eigen::VectorXd lambda = Eigen::VectorXd::Zero(nc);
-  Pairing pairing;
-  if (warm && warm->lambda.size() == nc) {
-    lambda = warm->lambda;
-    pairing = warm->pairing;
-  }
-  if (!warm || pairing.segment.size() != static_cast<size_t>(nc)) pairing = contact.search(u0_s);
+  // Start from the unconstrained solution, or from a previous solution if given.
+  const bool use_warm = warm && warm->lambda.size() == nc && warm->u.size() == m_problem.num_dofs();
+  if (use_warm) lambda = warm->lambda;
+  Eigen::VectorXd x = use_warm ? contact.restrict_to_surface(warm->u) : u0_s;
+  Pairing pairing = contact.search(x);
 
   DualQpSolver qp(m_options.qp);
   ConstraintMatrix c;
-  Eigen::VectorXd g, u_s = u0_s;
+  Eigen::VectorXd g;
+  Eigen::MatrixXd sct;  // S Cᵀ, n_s x n_c
   bool converged = false;
+  // Fixed point x -> F(x) on the surface displacement: pairing from x, exact dual
+  // QP for that pairing, F(x) = resulting surface displacement. Anderson
+  // acceleration (Walker & Ni 2011, type II) on x; the QP is always solved exactly,
+  // so the extrapolated x only chooses the pairing.
+  Eigen::VectorXd f_prev, r_prev;
+  std::vector<Eigen::VectorXd> d_f, d_r;
   for (int it = 0; it < m_options.max_pairing_iterations; ++it) {
     ++sol.pairing_iterations;
     contact.assemble(pairing, c, g);
-    const Eigen::MatrixXd cs = c * cond.s;           // n_c x n_s
-    const Eigen::MatrixXd delassus = cs * c.transpose();
+    delassus_parts(c, cond.s, sct);
+    const Eigen::MatrixXd delassus = c * sct;
     const Eigen::VectorXd h = c * u0_s - g;
     std::vector<char> eligible(nc, 1);
     for (int s = 0; s < nc; ++s)
@@ -135,18 +163,40 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
       sol.message = "dual active-set QP failed: " + std::string(to_string(qp.info()));
       break;
     }
-    u_s = u0_s - cs.transpose() * lambda;
+    const Eigen::VectorXd f = u0_s - sct * lambda;
     if (!contact.has_pairing()) {
       converged = true;
       break;
     }
-    Pairing next = contact.search(u_s);
-    const bool same = next.same_as(pairing, m_options.pairing_tolerance);
-    pairing = std::move(next);
-    if (same) {
+    // Converged when re-pairing at F(x) no longer changes the KKT system of
+    // this solution: the forces Cᵀλ, the gaps of active/penetrating rows and
+    // the penetration, each to `pairing_tolerance` (relative).
+    const Pairing next = contact.search(f);
+    ConstraintMatrix c_next;
+    Eigen::VectorXd g_next;
+    contact.assemble(next, c_next, g_next);
+    if (pairing_settled(c, g, c_next, g_next, f, lambda, contact.weights(), m_problem.displacement_scale(),
+                        m_options.pairing_tolerance)) {
       converged = true;
       break;
     }
+    const Eigen::VectorXd r = f - x;
+    if (it > 0) {
+      if (r.norm() > r_prev.norm()) d_f.clear(), d_r.clear();  // restart on growth
+      d_f.push_back(f - f_prev);
+      d_r.push_back(r - r_prev);
+      if (static_cast<int>(d_f.size()) > m_options.anderson_depth) d_f.erase(d_f.begin()), d_r.erase(d_r.begin());
+    }
+    f_prev = f;
+    r_prev = r;
+    x = f;
+    if (!d_r.empty() && m_options.anderson_depth > 0) {
+      Eigen::MatrixXd dr(r.size(), d_r.size()), df(r.size(), d_f.size());
+      for (size_t k = 0; k < d_r.size(); ++k) dr.col(k) = d_r[k], df.col(k) = d_f[k];
+      const Eigen::VectorXd gamma = dr.colPivHouseholderQr().solve(r);
+      if (gamma.allFinite()) x = f - df * gamma;
+    }
+    pairing = contact.search(x);
   }
   if (!converged && sol.status == Status::Success) {
     sol.status = Status::NoConvergence;

@@ -11,7 +11,7 @@
 ///  2. Per query: \f$ u_0(\mu) \f$ unconstrained; loop { pairing from u (deformed
 ///     configuration) → \f$ C, g \f$ → Delassus \f$ G = C S C^T \f$,
 ///     \f$ h = C u_{0,s} - g \f$ → dual QP (DualQpSolver) →
-///     \f$ u_s = u_{0,s} - S C^T\lambda \f$ } until the pairing no longer changes;
+///     \f$ u_s = u_{0,s} - S C^T\lambda \f$ } until re-pairing no longer changes the KKT system;
 ///     then \f$ u = u_0 - Z_s C^T \lambda \f$.
 /// solve() is const and thread-safe (no factorisation state is touched per query
 /// when the stiffness is parameter-independent).
@@ -41,7 +41,11 @@ struct FomSolution {
 /// \brief Options of ActiveSetSolver (documented defaults).
 struct ActiveSetOptions {
   int max_pairing_iterations = 50;  ///< cap of the pairing fixed point, default 50
-  double pairing_tolerance = 1e-12; ///< max change of ξ and of normal components to stop, default 1e-12
+  /// The pairing loop stops when re-pairing at the current solution changes the
+  /// contact forces Cᵀλ (relative to |Cᵀλ|), the gaps of active rows and the
+  /// penetration (relative to the displacement scale) by at most this; default 1e-12.
+  double pairing_tolerance = 1e-12;
+  int anderson_depth = 5;           ///< Anderson acceleration depth of the pairing fixed point (0: plain), default 5
   DualQpOptions qp;                 ///< options of the dual QP solve
 };
 

@@ -7,10 +7,13 @@
 namespace contactrom::fom {
 
 bool Pairing::same_as(const Pairing& other, double tol) const {
-  if (segment != other.segment || xi.size() != other.xi.size()) return false;
-  for (size_t s = 0; s < xi.size(); ++s) {
+  if (segment.size() != other.segment.size()) return false;
+  for (size_t s = 0; s < segment.size(); ++s) {
+    if ((segment[s] < 0) != (other.segment[s] < 0)) return false;
     if (segment[s] < 0) continue;
-    if (std::abs(xi[s] - other.xi[s]) > tol) return false;
+    // Position along the master chain, continuous across segment ends: a slave
+    // node moving from the end of segment j to the start of j+1 is no change.
+    if (std::abs(segment[s] + xi[s] - other.segment[s] - other.xi[s]) > tol) return false;
     if ((normal.col(s) - other.normal.col(s)).cwiseAbs().maxCoeff() > tol) return false;
   }
   return true;
@@ -65,6 +68,19 @@ Pairing NodeToSegmentContact::search(const Eigen::VectorXd& u_surface) const {
   for (int k = 0; k < ns; ++k) xs.col(k) += u_surface.segment<2>(2 * k);
   for (int j = 0; j < nm; ++j) xm.col(j) += u_surface.segment<2>(2 * (ns + j));
 
+  // Nodal normals of the deformed master surface (average of the adjacent
+  // segments' outward normals): interpolating them along a segment gives a
+  // normal field that is continuous across master nodes, so the constraint row
+  // does not jump when a slave node passes from one segment to the next.
+  Eigen::Matrix2Xd seg_normal(2, std::max(nm - 1, 0)), node_normal = Eigen::Matrix2Xd::Zero(2, nm);
+  for (int j = 0; j + 1 < nm; ++j) {
+    const Eigen::Vector2d t = xm.col(j + 1) - xm.col(j);
+    seg_normal.col(j) = m_orientation[j] * Eigen::Vector2d(t.y(), -t.x()).normalized();
+    node_normal.col(j) += seg_normal.col(j);
+    node_normal.col(j + 1) += seg_normal.col(j);
+  }
+  for (int j = 0; j < nm; ++j) node_normal.col(j).normalize();
+
   Pairing p;
   p.segment.assign(ns, -1);
   p.xi.assign(ns, 0.0);
@@ -82,10 +98,9 @@ Pairing NodeToSegmentContact::search(const Eigen::VectorXd& u_surface) const {
     }
     // A projection beyond either end of the master chain is no contact pair.
     if (best_seg < 0 || (best_seg == 0 && best_raw < 0.0) || (best_seg == nm - 2 && best_raw > 1.0)) continue;
-    const Eigen::Vector2d t = xm.col(best_seg + 1) - xm.col(best_seg);
     p.segment[k] = best_seg;
     p.xi[k] = best_xi;
-    p.normal.col(k) = m_orientation[best_seg] * Eigen::Vector2d(t.y(), -t.x()).normalized();
+    p.normal.col(k) = ((1.0 - best_xi) * node_normal.col(best_seg) + best_xi * node_normal.col(best_seg + 1)).normalized();
   }
   return p;
 }

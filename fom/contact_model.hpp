@@ -22,14 +22,17 @@ namespace contactrom::fom {
 using ConstraintMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
 /// \brief Contact pairing: for every constraint row, the master segment it is
-/// projected on (-1: unpaired), the local coordinate ξ ∈ [0,1] on it and the
-/// master's outward unit normal, all in the deformed configuration.
+/// projected on (closest point, -1: unpaired), the local coordinate ξ ∈ [0,1] on
+/// it and the master's outward unit normal there, all in the deformed
+/// configuration. The normal interpolates nodal (averaged) normals so that it
+/// is continuous along the master chain.
 /// Empty vectors for models without pairing (obstacles).
 struct Pairing {
   std::vector<int> segment;
   std::vector<double> xi;
   Eigen::Matrix2Xd normal;
-  /// True when both pairings use the same segments and ξ, n agree to `tol`.
+  /// True when both pairings pair the same rows, their chain positions
+  /// (segment + ξ) and normals agree to `tol`.
   bool same_as(const Pairing& other, double tol) const;
 };
 

@@ -1,0 +1,59 @@
+#pragma once
+/// \file ipopt_qp.hpp
+/// \brief Reference FOM solver: the same QP as fom::ActiveSetSolver (sparse
+/// Hessian K on the free dofs, linear constraints C u ≤ g, same lifting) solved
+/// by Ipopt (interior point, Wächter & Biegler 2006) inside the same contact
+/// pairing fixed-point loop. Used to cross-validate the custom active-set solver.
+#include <memory>
+
+#include "fom/active_set_solver.hpp"
+#include "fom/problem.hpp"
+
+namespace contactrom::baselines {
+
+/// \brief Options of IpoptQpSolver (documented defaults).
+struct IpoptOptions {
+  double tol = 1e-12;               ///< Ipopt `tol` (default 1e-12, tight for cross-validation)
+  int max_iterations = 3000;        ///< Ipopt `max_iter` per QP solve (default 3000)
+  int print_level = 0;              ///< Ipopt `print_level`; 0 with `sb = yes` silences Ipopt (default 0)
+  int max_pairing_iterations = 50;  ///< cap of the pairing fixed point (default 50)
+  double pairing_tolerance = 1e-12; ///< max change of ξ and normals to stop (default 1e-12)
+  /// A row counts as active (FomSolution::active) when \f$ \lambda_s > \f$ active_tolerance
+  /// \f$ \cdot \max_s \lambda_s \f$: an interior-point method leaves tiny positive multipliers
+  /// (≈ barrier parameter / slack) on inactive rows (default 1e-8).
+  double active_tolerance = 1e-8;
+};
+
+/// \brief Ipopt solver of the FOM contact QP. Ipopt's status maps to
+/// contactrom::Status (Solve_Succeeded/Solved_To_Acceptable_Level → Success,
+/// Maximum_Iterations_Exceeded → NoConvergence, others → NumericalIssue) and its
+/// constraint multipliers are returned as pressures. Maximum_CpuTime_Exceeded also
+/// maps to NoConvergence. On failure the message names Ipopt's status and the KKT
+/// residuals (fom/kkt.hpp) of the returned last iterate.
+///
+/// Each QP solve creates its own IpoptApplication. solve() is const and may be called
+/// from several threads, but the Ipopt calls are serialised by a process-wide mutex
+/// (Ipopt 3.11 with sequential MUMPS is not known to be re-entrant).
+///
+/// Variables are the free dofs of \f$ u_0 \f$ (\f$ u = u_{lift}(\mu) + u_0 \f$); the objective
+/// \f$ \tfrac12 u_0^T K_{ff} u_0 - f_f^T u_0 \f$ has the constant Hessian \f$ K_{ff} \f$ (lower
+/// triangle), the constraints are \f$ C_{\cdot f}\, u_{0,f} \le g - C u_{lift} \f$ for paired
+/// rows touching a free dof; other rows are dropped and get \f$ \lambda_s = 0 \f$. The pairing
+/// fixed point starts from the configuration \f$ u = u_{lift} \f$ (or from `warm`).
+class IpoptQpSolver {
+ public:
+  explicit IpoptQpSolver(const fom::Problem& problem, IpoptOptions options = {});
+  ~IpoptQpSolver();
+  /// \brief Solves at `mu` (range-checked). Never throws on numerical failure:
+  /// the status and message of the returned solution say what happened.
+  fom::FomSolution solve(const fom::Param& mu, const fom::FomSolution* warm = nullptr) const;
+  /// Time spent in the constructor extracting the constant \f$ K_{ff} \f$ (0 for rope's μ-dependent K).
+  double setup_time() const;
+  const IpoptOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace contactrom::baselines

@@ -1,0 +1,106 @@
+#include "fom/field_output.hpp"
+
+#include <filesystem>
+#include <iomanip>
+#include <limits>
+
+#include "fom/atomic_file.hpp"
+#include "fom/errors.hpp"
+#include "fom/kkt.hpp"
+
+namespace contactrom::fom {
+namespace {
+
+void data_array(std::ostream& out, const char* name, int components, const Eigen::MatrixXd& values) {
+  // values: one row per point/cell, `components` columns
+  out << "        <DataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\"" << components
+      << "\" format=\"ascii\">\n";
+  for (int i = 0; i < values.rows(); ++i) {
+    out << "         ";
+    for (int c = 0; c < components; ++c) out << ' ' << values(i, c);
+    out << '\n';
+  }
+  out << "        </DataArray>\n";
+}
+
+}  // namespace
+
+void ensure_directory(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw InputError("cannot create output folder '" + dir + "': " + (ec ? ec.message() : "not a folder"));
+}
+
+void write_vtu(const std::string& path, const Problem& problem, const Eigen::VectorXd& u,
+               const Eigen::VectorXd& lambda) {
+  const Mesh* mesh = problem.mesh();
+  const ContactModel& contact = problem.contact();
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << std::setprecision(std::numeric_limits<double>::max_digits10);
+    const int np = mesh ? mesh->num_nodes() : static_cast<int>(problem.rope_x().size());
+    const int ncell = mesh ? mesh->num_quads() : np - 1;
+    out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+        << "  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"" << np << "\" NumberOfCells=\"" << ncell << "\">\n";
+    Eigen::MatrixXd pts = Eigen::MatrixXd::Zero(np, 3);
+    for (int i = 0; i < np; ++i) {
+      if (mesh) pts.row(i).head(2) = mesh->nodes.col(i).transpose();
+      else pts(i, 0) = problem.rope_x()(i);
+    }
+    out << "      <Points>\n";
+    data_array(out, "Points", 3, pts);
+    out << "      </Points>\n      <Cells>\n"
+        << "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+    for (int c = 0; c < ncell; ++c) {
+      out << "         ";
+      if (mesh) for (int a = 0; a < 4; ++a) out << ' ' << mesh->quads[c][a];
+      else out << ' ' << c << ' ' << c + 1;
+      out << '\n';
+    }
+    out << "        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n         ";
+    for (int c = 0; c < ncell; ++c) out << ' ' << (mesh ? 4 : 2) * (c + 1);
+    out << "\n        </DataArray>\n        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n         ";
+    for (int c = 0; c < ncell; ++c) out << ' ' << (mesh ? 9 : 3);
+    out << "\n        </DataArray>\n      </Cells>\n      <PointData Vectors=\"displacement\">\n";
+    Eigen::MatrixXd disp = Eigen::MatrixXd::Zero(np, 3), press = Eigen::MatrixXd::Zero(np, 1);
+    for (int i = 0; i < np; ++i)
+      for (int d = 0; d < problem.dofs_per_node(); ++d) disp(i, d) = u(problem.dofs_per_node() * i + d);
+    // Constraint row s sits on the node of its first surface dof column.
+    const std::vector<int>& surf = contact.surface_dofs();
+    for (int s = 0; s < contact.num_constraints(); ++s)
+      press(surf[problem.dofs_per_node() * s] / problem.dofs_per_node(), 0) = lambda(s);
+    data_array(out, "displacement", 3, disp);
+    data_array(out, "contact_pressure", 1, press);
+    out << "      </PointData>\n";
+    if (mesh) {
+      const Eigen::MatrixXd stress = element_stresses(*mesh, problem.materials(), u);
+      Eigen::MatrixXd body(ncell, 1);
+      for (int c = 0; c < ncell; ++c) body(c, 0) = mesh->quad_body[c];
+      out << "      <CellData>\n";
+      data_array(out, "stress", 4, stress.leftCols(4));
+      data_array(out, "von_mises", 1, stress.col(4));
+      data_array(out, "body", 1, body);
+      out << "      </CellData>\n";
+    }
+    out << "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  });
+}
+
+void write_surface_csv(const std::string& path, const Problem& problem, const Eigen::VectorXd& u,
+                       const Eigen::VectorXd& lambda) {
+  const ContactModel& contact = problem.contact();
+  const Eigen::VectorXd gap = normal_gaps(problem, u);
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << std::setprecision(std::numeric_limits<double>::max_digits10);
+    out << "x,y,gap,pressure\n";
+    for (int s = 0; s < contact.num_constraints(); ++s) {
+      const double y = problem.mesh() ? contact.constraint_points()(1, s) : u(s);
+      out << contact.constraint_points()(0, s) << ',' << y << ',';
+      if (std::isfinite(gap(s))) out << gap(s);
+      else out << "inf";
+      out << ',' << lambda(s) << '\n';
+    }
+  });
+}
+
+}  // namespace contactrom::fom

@@ -1,0 +1,29 @@
+#pragma once
+/// \file field_output.hpp
+/// \brief Field output for ParaView and plotting: VTU (XML UnstructuredGrid,
+/// ASCII) with displacement, stress and contact pressure, and a CSV of the
+/// contact surface (x, y, gap, pressure). Files are written atomically.
+#include <Eigen/Dense>
+#include <string>
+
+#include "fom/problem.hpp"
+
+namespace contactrom::fom {
+
+/// \brief Writes `path` (.vtu): points in the reference configuration, point data
+/// `displacement` (3 components) and `contact_pressure` (on constrained nodes),
+/// cell data `stress` (σxx, σyy, σxy, σzz), `von_mises` and `body`.
+/// The 1D rope is written as line cells with a scalar `displacement`.
+void write_vtu(const std::string& path, const Problem& problem, const Eigen::VectorXd& u,
+               const Eigen::VectorXd& lambda);
+
+/// \brief Writes the contact surface CSV: columns `x,y,gap,pressure` (one row per
+/// constraint, reference coordinates, gap with the pairing recomputed from u;
+/// rope: y is the displacement).
+void write_surface_csv(const std::string& path, const Problem& problem, const Eigen::VectorXd& u,
+                       const Eigen::VectorXd& lambda);
+
+/// \brief Creates `dir` (and parents) if needed; throws InputError naming it on failure.
+void ensure_directory(const std::string& dir);
+
+}  // namespace contactrom::fom

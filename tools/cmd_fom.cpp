@@ -1,0 +1,85 @@
+// contactrom fom --problem P --param V[,V2] [--solver active-set|ipopt] [--out DIR] [--json]
+// Solves one FOM query and prints a summary (or one JSON object with --json);
+// --out DIR writes DIR/<problem>.vtu (displacement, stress, pressure) and
+// DIR/<problem>_surface.csv (x, y, gap, pressure).
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "baselines/ipopt_qp.hpp"
+#include "fom/active_set_solver.hpp"
+#include "fom/field_output.hpp"
+#include "fom/kkt.hpp"
+#include "tools/cli.hpp"
+#include "tools/cli_common.hpp"
+
+namespace contactrom::cli {
+namespace {
+
+struct FomArgs {
+  std::string problem, param, solver = "active-set", out;
+  bool json = false;
+};
+
+void run_fom(const FomArgs& a) {
+  auto problem = fom::make_problem(a.problem);
+  const fom::Param mu = fom::parse_param(*problem, a.param);
+  fom::FomSolution sol;
+  double setup = 0.0;
+  if (a.solver == "active-set") {
+    fom::ActiveSetSolver solver(*problem);
+    setup = solver.setup_time();
+    sol = solver.solve(mu);
+  } else {
+    baselines::IpoptQpSolver solver(*problem);
+    sol = solver.solve(mu);
+  }
+  const fom::KktResiduals kkt = fom::kkt_residuals(*problem, mu, sol.u, sol.lambda);
+  if (!a.out.empty()) {
+    fom::ensure_directory(a.out);
+    fom::write_vtu(a.out + "/" + problem->name() + ".vtu", *problem, sol.u, sol.lambda);
+    fom::write_surface_csv(a.out + "/" + problem->name() + "_surface.csv", *problem, sol.u, sol.lambda);
+  }
+  nlohmann::json j;
+  j["problem"] = problem->name();
+  j["param"] = param_json(mu);
+  j["solver"] = a.solver;
+  j["status"] = to_string(sol.status);
+  if (!sol.message.empty()) j["message"] = sol.message;
+  j["iterations"] = sol.iterations;
+  j["pairing_iterations"] = sol.pairing_iterations;
+  j["active"] = sol.active;
+  j["time_s"] = sol.time_s;
+  j["setup_time_s"] = setup;
+  j["contact_force"] = fom::contact_force(*problem, sol.lambda);
+  j["kkt"] = kkt_json(kkt);
+  if (a.json) {
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::cout << "problem " << problem->name() << "  " << problem->range_text() << "\n"
+            << "param   " << j["param"].dump() << "   solver " << a.solver << "   status " << j["status"].get<std::string>()
+            << (sol.message.empty() ? "" : " (" + sol.message + ")") << "\n"
+            << "active contact rows " << sol.active << " of " << problem->contact().num_constraints()
+            << ", active-set iterations " << sol.iterations << ", pairing iterations " << sol.pairing_iterations << "\n"
+            << std::setprecision(3) << "contact force " << j["contact_force"].get<double>() << ", time "
+            << sol.time_s * 1e3 << " ms (setup " << setup * 1e3 << " ms)\n"
+            << "KKT (relative): stationarity " << kkt.stationarity << ", penetration " << kkt.penetration
+            << ", negative pressure " << kkt.negative_pressure << ", complementarity " << kkt.complementarity << "\n";
+  if (!a.out.empty()) std::cout << "fields written to " << a.out << "/\n";
+}
+
+CommandRegistrar reg("fom", [](CLI::App& app) {
+  auto args = std::make_shared<FomArgs>();
+  auto* sub = app.add_subcommand("fom", "Solve one full-order contact problem");
+  sub->add_option("--problem", args->problem, "rope | hertz | ironing | ironing2")->required();
+  sub->add_option("--param", args->param, "parameter value, V or V1,V2 (ironing2)")->required();
+  sub->add_option("--solver", args->solver, "active-set (default) | ipopt")
+      ->check(CLI::IsMember({"active-set", "ipopt"}));
+  sub->add_option("--out", args->out, "folder for <problem>.vtu and <problem>_surface.csv");
+  sub->add_flag("--json", args->json, "print one JSON object");
+  sub->callback([args] { run_fom(*args); });
+});
+
+}  // namespace
+}  // namespace contactrom::cli
