@@ -1,0 +1,293 @@
+#include "rom/nnls.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace contactrom::rom {
+
+using Eigen::Index;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+MatrixXd gram_matrix(const MatrixXd& a) {
+  MatrixXd gram = MatrixXd::Zero(a.cols(), a.cols());
+  gram.selfadjointView<Eigen::Lower>().rankUpdate(a.transpose());
+  gram.triangularView<Eigen::StrictlyUpper>() = gram.transpose();
+  return gram;
+}
+
+// ---------------------------------------------------------------------------
+// GramCholesky
+// ---------------------------------------------------------------------------
+
+GramCholesky::GramCholesky(Index capacity) { reset(capacity); }
+
+void GramCholesky::reset(Index capacity) {
+  if (m_r.rows() < capacity) m_r.resize(capacity, capacity);
+  m_indices.clear();
+  m_indices.reserve(static_cast<std::size_t>(capacity));
+}
+
+bool GramCholesky::append(const MatrixXd& gram, Index j, double dependence_tolerance) {
+  const Index k = size();
+  if (k >= m_r.rows()) {
+    // More indices than announced: grow geometrically, keeping R.
+    const Index capacity = std::max<Index>(2 * m_r.rows(), k + 1);
+    m_r.conservativeResize(capacity, capacity);
+  }
+  const double g_jj = gram(j, j);
+  if (!(g_jj > 0.0)) return false;  // zero (or invalid) column: never part of a basis
+
+  // New last column of R: R^T r = G_Ij; new pivot d^2 = G_jj - |r|^2.
+  auto r = m_r.col(k).head(k);
+  for (Index i = 0; i < k; ++i) r(i) = gram(m_indices[static_cast<std::size_t>(i)], j);
+  m_r.topLeftCorner(k, k).triangularView<Eigen::Upper>().transpose().solveInPlace(r);
+  const double pivot_squared = g_jj - r.squaredNorm();
+  // d^2 / G_jj is the squared sine of the angle between column j and the span of
+  // the held columns; below the threshold the column is a combination of them and
+  // R would become (numerically) singular.
+  if (!(pivot_squared > dependence_tolerance * g_jj)) return false;
+  m_r(k, k) = std::sqrt(pivot_squared);
+  m_indices.push_back(j);
+  return true;
+}
+
+void GramCholesky::remove(Index position) {
+  const Index k = size();
+  // Deleting column `position` of R leaves an upper-Hessenberg tail; shift the
+  // later columns left, then zero the subdiagonal with one Givens rotation per
+  // column (rows c, c+1), as in Golub & Van Loan, Matrix Computations, §6.5.2.
+  for (Index c = position; c + 1 < k; ++c) m_r.col(c).head(c + 2) = m_r.col(c + 1).head(c + 2);
+  for (Index c = position; c + 1 < k; ++c) {
+    const double a = m_r(c, c);
+    const double b = m_r(c + 1, c);  // > 0: it was the diagonal of the removed order
+    const double h = std::hypot(a, b);
+    const double cs = a / h;
+    const double sn = b / h;
+    m_r(c, c) = h;
+    m_r(c + 1, c) = 0.0;
+    for (Index col = c + 1; col + 1 < k; ++col) {
+      const double t1 = m_r(c, col);
+      const double t2 = m_r(c + 1, col);
+      m_r(c, col) = cs * t1 + sn * t2;
+      m_r(c + 1, col) = -sn * t1 + cs * t2;
+    }
+  }
+  m_indices.erase(m_indices.begin() + position);
+}
+
+void GramCholesky::solve_in_place(VectorXd& rhs) const {
+  const Index k = size();
+  const auto r = m_r.topLeftCorner(k, k).triangularView<Eigen::Upper>();
+  r.transpose().solveInPlace(rhs);
+  r.solveInPlace(rhs);
+}
+
+// ---------------------------------------------------------------------------
+// NnlsQp
+// ---------------------------------------------------------------------------
+
+NnlsQp& NnlsQp::compute(const MatrixXd& gram) {
+  if (gram.rows() != gram.cols()) {
+    m_gram.resize(0, 0);
+    m_computed = false;
+    m_info = Status::InvalidInput;
+    return *this;
+  }
+  MatrixXd full = gram.selfadjointView<Eigen::Upper>();
+  return compute_from_owned(std::move(full));
+}
+
+NnlsQp& NnlsQp::compute_from_owned(MatrixXd&& gram) {
+  m_gram = std::move(gram);
+  m_iterations = 0;
+  const bool valid = m_gram.allFinite() && (m_gram.size() == 0 || m_gram.diagonal().minCoeff() >= 0.0);
+  m_computed = valid;
+  m_info = valid ? Status::Success : Status::InvalidInput;
+  m_factor.reset(m_gram.cols());
+  return *this;
+}
+
+VectorXd NnlsQp::solve(const VectorXd& c) { return run(c, nullptr); }
+
+VectorXd NnlsQp::solve(const VectorXd& c, const VectorXd& x0) { return run(c, &x0); }
+
+VectorXd NnlsQp::run(const VectorXd& c, const VectorXd* x0) {
+  const Index n = m_gram.cols();
+  m_iterations = 0;
+  m_factor.reset(n);
+  VectorXd x = VectorXd::Zero(n);
+  if (!m_computed || c.size() != n || !c.allFinite() || (x0 && (x0->size() != n || !x0->allFinite()))) {
+    m_info = Status::InvalidInput;
+    return x;
+  }
+  m_info = Status::Success;
+  if (n == 0) return x;
+
+  const int max_iterations = m_options.max_iterations > 0 ? m_options.max_iterations : static_cast<int>(3 * n);
+  const double dep_tol = m_options.dependence_tolerance;
+  const double c_scale = c.lpNorm<Eigen::Infinity>();
+
+  std::vector<char> is_free(static_cast<std::size_t>(n), 0);
+  // Variables refused since the free set last changed: numerically dependent on
+  // the free ones, or whose least-squares value came out non-positive although
+  // their gradient said they should enter (possible only through rounding).
+  std::vector<char> refused(static_cast<std::size_t>(n), 0);
+  const auto clear_refused = [&] { std::fill(refused.begin(), refused.end(), 0); };
+
+  // Warm start: free the positive entries of x0 that are independent of the
+  // previously freed ones; x stays feasible (x >= 0) throughout.
+  bool start_with_inner_loop = false;
+  if (x0) {
+    for (Index j = 0; j < n; ++j) {
+      if ((*x0)(j) > 0.0 && m_factor.append(m_gram, j, dep_tol)) {
+        x(j) = (*x0)(j);
+        is_free[static_cast<std::size_t>(j)] = 1;
+      }
+    }
+    start_with_inner_loop = m_factor.size() > 0;
+  }
+
+  VectorXd z;
+  VectorXd w(n);
+  Index newly_freed = -1;
+  while (true) {
+    if (!start_with_inner_loop) {
+      // ---- Outer loop: optimality test on the bound variables (w = c - Gx). ----
+      VectorXd gx = VectorXd::Zero(n);
+      for (const Index j : m_factor.indices()) gx.noalias() += m_gram.col(j) * x(j);
+      w = c - gx;
+      const double threshold = m_options.tolerance * std::max(c_scale, gx.lpNorm<Eigen::Infinity>());
+      Index best = -1;
+      for (Index j = 0; j < n; ++j) {
+        const auto sj = static_cast<std::size_t>(j);
+        if (is_free[sj] || refused[sj]) continue;
+        if (best < 0 || w(j) > w(best)) best = j;
+      }
+      if (best < 0 || w(best) <= threshold) {
+        // Converged, unless a refused variable still descends far above rounding
+        // level: c then has a component outside range(G) that cannot be reached.
+        const double unbounded_threshold = std::sqrt(m_options.tolerance) * std::max(c_scale, gx.lpNorm<Eigen::Infinity>());
+        for (Index j = 0; j < n; ++j) {
+          if (refused[static_cast<std::size_t>(j)] && w(j) > unbounded_threshold) m_info = Status::NumericalIssue;
+        }
+        break;
+      }
+      if (m_iterations >= max_iterations) {
+        m_info = Status::NoConvergence;
+        break;
+      }
+      ++m_iterations;
+      if (!m_factor.append(m_gram, best, dep_tol)) {
+        refused[static_cast<std::size_t>(best)] = 1;
+        continue;
+      }
+      is_free[static_cast<std::size_t>(best)] = 1;
+      newly_freed = best;
+    }
+    start_with_inner_loop = false;
+
+    // ---- Inner loop: least squares on the free set, stepping back to keep x >= 0. ----
+    bool stop = false;
+    while (true) {
+      const auto& free_set = m_factor.indices();
+      const Index k = m_factor.size();
+      z.resize(k);
+      for (Index i = 0; i < k; ++i) z(i) = c(free_set[static_cast<std::size_t>(i)]);
+      m_factor.solve_in_place(z);
+      if (!z.allFinite()) {
+        m_info = Status::NumericalIssue;
+        stop = true;
+        break;
+      }
+      if (newly_freed >= 0) {
+        // Lawson–Hanson (Lemma 23.17): with w_j > 0 the entering variable is
+        // positive in exact arithmetic. If rounding says otherwise, undo the entry
+        // instead of taking a zero-length step that would cycle.
+        const Index j = newly_freed;
+        newly_freed = -1;
+        if (!(z(k - 1) > 0.0)) {
+          m_factor.remove(k - 1);
+          is_free[static_cast<std::size_t>(j)] = 0;
+          refused[static_cast<std::size_t>(j)] = 1;
+          break;
+        }
+        clear_refused();
+      }
+      if (k == 0 || z.minCoeff() > 0.0) {
+        for (Index i = 0; i < k; ++i) x(free_set[static_cast<std::size_t>(i)]) = z(i);
+        break;
+      }
+      // Longest step from x towards z that keeps x >= 0; the blocking variable
+      // leaves the free set (together with any other that reached zero).
+      double step = 1.0;
+      Index blocking = -1;
+      for (Index i = 0; i < k; ++i) {
+        if (z(i) > 0.0) continue;
+        const double xi = x(free_set[static_cast<std::size_t>(i)]);
+        const double ratio = xi / (xi - z(i));
+        if (blocking < 0 || ratio < step) {
+          step = ratio;
+          blocking = i;
+        }
+      }
+      for (Index i = 0; i < k; ++i) {
+        const Index j = free_set[static_cast<std::size_t>(i)];
+        x(j) += step * (z(i) - x(j));
+      }
+      x(free_set[static_cast<std::size_t>(blocking)]) = 0.0;
+      for (Index i = k - 1; i >= 0; --i) {
+        const Index j = m_factor.indices()[static_cast<std::size_t>(i)];
+        if (x(j) <= 0.0) {
+          x(j) = 0.0;
+          is_free[static_cast<std::size_t>(j)] = 0;
+          m_factor.remove(i);
+        }
+      }
+      clear_refused();
+      if (m_iterations >= max_iterations) {
+        m_info = Status::NoConvergence;
+        stop = true;
+        break;
+      }
+      ++m_iterations;
+    }
+    if (stop) break;
+  }
+  return x;
+}
+
+// ---------------------------------------------------------------------------
+// Nnls
+// ---------------------------------------------------------------------------
+
+Nnls& Nnls::compute(const MatrixXd& a) {
+  m_a = a;
+  m_computed = a.allFinite();
+  if (!m_computed) {
+    m_qp.compute_from_owned(MatrixXd::Zero(a.cols(), a.cols()));
+    m_qp.m_computed = false;
+    m_info = Status::InvalidInput;
+    return *this;
+  }
+  m_qp.compute_from_owned(gram_matrix(a));
+  m_info = m_qp.info();
+  return *this;
+}
+
+VectorXd Nnls::solve(const VectorXd& b) { return run(b, nullptr); }
+
+VectorXd Nnls::solve(const VectorXd& b, const VectorXd& x0) { return run(b, &x0); }
+
+VectorXd Nnls::run(const VectorXd& b, const VectorXd* x0) {
+  if (!m_computed || b.size() != m_a.rows() || !b.allFinite()) {
+    m_info = Status::InvalidInput;
+    return VectorXd::Zero(m_a.cols());
+  }
+  const VectorXd c = m_a.transpose() * b;
+  VectorXd x = x0 ? m_qp.solve(c, *x0) : m_qp.solve(c);
+  m_info = m_qp.info();
+  return x;
+}
+
+}  // namespace contactrom::rom
