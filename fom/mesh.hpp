@@ -14,8 +14,17 @@ namespace contactrom::fom {
 
 /// \brief A 2D Q1 mesh with named node/segment groups.
 ///
-/// Node numbering is contiguous 0..num_nodes()-1; two bodies that touch keep
-/// distinct nodes. Quads are counter-clockwise.
+/// Node numbering is contiguous 0..num_nodes()-1, body after body (in
+/// `body_names` order), and within a body by ascending gmsh node tag; it is
+/// deterministic for a given file and gmsh version. Two bodies that touch keep
+/// distinct nodes. Quads are counter-clockwise (positive signed area).
+///
+/// Curve chains are oriented with their body on the LEFT, i.e. they run
+/// counter-clockwise around the body that owns them, so for a segment with unit
+/// tangent \f$ t = (x_b - x_a)/|x_b - x_a| \f$ the outward normal of the body is
+/// \f$ n = (t_y, -t_x) \f$. (The body is the one whose quad has the first
+/// segment as an edge; an open chain therefore starts at the end that keeps the
+/// body on the left; a closed chain starts at its smallest node id.)
 struct Mesh {
   Eigen::Matrix2Xd nodes;                     ///< reference coordinates, 2 x n
   std::vector<std::array<int, 4>> quads;      ///< node ids, counter-clockwise
@@ -25,7 +34,7 @@ struct Mesh {
   /// from one end of the curve to the other (consecutive segments share a node).
   std::map<std::string, std::vector<std::array<int, 2>>> segments;
   /// Physical curve name -> its node ids, in chain order (one more than segments
-  /// for an open curve).
+  /// for an open curve, as many as segments for a closed one).
   std::map<std::string, std::vector<int>> curve_nodes;
 
   int num_nodes() const { return static_cast<int>(nodes.cols()); }
@@ -34,16 +43,32 @@ struct Mesh {
   const std::vector<int>& group_nodes(const std::string& name) const;
   /// Segments of a named curve; throws InputError naming the group if absent.
   const std::vector<std::array<int, 2>>& group_segments(const std::string& name) const;
-  /// 64-bit FNV-1a hash of coordinates (rounded to 1e-12) and connectivity, as
-  /// 16 hex digits; databases store it to refuse a mesh they were not built on.
+  /// 64-bit FNV-1a hash of coordinates (rounded to 1e-12) and connectivity
+  /// (quads, their bodies, body names, curve names and chains), as 16 lower-case
+  /// hex digits; databases store it to refuse a mesh they were not built on.
   std::string fingerprint() const;
 };
 
 /// \brief Meshes a `.geo` file (or reads a `.msh`) with the gmsh API and returns
 /// the Q1 mesh. Only quadrilateral surface elements are accepted.
+///
+/// Bodies are the physical surfaces, in ascending physical tag order; named
+/// boundaries are the physical curves (each must be one chain of 2-node lines
+/// whose segments are quad edges). Unnamed groups are named after their tag.
+/// Elements outside physical surfaces are ignored. A `.geo` file is meshed with
+/// `gmsh::model::mesh::generate(2)` and the options set in the file; a `.msh`
+/// file is read as is.
+///
+/// Each call opens and closes its own gmsh session (initialize ... finalize,
+/// no config files, nothing printed), so it may be called any number of times,
+/// but NOT concurrently from several threads, and not while the caller itself
+/// holds a gmsh session (gmsh keeps its state in globals). Keep it out of hot
+/// loops: a session costs about 0.01-0.1 s.
 /// \param path file to read
-/// \throws InputError if the file is missing, unreadable, produces non-quad
-///   elements, or lacks physical groups.
+/// \throws InputError if the file is missing ("mesh file 'X' not found"),
+///   unreadable, rejected by gmsh (syntax error, meshing error; the message names
+///   the file and quotes gmsh), produces non-quad elements, lacks physical
+///   groups, or has a curve group that is not a single chain.
 Mesh load_mesh(const std::string& path);
 
 /// \brief The folder holding the project's `.geo` files: `$CONTACTROM_MESH_DIR`

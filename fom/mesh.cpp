@@ -1,0 +1,434 @@
+#include "fom/mesh.hpp"
+
+#include <gmsh.h>
+
+#include <algorithm>
+#include <cctype>
+#include <clocale>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <type_traits>
+#include <unordered_map>
+#include <utility>
+
+#include "fom/errors.hpp"
+
+#ifndef CONTACTROM_DEFAULT_MESH_DIR
+#define CONTACTROM_DEFAULT_MESH_DIR "meshes"
+#endif
+
+namespace contactrom::fom {
+
+namespace {
+
+// gmsh element type codes (gmsh.info, "MSH file format"): only the two we keep.
+constexpr int kGmshLine2 = 1;
+constexpr int kGmshQuad4 = 3;
+constexpr int kGmshTriangle3 = 2;
+
+// Coordinates are hashed after rounding to this resolution, so that the last-bit
+// noise of a different libm does not change the fingerprint of the same mesh.
+constexpr double kFingerprintResolution = 1e-12;
+
+// A quad whose |signed area| is below this fraction of its squared diameter is
+// rejected as degenerate (collapsed or self-overlapping corner numbering).
+constexpr double kDegenerateAreaRatio = 1e-12;
+
+/// Owns one gmsh API session: quiet initialisation on construction, finalize
+/// on destruction (also when a check below throws), and the messages gmsh logged
+/// meanwhile. gmsh keeps its model in global state, hence load_mesh is not
+/// thread-safe; a fresh session per call makes it safe to call repeatedly and
+/// leaves no option (e.g. Mesh.SubdivisionAlgorithm set by one .geo) behind for
+/// the next file.
+class GmshSession {
+ public:
+  GmshSession() {
+    // gmsh calls setlocale(); give the host program its locale back afterwards.
+    if (const char* loc = std::setlocale(LC_ALL, nullptr)) m_locale = loc;
+    // No argv and no ~/.gmshrc: the mesh depends on the file only. This gmsh
+    // build installs no signal handlers.
+    gmsh::initialize(0, nullptr, /*readConfigFiles=*/false);
+    gmsh::option::setNumber("General.Terminal", 0);  // nothing on stdout/stderr
+    gmsh::option::setNumber("General.Verbosity", 2);  // log errors and warnings
+    // Errors must not throw from inside gmsh's .geo parser: an exception skips
+    // the parser's clean-up, and the stale lexer buffer then breaks every later
+    // gmsh::open in the process ("line 0: syntax error"), even across
+    // finalize/initialize. Errors are read from the log instead.
+    gmsh::option::setNumber("General.AbortOnError", 0);
+    gmsh::logger::start();
+  }
+  ~GmshSession() {
+    try {
+      gmsh::logger::stop();
+      gmsh::finalize();
+    } catch (...) {
+    }
+    if (!m_locale.empty()) std::setlocale(LC_ALL, m_locale.c_str());
+  }
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+
+  /// First error logged since the last call ("" if none); clears the log.
+  std::string take_first_error() {
+    std::vector<std::string> log;
+    gmsh::logger::get(log);
+    gmsh::logger::stop();
+    gmsh::logger::start();
+    for (const auto& line : log)
+      if (line.rfind("Error", 0) == 0) {
+        std::string msg = line.substr(line.find(':') == std::string::npos ? 0 : line.find(':') + 1);
+        msg.erase(0, msg.find_first_not_of(' '));
+        return msg.empty() ? line : msg;
+      }
+    return {};
+  }
+
+ private:
+  std::string m_locale;
+};
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+/// Human-readable plural name of a gmsh element type, for error messages.
+std::string element_kind(int type) {
+  if (type == kGmshTriangle3) return "triangles";
+  std::string name;
+  int dim = 0, order = 0, num_nodes = 0, num_primary = 0;
+  std::vector<double> local;
+  try {
+    gmsh::model::mesh::getElementProperties(type, name, dim, order, num_nodes, local, num_primary);
+  } catch (...) {
+    return "elements of gmsh type " + std::to_string(type);
+  }
+  return "'" + name + "' elements";
+}
+
+struct PhysicalGroup {
+  int tag;
+  std::string name;
+  std::vector<int> entities;
+};
+
+/// Physical groups of dimension `dim`, by ascending tag; unnamed groups are named
+/// after their tag.
+std::vector<PhysicalGroup> physical_groups(int dim) {
+  gmsh::vectorpair dim_tags;
+  gmsh::model::getPhysicalGroups(dim_tags, dim);
+  std::vector<PhysicalGroup> groups;
+  for (const auto& [d, tag] : dim_tags) {
+    PhysicalGroup g{tag, {}, {}};
+    gmsh::model::getPhysicalName(d, tag, g.name);
+    if (g.name.empty()) g.name = std::to_string(tag);
+    gmsh::model::getEntitiesForPhysicalGroup(d, tag, g.entities);
+    std::sort(g.entities.begin(), g.entities.end());
+    groups.push_back(std::move(g));
+  }
+  std::sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) { return a.tag < b.tag; });
+  return groups;
+}
+
+/// Elements of one type on the entities of a group, as flat node-tag lists (gmsh
+/// tags). Any other element type throws `on_other_type(type)`.
+template <class OnOther>
+std::vector<std::size_t> group_elements(int dim, const PhysicalGroup& g, int wanted_type, OnOther on_other_type) {
+  std::vector<std::size_t> result;
+  for (int entity : g.entities) {
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> element_tags, node_tags;
+    gmsh::model::mesh::getElements(types, element_tags, node_tags, dim, entity);
+    for (std::size_t k = 0; k < types.size(); ++k) {
+      if (node_tags[k].empty()) continue;
+      if (types[k] != wanted_type) on_other_type(types[k]);
+      result.insert(result.end(), node_tags[k].begin(), node_tags[k].end());
+    }
+  }
+  return result;
+}
+
+double signed_area(const Eigen::Matrix2Xd& x, const std::array<int, 4>& q) {
+  double a = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    const int j = (i + 1) % 4;
+    a += x(0, q[i]) * x(1, q[j]) - x(0, q[j]) * x(1, q[i]);
+  }
+  return 0.5 * a;
+}
+
+std::string point_string(const Eigen::Matrix2Xd& x, int node) {
+  std::ostringstream s;
+  s << "(" << x(0, node) << ", " << x(1, node) << ")";
+  return s.str();
+}
+
+/// Orders the segments of one curve as a chain. The chain runs so that the body
+/// owning the first segment lies on its left (the quad containing the segment
+/// has it as a counter-clockwise edge); for a closed curve it starts at the
+/// smallest node id.
+void order_chain(const std::string& where, const std::string& name, const Eigen::Matrix2Xd& x,
+                 const std::vector<std::array<int, 4>>& quads, std::vector<std::array<int, 2>> segs,
+                 std::vector<std::array<int, 2>>& out_segments, std::vector<int>& out_nodes) {
+  if (segs.empty()) throw InputError(where + ": physical curve '" + name + "' has no line elements");
+  std::map<int, std::vector<int>> incident;  // node -> segment indices
+  for (int s = 0; s < static_cast<int>(segs.size()); ++s) {
+    if (segs[s][0] == segs[s][1])
+      throw InputError(where + ": physical curve '" + name + "' has a zero-length segment at " +
+                       point_string(x, segs[s][0]));
+    for (int n : segs[s]) incident[n].push_back(s);
+  }
+  std::vector<int> ends;
+  for (const auto& [node, list] : incident) {
+    if (list.size() > 2)
+      throw InputError(where + ": physical curve '" + name + "' branches at " + point_string(x, node) +
+                       "; expected a single chain of segments");
+    if (list.size() == 1) ends.push_back(node);
+  }
+  if (!ends.empty() && ends.size() != 2)
+    throw InputError(where + ": physical curve '" + name + "' is not connected (" + std::to_string(ends.size() / 2) +
+                     " pieces); expected a single chain of segments");
+  const bool closed = ends.empty();
+
+  // Walk from a provisional start.
+  const int start = closed ? incident.begin()->first : ends.front();
+  std::vector<int> nodes{start};
+  std::vector<char> used(segs.size(), 0);
+  int current = start;
+  for (std::size_t step = 0; step < segs.size(); ++step) {
+    int next_seg = -1;
+    for (int s : incident[current])
+      if (!used[s]) {
+        next_seg = s;
+        break;
+      }
+    if (next_seg < 0) break;
+    used[next_seg] = 1;
+    current = segs[next_seg][0] == current ? segs[next_seg][1] : segs[next_seg][0];
+    nodes.push_back(current);
+  }
+  if (std::find(used.begin(), used.end(), 0) != used.end())
+    throw InputError(where + ": physical curve '" + name +
+                     "' is not connected (a closed loop plus other pieces); expected a single chain of segments");
+  if (closed) nodes.pop_back();  // the walk came back to the start
+
+  // Orientation: body on the left of the first segment.
+  const int a = nodes[0], b = nodes[1];
+  int orientation = 0;  // +1 keep, -1 reverse, 0 unknown
+  for (const auto& q : quads) {
+    for (int i = 0; i < 4 && orientation == 0; ++i) {
+      const int p = q[i], r = q[(i + 1) % 4];
+      if (p == a && r == b) orientation = +1;
+      if (p == b && r == a) orientation = -1;
+    }
+    if (orientation != 0) break;
+  }
+  if (orientation == 0)
+    throw InputError(where + ": physical curve '" + name + "' segment " + point_string(x, a) + "-" +
+                     point_string(x, b) + " is not an edge of any quad of a physical surface");
+  if (orientation < 0) {
+    if (closed)
+      std::reverse(nodes.begin() + 1, nodes.end());  // keep the start node
+    else
+      std::reverse(nodes.begin(), nodes.end());
+  }
+  out_nodes = nodes;
+  out_segments.clear();
+  const std::size_t nseg = closed ? nodes.size() : nodes.size() - 1;
+  for (std::size_t k = 0; k < nseg; ++k) out_segments.push_back({nodes[k], nodes[(k + 1) % nodes.size()]});
+}
+
+Mesh read_current_model(const std::string& where) {
+  const auto surfaces = physical_groups(2);
+  const auto curves = physical_groups(1);
+  if (surfaces.empty() && curves.empty())
+    throw InputError(where + " has no physical groups; expected physical surfaces (bodies) and physical curves "
+                             "(boundaries)");
+  if (surfaces.empty())
+    throw InputError(where + " has no physical surface; expected one per body");
+
+  // Quads per body, in gmsh node tags. An entity may belong to one body only.
+  std::vector<std::vector<std::size_t>> body_quads;
+  std::map<int, std::string> entity_owner;
+  Mesh mesh;
+  for (const auto& g : surfaces) {
+    for (int e : g.entities) {
+      auto [it, inserted] = entity_owner.emplace(e, g.name);
+      if (!inserted)
+        throw InputError(where + ": surface " + std::to_string(e) + " belongs to physical surfaces '" + it->second +
+                         "' and '" + g.name + "'; each element must belong to one body");
+    }
+    if (std::find(mesh.body_names.begin(), mesh.body_names.end(), g.name) != mesh.body_names.end())
+      throw InputError(where + ": two physical surfaces are named '" + g.name + "'");
+    auto tags = group_elements(2, g, kGmshQuad4, [&](int type) {
+      throw InputError(where + ": surface elements must be 4-node quads, found " + element_kind(type));
+    });
+    if (tags.empty()) throw InputError(where + ": physical surface '" + g.name + "' has no elements");
+    mesh.body_names.push_back(g.name);
+    body_quads.push_back(std::move(tags));
+  }
+
+  // Contiguous numbering: body after body, and within a body by ascending gmsh tag.
+  std::unordered_map<std::size_t, int> id_of;
+  std::vector<std::size_t> gmsh_tag_of;
+  for (const auto& tags : body_quads) {
+    std::vector<std::size_t> sorted(tags);
+    std::sort(sorted.begin(), sorted.end());
+    sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+    for (std::size_t t : sorted)
+      if (id_of.emplace(t, static_cast<int>(gmsh_tag_of.size())).second) gmsh_tag_of.push_back(t);
+  }
+
+  std::vector<std::size_t> all_tags;
+  std::vector<double> coord, param;
+  gmsh::model::mesh::getNodes(all_tags, coord, param, -1, -1, true, false);
+  mesh.nodes.resize(2, static_cast<Eigen::Index>(gmsh_tag_of.size()));
+  std::vector<char> found(gmsh_tag_of.size(), 0);
+  for (std::size_t k = 0; k < all_tags.size(); ++k) {
+    auto it = id_of.find(all_tags[k]);
+    if (it == id_of.end()) continue;
+    if (std::abs(coord[3 * k + 2]) > 1e-12)
+      throw InputError(where + ": node at z = " + std::to_string(coord[3 * k + 2]) + "; expected a planar mesh in z = 0");
+    mesh.nodes(0, it->second) = coord[3 * k];
+    mesh.nodes(1, it->second) = coord[3 * k + 1];
+    found[it->second] = 1;
+  }
+  if (std::find(found.begin(), found.end(), 0) != found.end())
+    throw InputError(where + ": an element refers to a node without coordinates");
+
+  for (std::size_t b = 0; b < body_quads.size(); ++b) {
+    const auto& tags = body_quads[b];
+    for (std::size_t e = 0; e + 3 < tags.size(); e += 4) {
+      std::array<int, 4> q{id_of.at(tags[e]), id_of.at(tags[e + 1]), id_of.at(tags[e + 2]), id_of.at(tags[e + 3])};
+      const double area = signed_area(mesh.nodes, q);
+      double diam2 = 0.0;
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) diam2 = std::max(diam2, (mesh.nodes.col(q[i]) - mesh.nodes.col(q[j])).squaredNorm());
+      if (!(std::abs(area) > kDegenerateAreaRatio * diam2))
+        throw InputError(where + ": quad at " + point_string(mesh.nodes, q[0]) + " in body '" + mesh.body_names[b] +
+                         "' is degenerate (zero area)");
+      if (area < 0) std::swap(q[1], q[3]);  // clockwise -> counter-clockwise, same first node
+      mesh.quads.push_back(q);
+      mesh.quad_body.push_back(static_cast<int>(b));
+    }
+  }
+
+  for (const auto& g : curves) {
+    if (mesh.segments.count(g.name))
+      throw InputError(where + ": two physical curves are named '" + g.name + "'");
+    const auto tags = group_elements(1, g, kGmshLine2, [&](int type) {
+      throw InputError(where + ": curve elements of '" + g.name + "' must be 2-node lines, found " +
+                       element_kind(type));
+    });
+    std::vector<std::array<int, 2>> segs;
+    for (std::size_t e = 0; e + 1 < tags.size(); e += 2) {
+      auto a = id_of.find(tags[e]), b = id_of.find(tags[e + 1]);
+      if (a == id_of.end() || b == id_of.end())
+        throw InputError(where + ": physical curve '" + g.name + "' has nodes that belong to no physical surface");
+      segs.push_back({a->second, b->second});
+    }
+    order_chain(where, g.name, mesh.nodes, mesh.quads, segs, mesh.segments[g.name], mesh.curve_nodes[g.name]);
+  }
+  return mesh;
+}
+
+template <class T>
+void fnv1a(std::uint64_t& h, T value) {
+  // Hash the value's bytes least significant first, independent of endianness.
+  using U = std::make_unsigned_t<T>;
+  U u = static_cast<U>(value);
+  for (std::size_t i = 0; i < sizeof(U); ++i) {
+    h ^= static_cast<std::uint64_t>(u & 0xffu);
+    h *= 1099511628211ull;
+    u = static_cast<U>(u >> 8);
+  }
+}
+
+void fnv1a(std::uint64_t& h, const std::string& s) {
+  fnv1a(h, static_cast<std::int64_t>(s.size()));
+  for (unsigned char c : s) fnv1a(h, c);
+}
+
+}  // namespace
+
+const std::vector<int>& Mesh::group_nodes(const std::string& name) const {
+  auto it = curve_nodes.find(name);
+  if (it != curve_nodes.end()) return it->second;
+  std::string have;
+  for (const auto& [n, list] : curve_nodes) have += (have.empty() ? "" : ", ") + n;
+  throw InputError("mesh has no physical group '" + name + "' (has: " + have + ")");
+}
+
+const std::vector<std::array<int, 2>>& Mesh::group_segments(const std::string& name) const {
+  auto it = segments.find(name);
+  if (it != segments.end()) return it->second;
+  std::string have;
+  for (const auto& [n, list] : segments) have += (have.empty() ? "" : ", ") + n;
+  throw InputError("mesh has no physical group '" + name + "' (has: " + have + ")");
+}
+
+std::string Mesh::fingerprint() const {
+  std::uint64_t h = 14695981039346656037ull;  // FNV-1a 64 offset basis
+  fnv1a(h, static_cast<std::int64_t>(nodes.cols()));
+  for (Eigen::Index j = 0; j < nodes.cols(); ++j)
+    for (int i = 0; i < 2; ++i) fnv1a(h, static_cast<std::int64_t>(std::llround(nodes(i, j) / kFingerprintResolution)));
+  fnv1a(h, static_cast<std::int64_t>(quads.size()));
+  for (std::size_t e = 0; e < quads.size(); ++e) {
+    for (int n : quads[e]) fnv1a(h, static_cast<std::int32_t>(n));
+    fnv1a(h, static_cast<std::int32_t>(e < quad_body.size() ? quad_body[e] : -1));
+  }
+  for (const auto& name : body_names) fnv1a(h, name);
+  for (const auto& [name, segs] : segments) {
+    fnv1a(h, name);
+    fnv1a(h, static_cast<std::int64_t>(segs.size()));
+    for (const auto& s : segs) {
+      fnv1a(h, static_cast<std::int32_t>(s[0]));
+      fnv1a(h, static_cast<std::int32_t>(s[1]));
+    }
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+Mesh load_mesh(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh file '" + path + "' not found");
+  if (!std::ifstream(path)) throw InputError("mesh file '" + path + "' is not readable");
+  const std::string where = "mesh '" + path + "'";
+  const std::string ext = lower_extension(path);
+
+  GmshSession session;
+  try {
+    gmsh::open(path);
+    if (std::string err = session.take_first_error(); !err.empty())
+      throw InputError(where + ": gmsh could not read it: " + err);
+    if (ext == ".geo") {
+      gmsh::model::mesh::generate(2);
+      if (std::string err = session.take_first_error(); !err.empty())
+        throw InputError(where + ": gmsh meshing failed: " + err);
+    }
+    return read_current_model(where);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(where + ": gmsh failed: " + e.what());
+  } catch (...) {
+    // gmsh 4.8 throws non-std values (ints, strings) from its API on errors.
+    std::string err = session.take_first_error();
+    throw InputError(where + ": gmsh failed" + (err.empty() ? std::string() : ": " + err));
+  }
+}
+
+std::string mesh_directory() {
+  const char* env = std::getenv("CONTACTROM_MESH_DIR");
+  if (env != nullptr && *env != '\0') return env;
+  return CONTACTROM_DEFAULT_MESH_DIR;
+}
+
+}  // namespace contactrom::fom
