@@ -5,6 +5,7 @@
 /// User-input and I/O errors throw InputError with a one-line message that names
 /// the offending value and what was expected. Numerical failure is never an
 /// exception: solvers report a Status through `info()`.
+#include <ostream>
 #include <stdexcept>
 #include <string>
 
@@ -35,5 +36,8 @@ inline const char* to_string(Status s) {
   }
   return "unknown";
 }
+
+/// \brief Streams the lower-case status name (logs, test messages).
+inline std::ostream& operator<<(std::ostream& out, Status s) { return out << to_string(s); }
 
 }  // namespace contactrom

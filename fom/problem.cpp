@@ -115,8 +115,13 @@ class IroningProblem final : public TwoBodyProblem {
     if (!(opt.ironing_length > 0)) throw InputError("ironing length " + format_number(opt.ironing_length) + " invalid; expected > 0");
     m_name = free_dy ? "ironing2" : "ironing";
     m_param_names = free_dy ? std::vector<std::string>{"d_x", "d_y"} : std::vector<std::string>{"d_x"};
-    m_lower = free_dy ? Eigen::Vector2d(0.0, 0.1) : Eigen::VectorXd::Constant(1, 0.0);
-    m_upper = free_dy ? Eigen::Vector2d(opt.ironing_length, 0.3) : Eigen::VectorXd::Constant(1, opt.ironing_length);
+    if (free_dy) {
+      m_lower = Eigen::Vector2d(0.0, 0.1);
+      m_upper = Eigen::Vector2d(opt.ironing_length, 0.3);
+    } else {
+      m_lower = Eigen::VectorXd::Constant(1, 0.0);
+      m_upper = Eigen::VectorXd::Constant(1, opt.ironing_length);
+    }
     setup_mesh(opt, "ironing.geo", "slab", {"slab_bottom", "iron_top"});
     m_lift_terms = {lift("iron_top", 0, 1.0), lift("iron_top", 1, -1.0)};
     m_fext_terms = {Eigen::VectorXd::Zero(num_dofs()), Eigen::VectorXd::Zero(num_dofs())};

@@ -1,0 +1,186 @@
+// Acceptance tests of the FOM (issue 2): KKT conditions across every problem's
+// range, Hertz theory, physics sanity checks, separated configuration.
+#define BOOST_TEST_MODULE fom_active_set_solver
+#include <Eigen/SparseCholesky>
+#include <boost/test/unit_test.hpp>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "fom/active_set_solver.hpp"
+#include "fom/kkt.hpp"
+
+using namespace contactrom;
+using namespace contactrom::fom;
+
+namespace {
+
+/// Problems and solvers are built once per test module (meshing costs time).
+struct Fixture {
+  std::map<std::string, std::unique_ptr<Problem>> problems;
+  std::map<std::string, std::unique_ptr<ActiveSetSolver>> solvers;
+  ActiveSetSolver& solver(const std::string& name) {
+    if (!problems.count(name)) {
+      problems[name] = make_problem(name);
+      solvers[name] = std::make_unique<ActiveSetSolver>(*problems[name]);
+    }
+    return *solvers[name];
+  }
+};
+Fixture& fixture() {
+  static Fixture f;
+  return f;
+}
+
+Param p1(double v) { return Eigen::VectorXd::Constant(1, v); }
+
+void check_kkt(const std::string& name, const std::vector<Param>& params) {
+  ActiveSetSolver& s = fixture().solver(name);
+  for (const Param& mu : params) {
+    const FomSolution sol = s.solve(mu);
+    BOOST_TEST_CONTEXT(name << " at " << mu.transpose()) {
+      BOOST_TEST(sol.status == Status::Success, sol.message);
+      const KktResiduals k = kkt_residuals(s.problem(), mu, sol.u, sol.lambda);
+      BOOST_TEST(k.stationarity <= 1e-10);
+      BOOST_TEST(k.penetration <= 1e-10);
+      BOOST_TEST(k.negative_pressure <= 1e-10);
+      BOOST_TEST(k.complementarity <= 1e-10);
+      BOOST_TEST(sol.active > 0);
+    }
+  }
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(kkt_rope_across_range) { check_kkt("rope", {p1(10), p1(17.5), p1(30), p1(42.5), p1(50)}); }
+BOOST_AUTO_TEST_CASE(kkt_hertz_across_range) {
+  check_kkt("hertz", {p1(1e-3), p1(0.075), p1(0.15), p1(0.225), p1(0.3)});
+}
+BOOST_AUTO_TEST_CASE(kkt_ironing_across_range) { check_kkt("ironing", {p1(0), p1(1), p1(2), p1(3), p1(4)}); }
+BOOST_AUTO_TEST_CASE(kkt_ironing2_across_range) {
+  check_kkt("ironing2", {Eigen::Vector2d(0, 0.1), Eigen::Vector2d(4, 0.3), Eigen::Vector2d(1, 0.2),
+                         Eigen::Vector2d(2.5, 0.15), Eigen::Vector2d(4, 0.1), Eigen::Vector2d(0, 0.3)});
+}
+
+// Two-cylinder plane-strain Hertz theory: with P the FOM's contact force,
+// a = sqrt(4 P R / (π E*)), p0 = 2P/(π a), p(x) = p0 sqrt(1 − x²/a²),
+// R = (1/R1 + 1/R2)⁻¹ = 0.5, 1/E* = 2(1 − ν²)/E.
+BOOST_AUTO_TEST_CASE(hertz_pressure_matches_theory) {
+  ActiveSetSolver& s = fixture().solver("hertz");
+  const ContactModel& contact = s.problem().contact();
+  const Eigen::VectorXd& w = contact.weights();
+  const Eigen::Matrix2Xd& x = contact.constraint_points();
+  const double r = 0.5, e_star = 1.0 / (2.0 * (1.0 - 0.3 * 0.3));
+  for (double d : {0.02, 0.04, 0.06}) {
+    const FomSolution sol = s.solve(p1(d));
+    const double force = contact_force(s.problem(), sol.lambda);
+    const double a = std::sqrt(4.0 * force * r / (M_PI * e_star)), p0 = 2.0 * force / (M_PI * a);
+    double num = 0.0, den = 0.0;
+    for (int k = 0; k < w.size(); ++k) {
+      const double ph = std::abs(x(0, k)) < a ? p0 * std::sqrt(1.0 - x(0, k) * x(0, k) / (a * a)) : 0.0;
+      num += w(k) * std::pow(sol.lambda(k) - ph, 2);
+      den += w(k) * ph * ph;
+    }
+    // FOM half-width: midway between the outermost active node and the next node, both sides.
+    double half = 0.0;
+    for (int side : {-1, 1}) {
+      double last_active = 0.0, first_free = 1e9;
+      for (int k = 0; k < w.size(); ++k) {
+        const double xs = side * x(0, k);
+        if (xs < -1e-12) continue;
+        if (sol.lambda(k) > 0.0) last_active = std::max(last_active, xs);
+      }
+      for (int k = 0; k < w.size(); ++k) {
+        const double xs = side * x(0, k);
+        if (xs > last_active + 1e-12) first_free = std::min(first_free, xs);
+      }
+      half += 0.25 * (last_active + first_free);
+    }
+    BOOST_TEST_CONTEXT("d = " << d << ", P = " << force << ", a_Hertz = " << a << ", a_FOM = " << half) {
+      BOOST_TEST(std::sqrt(num / den) <= 0.10);
+      BOOST_TEST(std::abs(half - a) <= 0.15 * a);
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(hertz_force_grows_with_d) {
+  ActiveSetSolver& s = fixture().solver("hertz");
+  double previous = 0.0;
+  for (int i = 1; i <= 10; ++i) {
+    const double force = contact_force(s.problem(), s.solve(p1(0.03 * i)).lambda);
+    BOOST_TEST(force > previous);
+    previous = force;
+  }
+}
+
+BOOST_AUTO_TEST_CASE(rope_contact_set_changes_with_gamma) {
+  ActiveSetSolver& s = fixture().solver("rope");
+  std::vector<Eigen::VectorXd> sets;
+  for (double g : {10.0, 30.0, 50.0}) {
+    const FomSolution sol = s.solve(p1(g));
+    BOOST_TEST(sol.active > 0);
+    sets.push_back((sol.lambda.array() > 0.0).cast<double>().matrix());
+  }
+  BOOST_TEST((sets[0] - sets[1]).cwiseAbs().sum() > 0.0);
+  BOOST_TEST((sets[1] - sets[2]).cwiseAbs().sum() > 0.0);
+}
+
+// The pressure centroid (deformed x) of `ironing` follows the iron: monotone in
+// d_x and within one slab element (6/49) of d_x.
+BOOST_AUTO_TEST_CASE(ironing_pressure_centroid_follows_iron) {
+  ActiveSetSolver& s = fixture().solver("ironing");
+  const ContactModel& contact = s.problem().contact();
+  const double element = 6.0 / 49.0;
+  double previous = -1e9;
+  for (int i = 0; i <= 8; ++i) {
+    const double dx = 0.5 * i;
+    const FomSolution sol = s.solve(p1(dx));
+    const Eigen::VectorXd us = contact.restrict_to_surface(sol.u);
+    double num = 0.0, den = 0.0;
+    for (int k = 0; k < contact.num_constraints(); ++k) {
+      const double wl = contact.weights()(k) * sol.lambda(k);
+      num += wl * (contact.constraint_points()(0, k) + us(2 * k));
+      den += wl;
+    }
+    const double centroid = num / den;
+    BOOST_TEST_CONTEXT("d_x = " << dx << ", centroid = " << centroid) {
+      BOOST_TEST(centroid > previous);
+      BOOST_TEST(std::abs(centroid - dx) <= element);
+    }
+    previous = centroid;
+  }
+}
+
+// A rope pulled upwards never touches the obstacle: λ = 0 and u is the
+// unconstrained solution, computed here independently with a sparse Cholesky.
+BOOST_AUTO_TEST_CASE(separated_configuration_is_unconstrained) {
+  ProblemOptions opt;
+  opt.rope_load = -100.0;
+  auto problem = make_problem("rope", opt);
+  ActiveSetSolver s(*problem);
+  const Param mu = p1(20.0);
+  const FomSolution sol = s.solve(mu);
+  BOOST_TEST(sol.status == Status::Success);
+  BOOST_TEST(sol.lambda.cwiseAbs().maxCoeff() == 0.0);
+  const std::vector<int>& free = problem->free_dofs();
+  const SparseMatrix k = problem->stiffness(mu);
+  const Eigen::VectorXd f = problem->rhs(mu);
+  Eigen::MatrixXd kff(free.size(), free.size());
+  Eigen::VectorXd ff(free.size());
+  for (size_t a = 0; a < free.size(); ++a) {
+    ff(a) = f(free[a]);
+    for (size_t b = 0; b < free.size(); ++b) kff(a, b) = k.coeff(free[a], free[b]);
+  }
+  const Eigen::VectorXd uf = kff.llt().solve(ff);
+  double err = 0.0;
+  for (size_t a = 0; a < free.size(); ++a) err = std::max(err, std::abs(sol.u(free[a]) - uf(a)));
+  BOOST_TEST(err <= 1e-10 * uf.cwiseAbs().maxCoeff());
+}
+
+BOOST_AUTO_TEST_CASE(parameter_outside_range_is_rejected) {
+  ActiveSetSolver& s = fixture().solver("hertz");
+  BOOST_CHECK_THROW(s.solve(p1(0.0)), InputError);
+  BOOST_CHECK_THROW(s.solve(p1(0.31)), InputError);
+  BOOST_CHECK_THROW(parse_param(s.problem(), "abc"), InputError);
+  BOOST_CHECK_THROW(make_problem("nonsense"), InputError);
+}

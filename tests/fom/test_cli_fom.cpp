@@ -1,0 +1,87 @@
+// CLI tests of `contactrom fom`: JSON contract, field files, and bad input
+// (one-line error naming the value, non-zero exit, no partial files).
+#define BOOST_TEST_MODULE fom_cli
+#include <boost/test/unit_test.hpp>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "common/run_command.hpp"
+
+using contactrom::test::run_command;
+namespace fs = std::filesystem;
+
+namespace {
+const std::string exe = CONTACTROM_EXE;
+int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(json_summary_has_contract_keys) {
+  const auto r = run_command(exe + " fom --problem hertz --param 0.1 --json");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"problem", "param", "solver", "iterations", "active", "time_s", "kkt"})
+    BOOST_TEST(j.contains(key), key);
+  for (const char* key : {"stationarity", "penetration", "negative_pressure", "complementarity"})
+    BOOST_TEST(j["kkt"][key].get<double>() <= 1e-10, key);
+  BOOST_TEST(j["problem"] == "hertz");
+  BOOST_TEST(j["active"].get<int>() > 0);
+}
+
+BOOST_AUTO_TEST_CASE(out_writes_vtu_and_surface_csv) {
+  const std::string dir = contactrom::test::temp_dir() + "/fields";
+  const auto r = run_command(exe + " fom --problem ironing --param 2 --json --out " + dir);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  const int rows = nlohmann::json::parse(r.out)["constraints"].get<int>();
+  const std::string vtu = contactrom::test::slurp(dir + "/ironing.vtu");
+  BOOST_TEST(vtu.find("<VTKFile type=\"UnstructuredGrid\"") != std::string::npos);
+  BOOST_TEST(vtu.find("Name=\"contact_pressure\"") != std::string::npos);
+  BOOST_TEST(vtu.find("Name=\"stress\"") != std::string::npos);
+  const std::string csv = contactrom::test::slurp(dir + "/ironing_surface.csv");
+  BOOST_TEST(csv.rfind("x,y,gap,pressure\n", 0) == 0);
+  BOOST_TEST(lines(csv) == 1 + rows);  // header + one row per slave node
+  BOOST_TEST(rows > 20);
+  fs::remove_all(fs::path(dir).parent_path());
+}
+
+BOOST_AUTO_TEST_CASE(unknown_problem_is_one_line_error) {
+  const auto r = run_command(exe + " fom --problem cylinder --param 0.1");
+  BOOST_TEST(r.exit_code != 0);
+  BOOST_TEST(lines(r.err) == 1);
+  BOOST_TEST(r.err.find("cylinder") != std::string::npos);
+  BOOST_TEST(r.err.find("hertz") != std::string::npos);  // lists what is expected
+}
+
+BOOST_AUTO_TEST_CASE(parameter_out_of_range_names_value_and_range) {
+  const std::string dir = contactrom::test::temp_dir();
+  const auto r = run_command(exe + " fom --problem hertz --param 0.5 --out " + dir + "/out");
+  BOOST_TEST(r.exit_code != 0);
+  BOOST_TEST(lines(r.err) == 1);
+  BOOST_TEST(r.err.find("0.5") != std::string::npos);
+  BOOST_TEST(r.err.find("(0, 0.3]") != std::string::npos);
+  BOOST_TEST(!fs::exists(dir + "/out"));  // no partial output
+  const auto r2 = run_command(exe + " fom --problem ironing2 --param 1");
+  BOOST_TEST(r2.exit_code != 0);
+  BOOST_TEST(r2.err.find("2 parameter") != std::string::npos);
+  const auto r3 = run_command(exe + " fom --problem rope --param twelve");
+  BOOST_TEST(r3.exit_code != 0);
+  BOOST_TEST(r3.err.find("twelve") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+BOOST_AUTO_TEST_CASE(missing_and_malformed_mesh_are_reported) {
+  const std::string dir = contactrom::test::temp_dir();
+  auto r = run_command("CONTACTROM_MESH_DIR=" + dir + " " + exe + " fom --problem hertz --param 0.1 --out " + dir + "/o");
+  BOOST_TEST(r.exit_code != 0);
+  BOOST_TEST(lines(r.err) == 1);
+  BOOST_TEST(r.err.find("hertz.geo") != std::string::npos);
+  {
+    std::ofstream bad(dir + "/hertz.geo");
+    bad << "this is not a gmsh file {{{\n";
+  }
+  r = run_command("CONTACTROM_MESH_DIR=" + dir + " " + exe + " fom --problem hertz --param 0.1 --out " + dir + "/o");
+  BOOST_TEST(r.exit_code != 0);
+  BOOST_TEST(lines(r.err) == 1);
+  BOOST_TEST(r.err.find("hertz.geo") != std::string::npos);
+  BOOST_TEST(!fs::exists(dir + "/o"));
+  fs::remove_all(dir);
+}
