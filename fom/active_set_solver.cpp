@@ -27,9 +27,16 @@ SparseMatrix free_block(const SparseMatrix& k, const std::vector<int>& free, con
 /// S Cᵀ (n_s x n_c) for the sparse constraint rows: column a is the sum of the
 /// columns of the symmetric S picked by row a's (at most six) entries.
 void delassus_parts(const ConstraintMatrix& c, const Eigen::MatrixXd& s, Eigen::MatrixXd& sct) {
-  sct.setZero(s.rows(), c.rows());
-  for (int a = 0; a < c.outerSize(); ++a)
-    for (ConstraintMatrix::InnerIterator it(c, a); it; ++it) sct.col(a).noalias() += it.value() * s.col(it.col());
+  sct.resize(s.rows(), c.rows());
+  for (int a = 0; a < c.outerSize(); ++a) {
+    ConstraintMatrix::InnerIterator it(c, a);
+    if (!it) {
+      sct.col(a).setZero();
+      continue;
+    }
+    sct.col(a).noalias() = it.value() * s.col(it.col());
+    for (++it; it; ++it) sct.col(a).noalias() += it.value() * s.col(it.col());
+  }
 }
 
 bool pairing_settled(const ConstraintMatrix& c, const Eigen::VectorXd& g, const ConstraintMatrix& c_next,

@@ -85,17 +85,43 @@ Pairing NodeToSegmentContact::search(const Eigen::VectorXd& u_surface) const {
   p.segment.assign(ns, -1);
   p.xi.assign(ns, 0.0);
   p.normal = Eigen::Matrix2Xd::Zero(2, ns);
+  // Segment data once per search; the inner loop uses squared distances only and
+  // skips a segment whose bounding circle (centre `mid`, radius `half`) is
+  // farther than the best distance found so far. The previous slave node's
+  // segment is tried first: neighbouring slave nodes have neighbouring pairs.
+  const int nseg = std::max(nm - 1, 0);
+  Eigen::Matrix2Xd seg_t(2, nseg), mid(2, nseg);
+  Eigen::VectorXd inv_len2(nseg), half(nseg);
+  for (int j = 0; j < nseg; ++j) {
+    seg_t.col(j) = xm.col(j + 1) - xm.col(j);
+    mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
+    inv_len2(j) = 1.0 / seg_t.col(j).squaredNorm();
+    half(j) = 0.5 * seg_t.col(j).norm();
+  }
+  int guess = 0;
   for (int k = 0; k < ns; ++k) {
-    double best = std::numeric_limits<double>::max();
+    const double px = xs(0, k), py = xs(1, k);
+    double best = std::numeric_limits<double>::max(), best_root = std::numeric_limits<double>::max();
     int best_seg = -1;
     double best_xi = 0.0, best_raw = 0.0;
-    for (int j = 0; j + 1 < nm; ++j) {
-      const Eigen::Vector2d a = xm.col(j), t = xm.col(j + 1) - a;
-      const double raw = (xs.col(k) - a).dot(t) / t.squaredNorm();
-      const double xi = std::clamp(raw, 0.0, 1.0);
-      const double dist = (xs.col(k) - a - xi * t).norm();
-      if (dist < best - 1e-14) best = dist, best_seg = j, best_xi = xi, best_raw = raw;
+    for (int step = -1; step < nseg; ++step) {
+      const int j = step < 0 ? guess : step;
+      if (step >= 0 && j == guess) continue;
+      if (best_seg >= 0) {
+        const double mx = px - mid(0, j), my = py - mid(1, j);
+        if (mx * mx + my * my > best + half(j) * (2.0 * best_root + half(j))) continue;
+      }
+      const double dx = px - xm(0, j), dy = py - xm(1, j), tx = seg_t(0, j), ty = seg_t(1, j);
+      const double raw = (dx * tx + dy * ty) * inv_len2(j);
+      const double xi = raw < 0.0 ? 0.0 : (raw > 1.0 ? 1.0 : raw);
+      const double ex = dx - xi * tx, ey = dy - xi * ty;
+      const double dist2 = ex * ex + ey * ey;
+      // Ties (a slave node exactly at a master node) go to the lower segment index.
+      if (dist2 < best * (1.0 - 1e-14) || (best_seg >= 0 && dist2 <= best * (1.0 + 1e-14) && j < best_seg)) {
+        best = dist2, best_root = std::sqrt(dist2), best_seg = j, best_xi = xi, best_raw = raw;
+      }
     }
+    if (best_seg >= 0) guess = best_seg;
     // A projection beyond either end of the master chain is no contact pair.
     if (best_seg < 0 || (best_seg == 0 && best_raw < 0.0) || (best_seg == nm - 2 && best_raw > 1.0)) continue;
     p.segment[k] = best_seg;

@@ -1,0 +1,148 @@
+// contactrom bench --problem P [--train N | --level n] [--delta D] [--repeats R] [--json]
+// Median per-query times of every solver, all measured in the same run so that
+// their ratios are meaningful on a noisy machine:
+//   fom_active_set  custom active-set FOM, factorisation reused (built before timing)
+//   fom_ipopt       Ipopt on the same QP (fewer queries: it is slow)
+//   rom_<method>    every registered online method (greedy, cpg, full-dictionary,
+//                   convex-hull where it applies), nonlinear contact operators included
+// Queries are the problem's validation parameters (thinned to --queries).
+#include <algorithm>
+#include <chrono>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "baselines/ipopt_qp.hpp"
+#include "fom/active_set_solver.hpp"
+#include "rom/offline.hpp"
+#include "rom/online_evaluation.hpp"
+#include "rom/reduced_model.hpp"
+#include "tools/cli.hpp"
+
+namespace contactrom::cli {
+namespace {
+
+struct BenchArgs {
+  std::string problem;
+  int train = 0, level = 0, repeats = 3, queries = 30, ipopt_queries = 5, threads = 0;
+  double delta = 1e-8;
+  bool json = false;
+};
+
+std::vector<fom::Param> thin(const std::vector<fom::Param>& all, int n) {
+  if (n <= 0 || static_cast<int>(all.size()) <= n) return all;
+  std::vector<fom::Param> out;
+  for (int i = 0; i < n; ++i) out.push_back(all[(static_cast<size_t>(i) * (all.size() - 1)) / std::max(n - 1, 1)]);
+  return out;
+}
+
+std::string key_of(const std::string& method) {
+  std::string k = "rom_" + method;
+  std::replace(k.begin(), k.end(), '-', '_');
+  return k;
+}
+
+void run_bench(const BenchArgs& a) {
+  if (a.repeats < 1) throw InputError("--repeats " + std::to_string(a.repeats) + " invalid; expected >= 1");
+  if (a.queries < 1) throw InputError("--queries " + std::to_string(a.queries) + " invalid; expected >= 1");
+  auto problem = fom::make_problem(a.problem);
+  int n = problem->uses_levels() ? a.level : a.train;
+  if (problem->uses_levels() && a.train) throw InputError("problem '" + a.problem + "' takes --level, not --train");
+  if (!problem->uses_levels() && a.level) throw InputError("problem '" + a.problem + "' takes --train, not --level");
+  if (n == 0) n = a.problem == "hertz" ? 30 : a.problem == "ironing" ? 7 : a.problem == "ironing2" ? 3 : 9;
+
+  nlohmann::json j;
+  j["problem"] = problem->name();
+  j["training"] = n;
+  j["delta"] = a.delta;
+  j["repeats"] = a.repeats;
+  auto log = [&](const std::string& s) {
+    if (!a.json) std::cerr << s << std::endl;
+  };
+
+  fom::ActiveSetSolver fom_solver(*problem);
+  rom::OfflineOptions off;
+  off.threads = a.threads;
+  const auto t0 = std::chrono::steady_clock::now();
+  const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, n, off);
+  const double offline_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::vector<fom::Param> queries = thin(rom::database_validation_set(db, *problem), a.queries);
+  j["queries"] = queries.size();
+  j["offline_s"] = offline_s;
+  j["snapshots"] = db.parameters.cols();
+  log("offline: " + std::to_string(db.parameters.cols()) + " snapshots in " + std::to_string(offline_s) + " s");
+
+  const double t_fom = rom::time_fom(fom_solver, queries, a.repeats);
+  j["fom_active_set"] = t_fom;
+  {
+    baselines::IpoptQpSolver ipopt(*problem);
+    std::vector<double> times;
+    for (const fom::Param& mu : thin(queries, a.ipopt_queries)) {
+      const auto s0 = std::chrono::steady_clock::now();
+      ipopt.solve(mu);
+      times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count());
+    }
+    j["fom_ipopt"] = rom::median(times);
+    j["ipopt_queries"] = times.size();
+  }
+
+  rom::ReducedModelOptions ro;
+  ro.delta = a.delta;
+  const rom::ReducedModel model(*problem, db, ro);
+  j["primal_rank"] = model.primal_rank();
+  j["dictionary_size"] = model.dictionary_size();
+  nlohmann::json skipped = nlohmann::json::object();
+  for (const std::string& method : rom::online_solver_names()) {
+    std::unique_ptr<rom::OnlineSolver> solver;
+    try {
+      solver = rom::make_online_solver(method, model);
+    } catch (const InputError& e) {
+      skipped[method] = e.what();  // e.g. convex-hull on a non-convex feasible set
+      continue;
+    }
+    const rom::OnlineTiming t = rom::time_online(*solver, queries, a.repeats);
+    j[key_of(method)] = t.median_core_s;
+    j[key_of(method) + "_with_reconstruction"] = t.median_total_s;
+  }
+  if (!skipped.empty()) j["not_applicable"] = skipped;
+
+  nlohmann::json ratios = nlohmann::json::object();
+  ratios["fom_ipopt/fom_active_set"] = j["fom_ipopt"].get<double>() / t_fom;
+  for (const std::string& method : rom::online_solver_names()) {
+    const std::string k = key_of(method);
+    if (!j.contains(k)) continue;
+    ratios["fom_active_set/" + k] = t_fom / j[k].get<double>();
+    if (k != "rom_greedy" && j.contains("rom_greedy")) ratios[k + "/rom_greedy"] = j[k].get<double>() / j["rom_greedy"].get<double>();
+  }
+  j["ratios"] = ratios;
+  if (a.json) {
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::cout << "contactrom bench: " << problem->name() << ", training " << n << ", delta " << a.delta << ", "
+            << queries.size() << " queries x " << a.repeats << " repeats (median seconds per query)\n";
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if ((it.key().rfind("fom_", 0) == 0 || it.key().rfind("rom_", 0) == 0) && it.value().is_number())
+      std::cout << "  " << std::left << std::setw(40) << it.key() << std::setprecision(4) << it.value().get<double>() << "\n";
+  std::cout << "ratios:\n";
+  for (auto it = ratios.begin(); it != ratios.end(); ++it)
+    std::cout << "  " << std::left << std::setw(40) << it.key() << std::setprecision(4) << it.value().get<double>() << "\n";
+}
+
+CommandRegistrar reg("bench", [](CLI::App& app) {
+  auto a = std::make_shared<BenchArgs>();
+  auto* sub = app.add_subcommand("bench", "Median per-query times of the FOM solvers and every ROM, in one run");
+  sub->add_option("--problem", a->problem, "rope | hertz | ironing | ironing2")->required();
+  sub->add_option("--train", a->train, "training size (hertz; default 30)");
+  sub->add_option("--level", a->level, "training level (ironing default 7, ironing2 default 3)");
+  sub->add_option("--delta", a->delta, "POD energy tolerance (default 1e-8)");
+  sub->add_option("--repeats", a->repeats, "timing passes over the queries (default 3)");
+  sub->add_option("--queries", a->queries, "number of validation parameters timed (default 30)");
+  sub->add_option("--ipopt-queries", a->ipopt_queries, "queries timed for Ipopt (default 5)");
+  sub->add_option("--threads", a->threads, "threads of the offline stage (default: all cores)");
+  sub->add_flag("--json", a->json, "print one JSON object");
+  sub->callback([a] { run_bench(*a); });
+});
+
+}  // namespace
+}  // namespace contactrom::cli
