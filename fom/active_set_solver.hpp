@@ -45,7 +45,7 @@ struct ActiveSetOptions {
   /// contact forces Cᵀλ (relative to |Cᵀλ|), the gaps of active rows and the
   /// penetration (relative to the displacement scale) by at most this; default 1e-12.
   double pairing_tolerance = 1e-12;
-  int anderson_depth = 5;           ///< Anderson acceleration depth of the pairing fixed point (0: plain), default 5
+  int anderson_depth = 10;          ///< Anderson acceleration depth of the pairing fixed point (0: plain), default 10
   DualQpOptions qp;                 ///< options of the dual QP solve
 };
 
