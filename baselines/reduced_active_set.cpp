@@ -1,0 +1,191 @@
+#include "baselines/reduced_active_set.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "baselines/cpg.hpp"
+#include "baselines/full_dictionary.hpp"
+
+namespace contactrom::baselines {
+
+ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options) {
+  // The greedy's translation validates the shared fields; reuse it, not a copy.
+  const rom::GreedyOptions g = rom::greedy_options(options);
+  ReducedActiveSetOptions o;
+  o.tau = g.tau;
+  o.tau_scaling = g.tau_scaling;
+  o.max_iterations = g.max_iterations;
+  o.step_tolerance = g.step_tolerance;
+  return o;
+}
+
+ReducedActiveSet::ReducedActiveSet(std::string name, const rom::ReducedModel& model, std::vector<int> dual_columns,
+                                   const Options& options)
+    : m_name(std::move(name)), m_model(model), m_columns(std::move(dual_columns)), m_options(options) {
+  const int m = model.dictionary_size();
+  std::vector<char> seen(m, 0);
+  for (int p : m_columns) {
+    if (p < 0 || p >= m)
+      throw InputError("dual basis column " + std::to_string(p) + " out of range; the dictionary has " +
+                       std::to_string(m) + " columns");
+    if (seen[p]) throw InputError("dual basis column " + std::to_string(p) + " given twice");
+    seen[p] = 1;
+  }
+  m_w.resize(model.dictionary().rows(), static_cast<Eigen::Index>(m_columns.size()));
+  for (size_t i = 0; i < m_columns.size(); ++i) m_w.col(static_cast<Eigen::Index>(i)) = model.dictionary().col(m_columns[i]);
+  if (options.max_iterations < 1)
+    throw InputError("max iterations " + std::to_string(options.max_iterations) + " invalid; expected >= 1");
+  // τ exactly as the greedy applies it (same default, same relative scale), so the
+  // three methods are held to the same reduced constraint.
+  rom::GreedyOptions g;
+  g.tau = options.tau;
+  g.tau_scaling = options.tau_scaling;
+  m_threshold = rom::GreedyActiveSet(model, g).threshold();
+}
+
+rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  const fom::Problem& problem = m_model.problem();
+  const fom::ContactModel& contact = problem.contact();
+  const Eigen::MatrixXd& phi_s = m_model.surface_basis();
+  const int r = m_model.primal_rank(), mw = static_cast<int>(m_w.cols()), nc = static_cast<int>(m_w.rows());
+
+  rom::OnlineResult res;
+  res.mu = mu;
+
+  // K̂(μ)⁻¹ as in the greedy: the offline Cholesky factor when K̂(μ) = θ₀(μ) K̂₀.
+  Eigen::LLT<Eigen::MatrixXd> local;
+  const Eigen::LLT<Eigen::MatrixXd>* llt = m_model.single_term_factor();
+  double inv_theta = 1.0;
+  if (llt) {
+    inv_theta = 1.0 / problem.stiffness_coefficients(mu)(0);
+  } else {
+    local.compute(m_model.reduced_stiffness(mu));
+    llt = &local;
+  }
+  if (llt->info() != Eigen::Success || !std::isfinite(inv_theta)) {
+    res.status = Status::NumericalIssue;
+    res.message = "Cholesky factorisation of the reduced stiffness failed";
+    res.u_hat = Eigen::VectorXd::Zero(r);
+    res.lambda = Eigen::VectorXd::Zero(nc);
+    res.u = m_model.reconstruct_primal(res.u_hat, mu);
+    res.time_s = std::chrono::duration<double>(clock::now() - t0).count();
+    return res;
+  }
+
+  const Eigen::VectorXd f_hat = m_model.reduced_rhs(mu);
+  const Eigen::VectorXd lift_s = m_model.surface_lifting(mu);
+  const Eigen::VectorXd u_free = inv_theta * llt->solve(f_hat);
+
+  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, u_s, g, c0, v, violation, rhs;
+  Eigen::MatrixXd c_phi, c_hat_i, z, schur;
+  fom::ConstraintMatrix c;
+  std::vector<int> active, next, solved;  // positions in W
+  std::vector<char> in_active(mw, 0);
+  Eigen::LDLT<Eigen::MatrixXd> ldlt;
+  bool small_step = true;  // û = u_free is exact for I = ∅
+
+  for (int k = 0;; ++k) {
+    // 1. Operators at the current û (surface rows only) and the violation of every column.
+    u_s.noalias() = phi_s * u_hat;
+    u_s += lift_s;
+    contact.assemble(contact.search(u_s), c, g);
+    c_phi.noalias() = c * phi_s;  // C_s Φ_s
+    c0.noalias() = g - c * lift_s;  // g − C_s u_lift,s
+    v.noalias() = c_phi * u_hat;
+    v -= c0;  // C_s u_s − g
+    violation.noalias() = m_w.transpose() * v;
+
+    // 2. Primal–dual update: drop every negative multiplier, add every violated column.
+    next.clear();
+    for (size_t i = 0; i < active.size(); ++i)
+      if (lambda_i(static_cast<Eigen::Index>(i)) >= 0.0) next.push_back(active[i]);
+    for (int p = 0; p < mw; ++p)
+      if (!in_active[p] && violation(p) > m_threshold) next.push_back(p);
+    const bool changed = next != active;
+    const double worst = mw ? violation.maxCoeff() : -std::numeric_limits<double>::infinity();
+
+    // 3. Converged: stable set, reduced constraint met at the fresh pairing, û settled.
+    if (!changed && worst <= m_threshold && small_step) {
+      res.converged = true;
+      break;
+    }
+    if (k == m_options.max_iterations) break;
+
+    for (int p : active) in_active[p] = 0;
+    active.swap(next);
+    for (int p : active) in_active[p] = 1;
+
+    // 4. Saddle-point system on I by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ.
+    const int na = static_cast<int>(active.size());
+    u_prev = u_hat;
+    if (na == 0) {
+      u_hat = u_free;
+      lambda_i.resize(0);
+    } else {
+      c_hat_i.resize(na, r);
+      rhs.resize(na);
+      for (int i = 0; i < na; ++i) {
+        c_hat_i.row(i).noalias() = m_w.col(active[i]).transpose() * c_phi;  // Ĉ_I = W_Iᵀ C_s Φ_s
+        rhs(i) = m_w.col(active[i]).dot(c0);                                // ĝ_I
+      }
+      z = inv_theta * llt->solve(c_hat_i.transpose());  // K̂⁻¹ Ĉ_Iᵀ
+      schur.noalias() = c_hat_i * z;
+      rhs = c_hat_i * u_free - rhs;
+      ldlt.compute(schur);
+      if (ldlt.info() == Eigen::Success && ldlt.rcond() > m_options.singular_tolerance)
+        lambda_i = ldlt.solve(rhs);
+      else  // dependent rows: least-squares, minimum-norm multipliers
+        lambda_i = schur.completeOrthogonalDecomposition().solve(rhs);
+      u_hat.noalias() = u_free - z * lambda_i;
+    }
+    solved = active;
+    res.iterations = k + 1;
+    if (!u_hat.allFinite() || !lambda_i.allFinite()) {
+      res.status = Status::NumericalIssue;
+      res.message = "reduced saddle-point solve produced a non-finite value";
+      break;
+    }
+    small_step = (u_hat - u_prev).norm() <= m_options.step_tolerance * u_hat.norm();
+  }
+
+  res.u_hat = u_hat;
+  res.selected.reserve(solved.size());
+  for (int p : solved) res.selected.push_back(m_columns[p]);
+  res.coefficients = lambda_i;
+  res.lambda = m_model.reconstruct_dual(res.selected, lambda_i);
+  if (res.status == Status::Success && !res.converged) {
+    res.status = Status::NoConvergence;
+    res.message = m_name + " active set did not converge in " + std::to_string(m_options.max_iterations) +
+                  " iterations";
+  }
+  const auto t1 = clock::now();
+  res.time_s = std::chrono::duration<double>(t1 - t0).count();
+  res.u = m_model.reconstruct_primal(u_hat, mu);
+  res.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
+  return res;
+}
+
+double reduced_penetration(const rom::ReducedModel& model, const std::vector<int>& columns, const Eigen::VectorXd& u) {
+  const fom::ContactModel& contact = model.problem().contact();
+  const Eigen::VectorXd us = contact.restrict_to_surface(u);
+  fom::ConstraintMatrix c;
+  Eigen::VectorXd g;
+  contact.assemble(contact.search(us), c, g);
+  const Eigen::VectorXd v = c * us - g;
+  double worst = -std::numeric_limits<double>::infinity();
+  for (int p : columns) worst = std::max(worst, model.dictionary().col(p).dot(v));
+  return worst;
+}
+
+void register_baseline_online_solvers() {
+  rom::register_online_solver("cpg", make_cpg_solver);
+  rom::register_online_solver("full-dictionary", make_full_dictionary_solver);
+}
+
+}  // namespace contactrom::baselines

@@ -1,0 +1,116 @@
+#pragma once
+/// \file reduced_active_set.hpp
+/// \brief The standard (non-sparse) primal–dual active-set method on the reduced
+/// saddle-point system with a fixed dual basis W — the online core shared by the
+/// CPG baseline (W = cone-projected greedy basis, baselines/cpg.hpp) and the
+/// full-dictionary baseline (W = D_d, baselines/full_dictionary.hpp).
+///
+/// Unknowns: reduced displacement û (u = Φû + u_lift(μ)) and reduced multipliers
+/// λ̂ ≥ 0 on the columns of W (λ = Wλ̂). The reduced problem is
+/// \f[ \min_{\hat u} \tfrac12 \hat u^T \hat K \hat u - \hat f^T \hat u \quad\text{s.t.}\quad
+///     \hat C \hat u - \hat g \le \tau, \qquad
+///     \hat C = W^T C(u) \Phi, \ \hat g = W^T (g(u) - C(u)\,u_{lift}), \f]
+/// whose KKT system, on the active set I (the columns whose constraint holds with
+/// equality), is the saddle-point system
+/// \f[ \begin{bmatrix} \hat K & \hat C_I^T \\ \hat C_I & 0 \end{bmatrix}
+///     \begin{bmatrix} \hat u \\ \hat\lambda_I \end{bmatrix} =
+///     \begin{bmatrix} \hat f \\ \hat g_I \end{bmatrix}. \f]
+/// The loop (Hintermüller–Ito–Kunisch primal–dual active set, as in Benaceur, Ern,
+/// Ehrlacher 2020) reads, starting from I = ∅ and the unconstrained û = K̂⁻¹f̂:
+///  1. rebuild the contact operators at the current û from the surface rows only,
+///     exactly as rom::GreedyActiveSet does (pairing = search(Φ_s û + u_lift,s),
+///     C_s, g = assemble(pairing)), and evaluate the reduced violation of every
+///     column, \f$ v = W^T (C_s u_s - g) \f$;
+///  2. next active set = { i ∈ I : λ̂_i ≥ 0 } ∪ { p ∉ I : v_p > τ } — every negative
+///     multiplier is removed and every violated column added at once (the non-sparse
+///     counterpart of the greedy's one change per iteration);
+///  3. converged when the set does not change, every column satisfies v_p ≤ τ at the
+///     freshly paired û (active columns included, so the returned solution honours the
+///     reduced constraint with its own pairing) and the last step moved û by at most
+///     step_tolerance relatively; otherwise solve the saddle-point system on the new I
+///     by its Schur complement (same factorisation of K̂ as the greedy) and repeat,
+///     at most max_iterations solves.
+/// τ is applied exactly as in the greedy (absolute by default, τ = δ; or relative,
+/// with the greedy's dictionary-wide scale), so both methods satisfy the same
+/// reduced constraint.
+///
+/// OnlineResult::selected holds the active columns as indices into the model's
+/// dictionary (W's columns are dictionary columns), so λ = D_d[:, I] λ̂_I as for the
+/// greedy; `iterations` counts the saddle-point solves.
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+#include "rom/greedy_active_set.hpp"
+#include "rom/online_evaluation.hpp"
+#include "rom/reduced_model.hpp"
+
+namespace contactrom::baselines {
+
+/// \brief Settings of ReducedActiveSet (documented defaults; the same meaning as
+/// rom::GreedyOptions).
+struct ReducedActiveSetOptions {
+  /// Penetration threshold τ of the reduced constraint; < 0: τ = δ of the model. Default −1.
+  double tau = -1.0;
+  /// Absolute (paper, default) or relative threshold, as for the greedy.
+  rom::TauScaling tau_scaling = rom::TauScaling::Absolute;
+  /// Cap on the saddle-point solves (paper's k_max). Default 50.
+  int max_iterations = 50;
+  /// Converged only if the last solve moved û by at most this relatively. Default 1e-5.
+  double step_tolerance = 1e-5;
+  /// Reciprocal condition estimate of the Schur complement's LDLᵀ under which the
+  /// system is solved in the least-squares, minimum-norm sense (dependent rows, e.g.
+  /// more active columns than primal modes). Default 1e-13.
+  double singular_tolerance = 1e-13;
+};
+
+/// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
+/// step_tolerance; validated as for the greedy). \throws InputError on bad values.
+ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options);
+
+/// \brief Primal–dual active-set online solver with dual basis W = D_d[:, columns];
+/// see the file comment.
+class ReducedActiveSet : public rom::OnlineSolver {
+ public:
+  using Options = ReducedActiveSetOptions;
+
+  /// \param name registry name reported by name()
+  /// \param model reduced model (must outlive the solver)
+  /// \param dual_columns dictionary columns forming W (distinct, in range)
+  /// \throws InputError if a column is out of range or repeated.
+  ReducedActiveSet(std::string name, const rom::ReducedModel& model, std::vector<int> dual_columns,
+                   const Options& options = {});
+
+  std::string name() const override { return m_name; }
+  const rom::ReducedModel& model() const override { return m_model; }
+  rom::OnlineResult solve(const fom::Param& mu) const override;
+
+  /// Dictionary columns forming W, in the order of W's columns.
+  const std::vector<int>& dual_columns() const { return m_columns; }
+  /// W = D_d[:, dual_columns()] (n_c × |W|).
+  const Eigen::MatrixXd& dual_basis() const { return m_w; }
+  /// The threshold τ actually used (same units as \f$ W^T (Cu - g) \f$).
+  double threshold() const { return m_threshold; }
+  const Options& options() const { return m_options; }
+
+ private:
+  std::string m_name;
+  const rom::ReducedModel& m_model;
+  std::vector<int> m_columns;
+  Eigen::MatrixXd m_w;
+  Options m_options;
+  double m_threshold = 0.0;
+};
+
+/// \brief Reduced-level penetration \f$ \max_p D_d[:,p]^T (C(u)\,u - g(u)) \f$ over the
+/// dictionary columns `columns`, with the pairing recomputed from the full displacement
+/// `u` (as fom::kkt_residuals does). Returns −∞ for an empty column list.
+double reduced_penetration(const rom::ReducedModel& model, const std::vector<int>& columns,
+                           const Eigen::VectorXd& u);
+
+/// \brief Registers "cpg" and "full-dictionary" with rom::register_online_solver
+/// (idempotent). The CLI registers them from tools/cmd_verify.cpp; programs that do
+/// not link that file (tests) call this.
+void register_baseline_online_solvers();
+
+}  // namespace contactrom::baselines
