@@ -1,0 +1,190 @@
+#include "rom/online_evaluation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <mutex>
+#include <ostream>
+
+#include "fom/atomic_file.hpp"
+#include "rom/greedy_active_set.hpp"
+
+namespace contactrom::rom {
+namespace {
+
+struct Registry {
+  std::mutex mutex;
+  std::map<std::string, OnlineSolverFactory> factories;
+};
+
+/// The registry, with the built-in methods. A function-local static, so that
+/// registrars running during static initialisation find it constructed.
+Registry& registry() {
+  static Registry* r = [] {
+    auto* reg = new Registry;  // never destroyed: registrars may outlive static destruction order
+    reg->factories["greedy"] = [](const ReducedModel& model, const OnlineSolverOptions& options) {
+      return std::unique_ptr<OnlineSolver>(std::make_unique<GreedyActiveSet>(model, greedy_options(options)));
+    };
+    return reg;
+  }();
+  return *r;
+}
+
+std::string format_double(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+}  // namespace
+
+void register_online_solver(const std::string& name, OnlineSolverFactory factory) {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  r.factories[name] = std::move(factory);
+}
+
+std::vector<std::string> online_solver_names() {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  std::vector<std::string> names;
+  for (const auto& entry : r.factories) names.push_back(entry.first);
+  return names;
+}
+
+std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const ReducedModel& model,
+                                                 const OnlineSolverOptions& options) {
+  OnlineSolverFactory factory;
+  {
+    Registry& r = registry();
+    std::lock_guard<std::mutex> lock(r.mutex);
+    const auto it = r.factories.find(name);
+    if (it != r.factories.end()) factory = it->second;
+  }
+  if (!factory) {
+    std::string known;
+    for (const std::string& n : online_solver_names()) known += (known.empty() ? "" : ", ") + n;
+    throw InputError("unknown online method '" + name + "'; expected one of: " + known);
+  }
+  return factory(model, options);
+}
+
+std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& solver,
+                                                 const std::vector<fom::Param>& params, int threads,
+                                                 const ProgressCallback& progress) {
+  std::vector<fom::FomSolution> out(params.size());
+  parallel_for(
+      static_cast<int>(params.size()), threads, [&](int i) { out[i] = solver.solve(params[i]); }, progress);
+  return out;
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  const double upper = values[mid];
+  if (values.size() % 2 == 1) return upper;
+  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + mid));
+}
+
+EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<fom::Param>& params,
+                                  const std::vector<fom::FomSolution>& references, const EvaluationOptions& options) {
+  if (references.size() != params.size())
+    throw std::invalid_argument("evaluate_online: one reference solution per parameter expected");
+  const ReducedModel& model = solver.model();
+  const fom::Problem& problem = model.problem();
+  EvaluationSummary s;
+  s.method = solver.name();
+  s.delta = model.delta();
+  s.dictionary_size = model.dictionary_size();
+  s.primal_rank = model.primal_rank();
+  std::vector<double> times;
+  for (size_t i = 0; i < params.size(); ++i) {
+    const OnlineResult res = solver.solve(params[i]);
+    const fom::FomSolution& ref = references[i];
+    EvaluationRow row;
+    row.mu = params[i];
+    row.primal_error = fom::relative_h1_error(problem, res.u, ref.u);
+    row.dual_error = fom::relative_l2_pressure_error(problem, res.lambda, ref.lambda);
+    row.sparsity = static_cast<int>(res.selected.size());
+    row.iterations = res.iterations;
+    row.time_s = res.time_s;
+    row.converged = res.converged;
+    row.status = res.status;
+    for (int c : res.selected) row.selected.push_back(model.dictionary_snapshots()[c]);
+    row.fom_status = ref.status;
+    row.fom_time_s = ref.time_s;
+    if (options.kkt) {
+      row.kkt = fom::kkt_residuals(problem, params[i], res.u, res.lambda);
+      s.max_kkt = std::max(s.max_kkt, row.kkt.max());
+    }
+    s.mean_primal_error += row.primal_error;
+    s.max_primal_error = std::max(s.max_primal_error, row.primal_error);
+    s.mean_dual_error += row.dual_error;
+    s.max_dual_error = std::max(s.max_dual_error, row.dual_error);
+    s.mean_sparsity += row.sparsity;
+    s.max_sparsity = std::max(s.max_sparsity, row.sparsity);
+    s.mean_iterations += row.iterations;
+    s.mean_time_s += row.time_s;
+    if (!res.converged || res.status != Status::Success) ++s.nonconverged;
+    if (ref.status != Status::Success) ++s.fom_failures;
+    times.push_back(row.time_s);
+    s.rows.push_back(std::move(row));
+  }
+  const double n = std::max<double>(1.0, static_cast<double>(params.size()));
+  s.mean_primal_error /= n;
+  s.mean_dual_error /= n;
+  s.mean_sparsity /= n;
+  s.mean_iterations /= n;
+  s.mean_time_s /= n;
+  s.median_time_s = median(times);
+  return s;
+}
+
+void write_evaluation_csv(const std::string& path, const fom::Problem& problem, const EvaluationSummary& summary) {
+  write_file_atomically(path, [&](std::ostream& out) {
+    for (const std::string& name : problem.param_names()) out << name << ',';
+    out << "primal_h1_error,dual_l2_error,sparsity,iterations,time_s,converged,status,selected\n";
+    for (const EvaluationRow& row : summary.rows) {
+      for (int k = 0; k < row.mu.size(); ++k) out << format_double(row.mu(k)) << ',';
+      out << format_double(row.primal_error) << ',' << format_double(row.dual_error) << ',' << row.sparsity << ','
+          << row.iterations << ',' << format_double(row.time_s) << ',' << (row.converged ? 1 : 0) << ','
+          << to_string(row.status) << ',';
+      for (size_t j = 0; j < row.selected.size(); ++j) out << (j ? " " : "") << row.selected[j];
+      out << '\n';
+    }
+  });
+}
+
+OnlineTiming time_online(const OnlineSolver& solver, const std::vector<fom::Param>& params, int repeats) {
+  OnlineTiming t;
+  if (params.empty()) return t;
+  for (const fom::Param& mu : params) (void)solver.solve(mu);  // warm-up (caches, allocator)
+  std::vector<double> core, total;
+  for (int rep = 0; rep < std::max(repeats, 1); ++rep)
+    for (const fom::Param& mu : params) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const OnlineResult res = solver.solve(mu);
+      total.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      core.push_back(res.time_s);
+    }
+  t.median_core_s = median(core);
+  t.median_total_s = median(total);
+  t.queries = static_cast<int>(core.size());
+  return t;
+}
+
+double time_fom(const fom::ActiveSetSolver& solver, const std::vector<fom::Param>& params, int repeats) {
+  if (params.empty()) return 0.0;
+  (void)solver.solve(params.front());  // warm-up
+  std::vector<double> times;
+  for (int rep = 0; rep < std::max(repeats, 1); ++rep)
+    for (const fom::Param& mu : params) {
+      const auto t0 = std::chrono::steady_clock::now();
+      (void)solver.solve(mu);
+      times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+  return median(times);
+}
+
+}  // namespace contactrom::rom

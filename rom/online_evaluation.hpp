@@ -1,0 +1,182 @@
+#pragma once
+/// \file online_evaluation.hpp
+/// \brief The common interface of the online ROM solvers (greedy active set,
+/// convex hull, CPG, full dictionary, ...), a name → factory registry, and the
+/// evaluation of a ROM over a parameter set against the FOM: errors, sparsity,
+/// iterations, time.
+///
+/// Exact command line (see docs/rom.md):
+/// \code
+///   contactrom online --db hertz30.h5 --method greedy --delta 1e-8 --validation --out hertz30.csv --json
+/// \endcode
+///
+/// Adding a method: implement OnlineSolver, then register a factory under its name
+/// — with register_online_solver() at run time, or with a static
+/// OnlineSolverRegistrar in a translation unit that is linked into the program.
+/// Beware: `contactrom_rom` is a static library, and the linker drops a library
+/// object file that nothing references, together with its static registrar. A
+/// registrar placed in a tools/cmd_*.cpp file (always linked into the CLI), or in
+/// a library file whose other symbols the program uses, is safe. "greedy" is
+/// registered here, built in.
+#include <Eigen/Dense>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fom/active_set_solver.hpp"
+#include "fom/errors.hpp"
+#include "fom/kkt.hpp"
+#include "fom/problem.hpp"
+#include "rom/offline.hpp"
+#include "rom/reduced_model.hpp"
+
+namespace contactrom::rom {
+
+/// \brief One online query of a ROM.
+struct OnlineResult {
+  fom::Param mu;                 ///< parameter of the query
+  Eigen::VectorXd u_hat;         ///< reduced primal coordinates û (size r)
+  Eigen::VectorXd u;             ///< full displacement Φû + u_lift(μ) (n_dofs)
+  Eigen::VectorXd lambda;        ///< full contact pressure D_d[:, I] λ̂_I (n_c)
+  std::vector<int> selected;     ///< selected dictionary columns I (indices into ReducedModel::dictionary())
+  Eigen::VectorXd coefficients;  ///< λ̂_I, in the order of `selected`
+  int iterations = 0;            ///< iterations of the method (one reduced solve each for greedy)
+  bool converged = false;        ///< stopping criterion met before the iteration cap
+  Status status = Status::Success;  ///< NoConvergence when !converged; NumericalIssue on a failed solve
+  /// Wall time of the online core (seconds): everything from μ to (û, λ̂_I) and the
+  /// full pressure, nonlinear contact operators included; the full-field
+  /// reconstruction Φû + u_lift (a mesh-size operation needed only for output) is
+  /// excluded and timed in `reconstruction_time_s`.
+  double time_s = 0.0;
+  double reconstruction_time_s = 0.0;  ///< wall time of u = Φû + u_lift (seconds)
+  std::string message;                 ///< reason when status != Success
+};
+
+/// \brief An online ROM method. solve() is const and must be thread-safe.
+class OnlineSolver {
+ public:
+  virtual ~OnlineSolver() = default;
+  /// Registry name of the method ("greedy", ...).
+  virtual std::string name() const = 0;
+  /// The reduced model the solver works on.
+  virtual const ReducedModel& model() const = 0;
+  /// \brief Solves the reduced problem at μ (range-checked by the caller).
+  virtual OnlineResult solve(const fom::Param& mu) const = 0;
+};
+
+/// \brief Settings shared by the online methods (each documents which it reads).
+struct OnlineSolverOptions {
+  /// Penetration threshold τ of the greedy enrichment; < 0: τ = δ of the model (the
+  /// paper's choice). Default −1.
+  double tau = -1.0;
+  /// How τ is applied: "absolute" (paper: on D_dᵀ(Cu − g) directly) or "relative"
+  /// (τ times the scale U·max_p Σ_s w_s|D_d[s,p]|; see docs/rom.md). Default "absolute".
+  std::string tau_scaling = "absolute";
+  /// Iteration cap k_max. Default 50.
+  int max_iterations = 50;
+  /// Relative change of û under which the iteration may stop. Default 1e-5.
+  double step_tolerance = 1e-5;
+  /// Method-specific settings by name (for methods added later), as text.
+  std::map<std::string, std::string> extra;
+};
+
+/// \brief Builds an online solver on a reduced model (which must outlive it).
+using OnlineSolverFactory =
+    std::function<std::unique_ptr<OnlineSolver>(const ReducedModel& model, const OnlineSolverOptions& options)>;
+
+/// \brief Registers (or replaces) the factory of method `name`.
+void register_online_solver(const std::string& name, OnlineSolverFactory factory);
+
+/// \brief Registers a method at static-initialisation time; see the file comment
+/// for where such an object must live to be linked.
+struct OnlineSolverRegistrar {
+  OnlineSolverRegistrar(const std::string& name, OnlineSolverFactory factory) {
+    register_online_solver(name, std::move(factory));
+  }
+};
+
+/// \brief Registered method names, sorted.
+std::vector<std::string> online_solver_names();
+
+/// \brief Builds the solver registered as `name`.
+/// \throws InputError "unknown online method 'x'; expected one of: ..." for an unknown name.
+std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const ReducedModel& model,
+                                                 const OnlineSolverOptions& options = {});
+
+/// \brief FOM reference solutions at `params` (one shared solver, in parallel on
+/// `threads` threads, ≤ 0: hardware concurrency; no warm start).
+std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& solver,
+                                                 const std::vector<fom::Param>& params, int threads = 0,
+                                                 const ProgressCallback& progress = {});
+
+/// \brief One evaluated query.
+struct EvaluationRow {
+  fom::Param mu;
+  double primal_error = 0.0;   ///< relative H¹ error against the FOM
+  double dual_error = 0.0;     ///< relative L²(Γc) error against the FOM
+  int sparsity = 0;            ///< |I|, number of selected dictionary columns
+  int iterations = 0;
+  double time_s = 0.0;         ///< online core time (OnlineResult::time_s)
+  bool converged = false;
+  Status status = Status::Success;
+  std::vector<int> selected;   ///< selected columns as database snapshot indices
+  Status fom_status = Status::Success;
+  double fom_time_s = 0.0;     ///< FOM reference time (measured in parallel: indicative only)
+  fom::KktResiduals kkt;       ///< FOM KKT residuals of the ROM solution (if requested)
+};
+
+/// \brief Settings of evaluate_online.
+struct EvaluationOptions {
+  bool kkt = false;  ///< compute the FOM KKT residuals of every ROM solution. Default false.
+};
+
+/// \brief Means and maxima over the rows; keys of DESIGN §5 `online`.
+struct EvaluationSummary {
+  std::string method;
+  double delta = 0.0;
+  int dictionary_size = 0;
+  int primal_rank = 0;
+  std::vector<EvaluationRow> rows;
+  double mean_primal_error = 0.0, max_primal_error = 0.0;
+  double mean_dual_error = 0.0, max_dual_error = 0.0;
+  double mean_sparsity = 0.0;
+  int max_sparsity = 0;
+  double mean_iterations = 0.0;
+  double mean_time_s = 0.0, median_time_s = 0.0;
+  int nonconverged = 0;   ///< ROM queries that hit the iteration cap or failed
+  int fom_failures = 0;   ///< reference FOM solves whose status != Success
+  double max_kkt = 0.0;   ///< largest KKT residual over the rows (if computed)
+};
+
+/// \brief Solves `solver` at every parameter (sequentially, so the timings are not
+/// disturbed) and compares with the references (same order as `params`).
+EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<fom::Param>& params,
+                                  const std::vector<fom::FomSolution>& references,
+                                  const EvaluationOptions& options = {});
+
+/// \brief Writes the rows as CSV (atomically): one column per parameter (named
+/// after it), then primal_h1_error, dual_l2_error, sparsity, iterations, time_s,
+/// converged (0/1), status, selected (space-separated database snapshot indices).
+void write_evaluation_csv(const std::string& path, const fom::Problem& problem, const EvaluationSummary& summary);
+
+/// \brief Median online time per query.
+struct OnlineTiming {
+  double median_core_s = 0.0;   ///< median of OnlineResult::time_s (nonlinear operators included)
+  double median_total_s = 0.0;  ///< median wall time of solve(), full-field reconstruction included
+  int queries = 0;              ///< number of timed queries
+};
+
+/// \brief Times `solver` over `params`, `repeats` times each (after one warm-up
+/// pass), on the calling thread. For `contactrom bench` and docs/rom.md.
+OnlineTiming time_online(const OnlineSolver& solver, const std::vector<fom::Param>& params, int repeats = 3);
+
+/// \brief Median wall time per FOM query (factorisation reused: the solver is
+/// built before timing), `repeats` passes over `params` after one warm-up query.
+double time_fom(const fom::ActiveSetSolver& solver, const std::vector<fom::Param>& params, int repeats = 1);
+
+/// \brief Median of a list of numbers (0 for an empty list).
+double median(std::vector<double> values);
+
+}  // namespace contactrom::rom

@@ -1,0 +1,162 @@
+#include "rom/reduced_model.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <chrono>
+
+#include "rom/pod.hpp"
+
+namespace contactrom::rom {
+namespace {
+
+/// Unconstrained FOM responses L̃_k = L_k + K_ff⁻¹ (f_ext,k − K L_k)_f at μ̄.
+std::vector<Eigen::VectorXd> harmonic_offsets(const fom::Problem& problem) {
+  const fom::Param mid = 0.5 * (problem.param_lower() + problem.param_upper());
+  const fom::SparseMatrix k = problem.stiffness(mid);
+  const std::vector<int>& free = problem.free_dofs();
+  const int n = problem.num_dofs(), nf = static_cast<int>(free.size());
+  std::vector<int> index(n, -1);
+  for (int i = 0; i < nf; ++i) index[free[i]] = i;
+  std::vector<Eigen::Triplet<double>> trip;
+  for (int col = 0; col < k.outerSize(); ++col) {
+    if (index[col] < 0) continue;
+    for (fom::SparseMatrix::InnerIterator it(k, col); it; ++it)
+      if (index[it.row()] >= 0) trip.emplace_back(index[it.row()], index[col], it.value());
+  }
+  fom::SparseMatrix kff(nf, nf);
+  kff.setFromTriplets(trip.begin(), trip.end());
+  Eigen::SimplicialLDLT<fom::SparseMatrix> ldlt(kff);
+  if (ldlt.info() != Eigen::Success)
+    throw InputError("stiffness of '" + problem.name() + "' is singular on the free dofs; cannot build the lifting");
+  std::vector<Eigen::VectorXd> out;
+  for (int t = 0; t < problem.num_load_terms(); ++t) {
+    const Eigen::VectorXd r = problem.external_load_terms()[t] - k * problem.lifting_terms()[t];
+    Eigen::VectorXd rf(nf);
+    for (int i = 0; i < nf; ++i) rf(i) = r(free[i]);
+    const Eigen::VectorXd x = ldlt.solve(rf);
+    Eigen::VectorXd l = problem.lifting_terms()[t];
+    for (int i = 0; i < nf; ++i) l(free[i]) += x(i);
+    out.push_back(l);
+  }
+  return out;
+}
+
+}  // namespace
+
+ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options)
+    : m_problem(problem), m_options(options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
+  if (db.num_dofs() != nd || db.num_constraints() != nc)
+    throw InputError("database of problem '" + db.problem + "' has " + std::to_string(db.num_dofs()) + " dofs and " +
+                     std::to_string(db.num_constraints()) + " contact rows, but " + problem.name() + " has " +
+                     std::to_string(nd) + " and " + std::to_string(nc));
+  if (!(options.delta >= 0.0))
+    throw InputError("POD tolerance delta = " + std::to_string(options.delta) + " invalid; expected >= 0");
+
+  for (int j = 0; j < db.num_snapshots(); ++j)
+    if (options.include_failed_snapshots || db.status[j] == Status::Success) m_dict_snapshots.push_back(j);
+  if (m_dict_snapshots.empty())
+    throw InputError("database of problem '" + db.problem + "' holds no successful snapshot");
+  const int m = static_cast<int>(m_dict_snapshots.size());
+
+  const int nt = problem.num_load_terms();
+  m_offset = options.lifting == LiftingKind::Harmonic ? harmonic_offsets(problem) : problem.lifting_terms();
+  Eigen::MatrixXd& primal = m_primal;
+  primal.resize(nd, m);
+  m_dict.resize(nc, m);
+  for (int c = 0; c < m; ++c) {
+    const int j = m_dict_snapshots[c];
+    primal.col(c) = db.primal.col(j);
+    m_dict.col(c) = db.dual.col(j);
+    m_dict_params.push_back(db.parameter(j));
+  }
+  // The database stores u − u_lift; the reduced displacement is measured from the
+  // offset: u − u_off = (u − u_lift) − Σ_k φ_k (L̃_k − L_k).
+  if (options.lifting != LiftingKind::Dirichlet) {
+    for (int c = 0; c < m; ++c) {
+      const Eigen::VectorXd phi = problem.load_coefficients(m_dict_params[c]);
+      for (int k = 0; k < nt; ++k) primal.col(c) -= phi(k) * (m_offset[k] - problem.lifting_terms()[k]);
+    }
+  }
+
+  // Primal basis: POD with the energy criterion (rom/pod.hpp); Dirichlet rows of
+  // the snapshots are zero, so are those of Φ (set exactly, against rounding).
+  PodOptions pod_options;
+  pod_options.delta = options.delta;
+  Pod pod(pod_options);
+  pod.compute(primal);
+  if (pod.info() != Status::Success)
+    throw InputError("POD of the primal snapshots of '" + db.problem + "' failed (" + to_string(pod.info()) + ")");
+  m_phi = pod.basis();
+  m_sigma = pod.singular_values();
+  const std::vector<char>& dirichlet = problem.is_dirichlet();
+  for (int i = 0; i < nd; ++i)
+    if (dirichlet[i]) m_phi.row(i).setZero();
+
+  const std::vector<int>& surf = problem.contact().surface_dofs();
+  const int ns = static_cast<int>(surf.size()), r = primal_rank();
+  m_phi_s.resize(ns, r);
+  for (int a = 0; a < ns; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
+  m_lift_s.resize(ns, nt);
+  for (int k = 0; k < nt; ++k)
+    for (int a = 0; a < ns; ++a) m_lift_s(a, k) = m_offset[k](surf[a]);
+
+  // Affine reduced operators (file comment).
+  m_f_hat.resize(r, nt);
+  for (int k = 0; k < nt; ++k) m_f_hat.col(k) = m_phi.transpose() * problem.external_load_terms()[k];
+  for (int q = 0; q < problem.num_stiffness_terms(); ++q) {
+    const fom::SparseMatrix& kq = problem.stiffness_term(q);
+    const Eigen::MatrixXd kphi = kq * m_phi;
+    Eigen::MatrixXd khat = m_phi.transpose() * kphi;
+    m_k_hat.push_back(0.5 * (khat + khat.transpose()));  // symmetric to rounding
+    Eigen::MatrixXd kl(r, nt);
+    for (int k = 0; k < nt; ++k) kl.col(k) = kphi.transpose() * m_offset[k];  // Φᵀ K_q L̃_k, K_q symmetric
+    m_kl_hat.push_back(kl);
+  }
+  if (problem.num_stiffness_terms() == 1) {
+    m_k_llt.compute(m_k_hat[0]);
+    m_single_ok = m_k_llt.info() == Eigen::Success;
+  }
+  m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+Eigen::MatrixXd ReducedModel::reduced_stiffness(const fom::Param& mu) const {
+  const Eigen::VectorXd theta = m_problem.stiffness_coefficients(mu);
+  Eigen::MatrixXd k = Eigen::MatrixXd::Zero(primal_rank(), primal_rank());
+  for (size_t q = 0; q < m_k_hat.size(); ++q) k += theta(q) * m_k_hat[q];
+  return k;
+}
+
+Eigen::VectorXd ReducedModel::reduced_rhs(const fom::Param& mu) const {
+  const Eigen::VectorXd theta = m_problem.stiffness_coefficients(mu);
+  const Eigen::VectorXd phi = m_problem.load_coefficients(mu);
+  Eigen::VectorXd f = m_f_hat * phi;
+  for (size_t q = 0; q < m_kl_hat.size(); ++q) f.noalias() -= theta(q) * (m_kl_hat[q] * phi);
+  return f;
+}
+
+Eigen::VectorXd ReducedModel::surface_lifting(const fom::Param& mu) const {
+  return m_lift_s * m_problem.load_coefficients(mu);
+}
+
+Eigen::VectorXd ReducedModel::offset(const fom::Param& mu) const {
+  const Eigen::VectorXd phi = m_problem.load_coefficients(mu);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(m_problem.num_dofs());
+  for (size_t k = 0; k < m_offset.size(); ++k) u.noalias() += phi(static_cast<Eigen::Index>(k)) * m_offset[k];
+  return u;
+}
+
+Eigen::VectorXd ReducedModel::reconstruct_primal(const Eigen::VectorXd& u_hat, const fom::Param& mu) const {
+  Eigen::VectorXd u = offset(mu);
+  u.noalias() += m_phi * u_hat;
+  return u;
+}
+
+Eigen::VectorXd ReducedModel::reconstruct_dual(const std::vector<int>& columns,
+                                               const Eigen::VectorXd& coefficients) const {
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m_dict.rows());
+  for (size_t i = 0; i < columns.size(); ++i) lambda.noalias() += coefficients(static_cast<Eigen::Index>(i)) * m_dict.col(columns[i]);
+  return lambda;
+}
+
+}  // namespace contactrom::rom

@@ -1,0 +1,132 @@
+#pragma once
+/// \file reduced_model.hpp
+/// \brief The offline product shared by the dictionary ROMs: POD primal basis,
+/// uncompressed dual dictionary and the parameter-affine reduced operators.
+///
+/// With \f$ u = u_{lift}(\mu) + \Phi\hat u \f$ (Φ zero on Dirichlet dofs), the
+/// reduced problem of paper eq. (5) needs, for every parameter,
+/// \f[ \hat K(\mu) = \Phi^T K(\mu) \Phi = \sum_q \theta_q(\mu)\,\Phi^T K_q \Phi, \qquad
+///     \hat f(\mu) = \Phi^T f(\mu) = \sum_k \phi_k(\mu) \Big( \Phi^T f_{ext,k}
+///        - \sum_q \theta_q(\mu)\, \Phi^T K_q L_k \Big), \f]
+/// which are assembled from the offline pieces \f$ \Phi^T K_q \Phi \f$ (r × r),
+/// \f$ \Phi^T f_{ext,k} \f$ and \f$ \Phi^T K_q L_k \f$ (r each) at a cost
+/// independent of the mesh. The nonlinear contact operators are rebuilt online
+/// from the contact-surface rows only: \f$ \Phi_s = \Phi[\text{surface dofs}, :] \f$
+/// and the surface lifting \f$ u_{lift,s}(\mu) = \sum_k \phi_k(\mu) L_{k,s} \f$.
+///
+/// The dual dictionary \f$ D_d \f$ (n_c × m) holds every pressure snapshot of the
+/// database whose FOM status is Success, uncompressed, in database order.
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+#include <vector>
+
+#include "fom/problem.hpp"
+#include "rom/snapshot_database.hpp"
+
+namespace contactrom::rom {
+
+/// \brief Which affine offset u_off(μ) = Σ_k φ_k(μ) L̃_k the reduced displacement is
+/// measured from (u = u_off(μ) + Φû). Both carry the Dirichlet data exactly.
+enum class LiftingKind {
+  /// L̃_k = L_k, the problem's lifting (Dirichlet values, zero elsewhere): the POD is
+  /// taken of the database snapshots u − u_lift as stored.
+  Dirichlet,
+  /// L̃_k = the unconstrained FOM response to load term k (Dirichlet values L_k and
+  /// external load f_ext,k) at the reference parameter (centre of the range):
+  /// \f$ \tilde L_k = L_k + K_{ff}^{-1}(f_{ext,k} - K L_k)_f \f$. For a
+  /// parameter-independent K the reduced unconstrained solution is then exact
+  /// (f̂ = 0) and Φ only has to represent the contact response.
+  Harmonic
+};
+
+/// \brief Options of ReducedModel (documented defaults).
+struct ReducedModelOptions {
+  /// POD energy tolerance δ of the primal basis (paper: δ ∈ {1e-6, 1e-8, 1e-10}).
+  /// Default 1e-8.
+  double delta = 1e-8;
+  /// Keep snapshots whose FOM status is not Success in the basis and dictionary.
+  /// Default false (they are left out; the offline stage warns about them).
+  bool include_failed_snapshots = false;
+  /// Offset of the reduced displacement; see LiftingKind. Default Harmonic.
+  LiftingKind lifting = LiftingKind::Harmonic;
+};
+
+/// \brief POD basis, dual dictionary and reduced operators; see the file comment.
+/// Immutable after construction and safe to share between threads.
+class ReducedModel {
+ public:
+  /// \brief Builds the model from a database that check_database() accepted for `problem`.
+  /// The problem must outlive the model.
+  /// \throws InputError if the database does not match the problem's sizes or
+  ///   holds no usable snapshot.
+  ReducedModel(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options = {});
+
+  const fom::Problem& problem() const { return m_problem; }
+  const ReducedModelOptions& options() const { return m_options; }
+  double delta() const { return m_options.delta; }
+
+  /// Number of primal modes r.
+  int primal_rank() const { return static_cast<int>(m_phi.cols()); }
+  /// Number of dictionary columns m.
+  int dictionary_size() const { return static_cast<int>(m_dict.cols()); }
+  /// POD basis Φ (n_dofs × r), orthonormal, zero rows on Dirichlet dofs.
+  const Eigen::MatrixXd& basis() const { return m_phi; }
+  /// Singular values of the primal snapshot matrix (decreasing).
+  const Eigen::VectorXd& singular_values() const { return m_sigma; }
+  /// Contact-surface rows of the basis, Φ_s (n_s × r), in surface_dofs() order.
+  const Eigen::MatrixXd& surface_basis() const { return m_phi_s; }
+  /// Dual dictionary D_d (n_c × m).
+  const Eigen::MatrixXd& dictionary() const { return m_dict; }
+  /// Database snapshot index of each dictionary column.
+  const std::vector<int>& dictionary_snapshots() const { return m_dict_snapshots; }
+  /// Parameter of each dictionary column.
+  const std::vector<fom::Param>& dictionary_parameters() const { return m_dict_params; }
+  /// Primal snapshots u − u_lift of the dictionary columns (n_dofs × m), for methods
+  /// that need them (e.g. monolithic dictionaries).
+  const Eigen::MatrixXd& primal_snapshots() const { return m_primal; }
+
+  /// Reduced stiffness terms \f$ \Phi^T K_q \Phi \f$ (r × r each).
+  const std::vector<Eigen::MatrixXd>& reduced_stiffness_terms() const { return m_k_hat; }
+  /// \f$ \hat K(\mu) = \sum_q \theta_q(\mu) \Phi^T K_q \Phi \f$.
+  Eigen::MatrixXd reduced_stiffness(const fom::Param& mu) const;
+  /// \f$ \hat f(\mu) = \Phi^T f(\mu) \f$ from the affine pieces.
+  Eigen::VectorXd reduced_rhs(const fom::Param& mu) const;
+  /// Offset on the surface dofs, \f$ u_{off}(\mu) \f$ restricted to surface_dofs().
+  Eigen::VectorXd surface_lifting(const fom::Param& mu) const;
+  /// Offset terms L̃_k of the reduced displacement (n_dofs each; see LiftingKind).
+  const std::vector<Eigen::VectorXd>& offset_terms() const { return m_offset; }
+  /// \f$ u_{off}(\mu) = \sum_k \phi_k(\mu) \tilde L_k \f$ (n_dofs).
+  Eigen::VectorXd offset(const fom::Param& mu) const;
+  /// Lifting terms restricted to the surface dofs (n_s × n_terms).
+  const Eigen::MatrixXd& surface_lifting_terms() const { return m_lift_s; }
+
+  /// \brief Cholesky factor of \f$ \Phi^T K_0 \Phi \f$ when the problem has a single
+  /// stiffness term (then \f$ \hat K(\mu) = \theta_0(\mu)\,\Phi^T K_0\Phi \f$: factorised
+  /// once here, offline); nullptr otherwise (factorise per query).
+  const Eigen::LLT<Eigen::MatrixXd>* single_term_factor() const { return m_single_ok ? &m_k_llt : nullptr; }
+
+  /// \brief Full displacement \f$ u = \Phi\hat u + u_{off}(\mu) \f$ (n_dofs).
+  Eigen::VectorXd reconstruct_primal(const Eigen::VectorXd& u_hat, const fom::Param& mu) const;
+  /// \brief Full pressure \f$ \lambda = D_d[:, I]\,\hat\lambda_I \f$ (n_c).
+  Eigen::VectorXd reconstruct_dual(const std::vector<int>& columns, const Eigen::VectorXd& coefficients) const;
+
+  /// Offline time spent building the model (POD + reduced operators), seconds.
+  double setup_time() const { return m_setup_time; }
+
+ private:
+  const fom::Problem& m_problem;
+  ReducedModelOptions m_options;
+  Eigen::MatrixXd m_primal, m_phi, m_phi_s, m_dict, m_lift_s;
+  Eigen::VectorXd m_sigma;
+  std::vector<int> m_dict_snapshots;
+  std::vector<fom::Param> m_dict_params;
+  std::vector<Eigen::VectorXd> m_offset;  // L̃_k
+  std::vector<Eigen::MatrixXd> m_k_hat;   // Φᵀ K_q Φ
+  Eigen::MatrixXd m_f_hat;                // column k: Φᵀ f_ext,k
+  std::vector<Eigen::MatrixXd> m_kl_hat;  // per q, column k: Φᵀ K_q L_k
+  Eigen::LLT<Eigen::MatrixXd> m_k_llt;
+  bool m_single_ok = false;
+  double m_setup_time = 0.0;
+};
+
+}  // namespace contactrom::rom

@@ -1,0 +1,88 @@
+#pragma once
+/// \file snapshot_database.hpp
+/// \brief The snapshot database of the offline stage: FOM primal and dual
+/// snapshots at the training parameters, with their parameters and solver
+/// outcome, stored in one HDF5 file (layout in docs/database_format.md; readable
+/// with h5py).
+///
+/// In memory, snapshots are the *columns* of column-major Eigen matrices
+/// (primal: n_dofs × n_snap, dual: n_c × n_snap, parameters: n_params × n_snap).
+/// The column-major buffer of an n_dofs × n_snap matrix is exactly the row-major
+/// buffer of an n_snap × n_dofs array, so the HDF5 datasets are
+/// `/primal[n_snap][n_dofs]` (one snapshot per row, as h5py users expect) and are
+/// written and read without any transposition.
+///
+/// Writing is atomic (temporary file + rename). Reading refuses, with one-line
+/// InputError messages naming the file: a missing file, a file that is not HDF5,
+/// a truncated or corrupt file, a wrong `format_version`, and (check_database)
+/// a database built for another mesh or problem options.
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+#include "fom/errors.hpp"
+#include "fom/problem.hpp"
+
+namespace contactrom::rom {
+
+/// \brief Version of the file layout written by write_database (attribute `format_version`).
+inline constexpr int kDatabaseFormatVersion = 1;
+
+/// \brief FOM snapshots at the training parameters; see the file comment.
+struct SnapshotDatabase {
+  std::string problem;           ///< problem name (make_problem)
+  std::string mesh_fingerprint;  ///< Problem::fingerprint() of the discretisation
+  std::string created_by;        ///< program and version that wrote the file
+  /// How the training set was selected: "train" (size n, `hertz`/`rope`) or
+  /// "level" (nested level n, `ironing`/`ironing2`).
+  std::string training_kind = "train";
+  int training_size = 0;                  ///< n of `--train n` or `--level n`
+  std::vector<std::string> param_names;   ///< names of the parameter components
+  Eigen::MatrixXd parameters;             ///< n_params × n_snap, column j = μ_j
+  Eigen::MatrixXd primal;                 ///< n_dofs × n_snap, u(μ_j) − u_lift(μ_j) (zero on Dirichlet dofs)
+  Eigen::MatrixXd dual;                   ///< n_c × n_snap, contact pressures λ(μ_j)
+  std::vector<Status> status;             ///< FOM outcome of each snapshot
+  std::vector<int> iterations;            ///< FOM active-set iterations of each snapshot
+  std::vector<int> pairing_iterations;    ///< FOM pairing fixed-point iterations of each snapshot
+  std::vector<double> time_s;             ///< FOM wall time of each snapshot (s)
+  double setup_time_s = 0.0;              ///< FOM factorisation/condensation time (s)
+  double wall_time_s = 0.0;               ///< wall time of the whole offline run (s)
+  int threads = 1;                        ///< worker threads of the offline run
+
+  int num_snapshots() const { return static_cast<int>(primal.cols()); }
+  int num_dofs() const { return static_cast<int>(primal.rows()); }
+  int num_constraints() const { return static_cast<int>(dual.rows()); }
+  /// Parameter of snapshot j.
+  fom::Param parameter(int j) const { return parameters.col(j); }
+  /// Indices of the snapshots whose status is Success, ascending.
+  std::vector<int> successful_snapshots() const;
+};
+
+/// \brief Writes `db` to `path` (HDF5) atomically: the file is written at
+/// temporary_path_for(path) and renamed over `path` once complete.
+/// \throws InputError naming `path` if the folder is not writable or HDF5 fails;
+///   no partial file is left behind.
+void write_database(const std::string& path, const SnapshotDatabase& db);
+
+/// \brief Reads a database written by write_database.
+/// \throws InputError (one line, naming `path`) if the file is missing, is not an
+///   HDF5 file, is truncated or corrupt, has another `format_version`, or has
+///   inconsistent dataset sizes.
+SnapshotDatabase read_database(const std::string& path);
+
+/// \brief Checks that `db` (read from `path`) was built for `problem`: same
+/// problem name, same mesh fingerprint (mesh + problem options), same numbers of
+/// dofs, constraints and parameters.
+/// \throws InputError, e.g. "database X was built for mesh fingerprint A but the
+///   current hertz mesh is B".
+void check_database(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path);
+
+/// \brief Training set of `problem` selected by the database's options
+/// (training_set(training_size)).
+std::vector<fom::Param> database_training_set(const SnapshotDatabase& db, const fom::Problem& problem);
+
+/// \brief Validation set associated with the database's training options
+/// (validation_set(training_size), DESIGN §1).
+std::vector<fom::Param> database_validation_set(const SnapshotDatabase& db, const fom::Problem& problem);
+
+}  // namespace contactrom::rom

@@ -1,0 +1,193 @@
+// contactrom online --db DB.h5 --method greedy [--delta D] [--tau T] [--validation] [--param V]
+//                   [--out FILE.csv|DIR] [--json] [--threads T] [--kkt]
+// Builds the reduced model (POD basis with tolerance δ, dual dictionary) from a
+// snapshot database and evaluates an online method:
+//  - --validation (default without --param): at every validation parameter of the
+//    problem (validation_set(n), n = the database's training size/level), against
+//    the FOM; --out FILE.csv gets one row per parameter; prints a summary (or the
+//    JSON object of DESIGN §5 with --json).
+//  - --param V: one query, compared with the FOM; --out DIR writes
+//    DIR/<problem>_<method>.vtu and DIR/<problem>_<method>_surface.csv.
+#include <algorithm>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "fom/active_set_solver.hpp"
+#include "fom/errors.hpp"
+#include "fom/field_output.hpp"
+#include "fom/kkt.hpp"
+#include "rom/online_evaluation.hpp"
+#include "rom/reduced_model.hpp"
+#include "rom/snapshot_database.hpp"
+#include "tools/cli.hpp"
+#include "tools/cli_common.hpp"
+
+namespace contactrom::cli {
+namespace {
+
+struct OnlineArgs {
+  std::string db, method = "greedy", param, out, tau_scaling = "absolute";
+  double delta = 1e-8, tau = -1.0;
+  int threads = 0, max_iterations = 50;
+  bool validation = false, json = false, kkt = false;
+};
+
+nlohmann::json selected_json(const std::vector<int>& selected) { return selected; }
+
+void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::ReducedModel& model,
+                const rom::OnlineSolver& solver) {
+  const fom::Param mu = fom::parse_param(problem, a.param);
+  const rom::OnlineResult res = solver.solve(mu);
+  const fom::ActiveSetSolver fom_solver(problem);
+  const fom::FomSolution ref = fom_solver.solve(mu);
+  const double primal = fom::relative_h1_error(problem, res.u, ref.u);
+  const double dual = fom::relative_l2_pressure_error(problem, res.lambda, ref.lambda);
+  const fom::KktResiduals kkt = fom::kkt_residuals(problem, mu, res.u, res.lambda);
+  std::vector<int> snapshots;
+  for (int c : res.selected) snapshots.push_back(model.dictionary_snapshots()[c]);
+  if (!a.out.empty()) {
+    fom::ensure_directory(a.out);
+    const std::string stem = a.out + "/" + problem.name() + "_" + solver.name();
+    fom::write_vtu(stem + ".vtu", problem, res.u, res.lambda);
+    fom::write_surface_csv(stem + "_surface.csv", problem, res.u, res.lambda);
+  }
+  nlohmann::json j;
+  j["problem"] = problem.name();
+  j["method"] = solver.name();
+  j["param"] = param_json(mu);
+  j["delta"] = model.delta();
+  j["dictionary_size"] = model.dictionary_size();
+  j["primal_rank"] = model.primal_rank();
+  j["status"] = to_string(res.status);
+  j["converged"] = res.converged;
+  j["iterations"] = res.iterations;
+  j["sparsity"] = res.selected.size();
+  j["selected"] = selected_json(snapshots);
+  j["coefficients"] = std::vector<double>(res.coefficients.data(), res.coefficients.data() + res.coefficients.size());
+  j["time_s"] = res.time_s;
+  j["primal_error"] = primal;
+  j["dual_error"] = dual;
+  j["contact_force"] = fom::contact_force(problem, res.lambda);
+  j["fom_contact_force"] = fom::contact_force(problem, ref.lambda);
+  j["fom_time_s"] = ref.time_s;
+  j["kkt"] = kkt_json(kkt);
+  if (a.json) {
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::cout << "online " << solver.name() << " on " << problem.name() << " at " << j["param"].dump() << ": "
+            << to_string(res.status) << ", " << res.iterations << " iterations\n"
+            << "dictionary " << model.dictionary_size() << " columns, primal rank " << model.primal_rank()
+            << " (delta " << model.delta() << ")\n"
+            << "selected snapshots " << j["selected"].dump() << " coefficients " << j["coefficients"].dump() << "\n"
+            << std::setprecision(3) << "primal H1 error " << primal << ", dual L2 error " << dual << "\n"
+            << "time " << res.time_s * 1e6 << " us (FOM " << ref.time_s * 1e3 << " ms)\n"
+            << "KKT (relative): stationarity " << kkt.stationarity << ", penetration " << kkt.penetration
+            << ", negative pressure " << kkt.negative_pressure << ", complementarity " << kkt.complementarity << "\n";
+  if (!a.out.empty()) std::cout << "fields written to " << a.out << "/\n";
+}
+
+void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom::SnapshotDatabase& db,
+                    const rom::OnlineSolver& solver) {
+  const std::vector<fom::Param> params = rom::database_validation_set(db, problem);
+  const fom::ActiveSetSolver fom_solver(problem);
+  const std::vector<fom::FomSolution> refs = rom::compute_references(fom_solver, params, a.threads);
+  rom::EvaluationOptions options;
+  options.kkt = a.kkt;
+  const rom::EvaluationSummary s = rom::evaluate_online(solver, params, refs, options);
+  if (!a.out.empty()) rom::write_evaluation_csv(a.out, problem, s);
+
+  nlohmann::json j;
+  j["problem"] = problem.name();
+  j["method"] = s.method;
+  j["delta"] = s.delta;
+  j["dictionary_size"] = s.dictionary_size;
+  j["primal_rank"] = s.primal_rank;
+  j["validation_size"] = s.rows.size();
+  j["mean_primal_error"] = s.mean_primal_error;
+  j["max_primal_error"] = s.max_primal_error;
+  j["mean_dual_error"] = s.mean_dual_error;
+  j["max_dual_error"] = s.max_dual_error;
+  j["mean_sparsity"] = s.mean_sparsity;
+  j["max_sparsity"] = s.max_sparsity;
+  j["mean_iterations"] = s.mean_iterations;
+  j["mean_time_s"] = s.mean_time_s;
+  j["median_time_s"] = s.median_time_s;
+  j["nonconverged"] = s.nonconverged;
+  j["fom_failures"] = s.fom_failures;
+  if (a.kkt) j["max_kkt"] = s.max_kkt;
+  if (a.json) {
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::cout << "online " << s.method << " on " << problem.name() << " (" << db.training_kind << " "
+            << db.training_size << "): " << s.rows.size() << " validation parameters\n"
+            << "dictionary " << s.dictionary_size << " columns, primal rank " << s.primal_rank << " (delta "
+            << s.delta << ")\n"
+            << std::setprecision(3) << std::left << std::setw(22) << "" << std::setw(12) << "mean" << "max\n"
+            << std::setw(22) << "primal H1 error" << std::setw(12) << s.mean_primal_error << s.max_primal_error << "\n"
+            << std::setw(22) << "dual L2 error" << std::setw(12) << s.mean_dual_error << s.max_dual_error << "\n"
+            << std::setw(22) << "sparsity |I|" << std::setw(12) << s.mean_sparsity << s.max_sparsity << "\n"
+            << std::setw(22) << "iterations" << std::setw(12) << s.mean_iterations << "\n"
+            << std::setw(22) << "time per query (us)" << std::setw(12) << s.mean_time_s * 1e6 << "(median "
+            << s.median_time_s * 1e6 << ")\n"
+            << "not converged: " << s.nonconverged << " of " << s.rows.size();
+  if (s.fom_failures) std::cout << "; FOM reference failures: " << s.fom_failures;
+  if (a.kkt) std::cout << "; max KKT residual " << s.max_kkt;
+  std::cout << "\n";
+  if (!a.out.empty()) std::cout << "per-parameter results written to " << a.out << "\n";
+}
+
+void run_online(const OnlineArgs& a) {
+  if (!a.param.empty() && a.validation)
+    throw InputError("--param and --validation exclude each other; give one");
+  const rom::SnapshotDatabase db = rom::read_database(a.db);
+  auto problem = fom::make_problem(db.problem);
+  rom::check_database(db, *problem, a.db);
+  rom::OnlineSolverOptions options;
+  options.tau = a.tau;
+  options.tau_scaling = a.tau_scaling;
+  options.max_iterations = a.max_iterations;
+  // Validate the method name before the (more expensive) model construction.
+  const std::vector<std::string> names = rom::online_solver_names();
+  if (std::find(names.begin(), names.end(), a.method) == names.end()) {
+    std::string known;
+    for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+    throw InputError("unknown online method '" + a.method + "'; expected one of: " + known);
+  }
+  rom::ReducedModelOptions model_options;
+  model_options.delta = a.delta;
+  const rom::ReducedModel model(*problem, db, model_options);
+  const auto solver = rom::make_online_solver(a.method, model, options);
+  if (!a.param.empty())
+    run_single(a, *problem, model, *solver);
+  else
+    run_validation(a, *problem, db, *solver);
+}
+
+CommandRegistrar reg("online", [](CLI::App& app) {
+  auto args = std::make_shared<OnlineArgs>();
+  auto* sub = app.add_subcommand("online", "Evaluate a reduced model built from a snapshot database");
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
+  sub->add_option("--method", args->method, "online method (default greedy; see the error text for all)");
+  sub->add_option("--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--tau", args->tau, "greedy penetration threshold (default: tau = delta)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--tau-scaling", args->tau_scaling, "absolute (default, paper) | relative")
+      ->check(CLI::IsMember({"absolute", "relative"}));
+  sub->add_option("--max-iterations", args->max_iterations, "iteration cap k_max (default 50)")
+      ->check(CLI::Range(1, 100000));
+  sub->add_flag("--validation", args->validation, "evaluate on the validation set (default without --param)");
+  sub->add_option("--param", args->param, "one query V or V1,V2");
+  sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)");
+  sub->add_option("--threads", args->threads, "threads for the FOM references (default: hardware concurrency)")
+      ->check(CLI::Range(1, 1024));
+  sub->add_flag("--kkt", args->kkt, "also compute the FOM KKT residuals of every ROM solution");
+  sub->add_flag("--json", args->json, "print one JSON object");
+  sub->callback([args] { run_online(*args); });
+});
+
+}  // namespace
+}  // namespace contactrom::cli
