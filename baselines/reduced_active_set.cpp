@@ -20,6 +20,14 @@ ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOption
   o.tau_scaling = g.tau_scaling;
   o.max_iterations = g.max_iterations;
   o.step_tolerance = g.step_tolerance;
+  if (const auto it = options.extra.find("inner_solve"); it != options.extra.end()) {
+    if (it->second == "nonnegative")
+      o.inner_solve = InnerSolve::NonNegative;
+    else if (it->second == "equality")
+      o.inner_solve = InnerSolve::Equality;
+    else
+      throw InputError("option inner_solve = '" + it->second + "' unknown; expected nonnegative or equality");
+  }
   return o;
 }
 
@@ -88,6 +96,8 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   std::vector<int> active, next, solved;  // positions in W
   std::vector<char> in_active(mw, 0);
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
+  rom::NnlsQp nnls(m_options.nnls);
+  const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
   bool small_step = true;  // û = u_free is exact for I = ∅
 
   for (int k = 0;; ++k) {
@@ -101,10 +111,15 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
     v -= c0;  // C_s u_s − g
     violation.noalias() = m_w.transpose() * v;
 
-    // 2. Primal–dual update: drop every negative multiplier, add every violated column.
+    // 2. Primal–dual update: drop the columns whose multiplier left the cone, add every
+    //    violated column. With the non-negative inner solve a zero multiplier on a
+    //    still-violated column keeps it (dropping and re-adding it would cycle).
     next.clear();
-    for (size_t i = 0; i < active.size(); ++i)
-      if (lambda_i(static_cast<Eigen::Index>(i)) >= 0.0) next.push_back(active[i]);
+    for (size_t i = 0; i < active.size(); ++i) {
+      const double l = lambda_i(static_cast<Eigen::Index>(i));
+      const bool keep = nonnegative ? (l > 0.0 || violation(active[i]) > m_threshold) : l >= 0.0;
+      if (keep) next.push_back(active[i]);
+    }
     for (int p = 0; p < mw; ++p)
       if (!in_active[p] && violation(p) > m_threshold) next.push_back(p);
     const bool changed = next != active;
@@ -137,11 +152,19 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
       z = inv_theta * llt->solve(c_hat_i.transpose());  // K̂⁻¹ Ĉ_Iᵀ
       schur.noalias() = c_hat_i * z;
       rhs = c_hat_i * u_free - rhs;
-      ldlt.compute(schur);
-      if (ldlt.info() == Eigen::Success && ldlt.rcond() > m_options.singular_tolerance)
-        lambda_i = ldlt.solve(rhs);
-      else  // dependent rows: least-squares, minimum-norm multipliers
-        lambda_i = schur.completeOrthogonalDecomposition().solve(rhs);
+      if (nonnegative) {
+        // min ½ λᵀ S λ − rhsᵀ λ, λ ≥ 0: the saddle-point system on I with the sign
+        // condition imposed (Lawson–Hanson; dependent rows are never freed together).
+        nnls.compute(schur);
+        lambda_i = nnls.solve(rhs);
+        if (nnls.info() == Status::InvalidInput) lambda_i = Eigen::VectorXd::Constant(na, std::numeric_limits<double>::quiet_NaN());
+      } else {
+        ldlt.compute(schur);
+        if (ldlt.info() == Eigen::Success && ldlt.rcond() > m_options.singular_tolerance)
+          lambda_i = ldlt.solve(rhs);
+        else  // dependent rows: least-squares, minimum-norm multipliers
+          lambda_i = schur.completeOrthogonalDecomposition().solve(rhs);
+      }
       u_hat.noalias() = u_free - z * lambda_i;
     }
     solved = active;
@@ -155,10 +178,16 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   }
 
   res.u_hat = u_hat;
-  res.selected.reserve(solved.size());
-  for (int p : solved) res.selected.push_back(m_columns[p]);
-  res.coefficients = lambda_i;
-  res.lambda = m_model.reconstruct_dual(res.selected, lambda_i);
+  // Report the support: columns of the last solve with a non-zero multiplier.
+  res.coefficients.resize(static_cast<Eigen::Index>(solved.size()));
+  for (size_t i = 0; i < solved.size(); ++i) {
+    const double l = lambda_i(static_cast<Eigen::Index>(i));
+    if (l == 0.0) continue;
+    res.coefficients(static_cast<Eigen::Index>(res.selected.size())) = l;
+    res.selected.push_back(m_columns[solved[i]]);
+  }
+  res.coefficients.conservativeResize(static_cast<Eigen::Index>(res.selected.size()));
+  res.lambda = m_model.reconstruct_dual(res.selected, res.coefficients);
   if (res.status == Status::Success && !res.converged) {
     res.status = Status::NoConvergence;
     res.message = m_name + " active set did not converge in " + std::to_string(m_options.max_iterations) +

@@ -21,15 +21,28 @@
 ///     exactly as rom::GreedyActiveSet does (pairing = search(Φ_s û + u_lift,s),
 ///     C_s, g = assemble(pairing)), and evaluate the reduced violation of every
 ///     column, \f$ v = W^T (C_s u_s - g) \f$;
-///  2. next active set = { i ∈ I : λ̂_i ≥ 0 } ∪ { p ∉ I : v_p > τ } — every negative
-///     multiplier is removed and every violated column added at once (the non-sparse
-///     counterpart of the greedy's one change per iteration);
+///  2. next active set = the columns of I whose multiplier stays in the cone, plus
+///     every column p ∉ I with v_p > τ — any number of columns enters or leaves at
+///     once (the non-sparse counterpart of the greedy's one change per iteration);
 ///  3. converged when the set does not change, every column satisfies v_p ≤ τ at the
 ///     freshly paired û (active columns included, so the returned solution honours the
-///     reduced constraint with its own pairing) and the last step moved û by at most
+///     reduced constraint with its own pairing) and the last solve moved û by at most
 ///     step_tolerance relatively; otherwise solve the saddle-point system on the new I
-///     by its Schur complement (same factorisation of K̂ as the greedy) and repeat,
-///     at most max_iterations solves.
+///     through its Schur complement \f$ S = \hat C_I \hat K^{-1} \hat C_I^T \f$ (same
+///     factorisation of K̂ as the greedy) and repeat, at most max_iterations solves.
+///
+/// Inner solve (InnerSolve). `Equality` is the textbook PDAS: Sλ̂_I = Ĉ_I K̂⁻¹f̂ − ĝ_I
+/// (minimum-norm when S is singular), then every negative λ̂_i leaves I. With a
+/// non-negative, highly correlated dual basis (pressure snapshots), Ĉ_I has more rows
+/// than rank as soon as a few columns are active; the multipliers are then not unique,
+/// the minimum-norm ones have mixed signs and the plain iteration cycles or diverges
+/// (measured in docs/baselines.md). `NonNegative` (default) solves the same system with
+/// the sign condition imposed, \f$ \min_{\hat\lambda_I \ge 0} \tfrac12
+/// \hat\lambda_I^T S \hat\lambda_I - (\hat C_I \hat K^{-1}\hat f - \hat g_I)^T
+/// \hat\lambda_I \f$ (rom::NnlsQp), i.e. "remove every negative" is done exactly inside
+/// the solve; a column leaves I when its multiplier is zero and its constraint holds.
+/// For a fixed pairing the working set then only gains violated columns or loses
+/// inactive ones, so the iteration cannot cycle.
 /// τ is applied exactly as in the greedy (absolute by default, τ = δ; or relative,
 /// with the greedy's dictionary-wide scale), so both methods satisfy the same
 /// reduced constraint.
@@ -42,13 +55,20 @@
 #include <vector>
 
 #include "rom/greedy_active_set.hpp"
+#include "rom/nnls.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::baselines {
 
-/// \brief Settings of ReducedActiveSet (documented defaults; the same meaning as
-/// rom::GreedyOptions).
+/// \brief How the saddle-point system on the active set is solved; see the file comment.
+enum class InnerSolve {
+  NonNegative,  ///< multipliers constrained to λ̂_I ≥ 0 (NNLS on the Schur complement); default
+  Equality      ///< textbook PDAS: equality solve, negatives removed afterwards
+};
+
+/// \brief Settings of ReducedActiveSet (documented defaults; tau … step_tolerance have
+/// the same meaning as in rom::GreedyOptions).
 struct ReducedActiveSetOptions {
   /// Penetration threshold τ of the reduced constraint; < 0: τ = δ of the model. Default −1.
   double tau = -1.0;
@@ -62,10 +82,15 @@ struct ReducedActiveSetOptions {
   /// system is solved in the least-squares, minimum-norm sense (dependent rows, e.g.
   /// more active columns than primal modes). Default 1e-13.
   double singular_tolerance = 1e-13;
+  /// Inner solve of the saddle-point system. Default InnerSolve::NonNegative.
+  InnerSolve inner_solve = InnerSolve::NonNegative;
+  /// Settings of the NNLS inner solve (default: those of rom::NnlsOptions).
+  rom::NnlsOptions nnls;
 };
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
-/// step_tolerance; validated as for the greedy). \throws InputError on bad values.
+/// step_tolerance; validated as for the greedy) and `extra["inner_solve"]`
+/// ("nonnegative" or "equality"). \throws InputError on bad values.
 ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options);
 
 /// \brief Primal–dual active-set online solver with dual basis W = D_d[:, columns];

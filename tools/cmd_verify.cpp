@@ -1,5 +1,5 @@
 // contactrom verify --db DB.h5 --method M[,M2,...] [--delta D] [--tau T] [--tau-scaling S]
-//                   [--cpg-tolerance E] [--reference ipopt|fom] [--threads T] [--limit N]
+//                   [--cpg-tolerance E] [--inner-solve nonnegative|equality] [--reference ipopt|fom] [--threads T] [--limit N]
 //                   [--bench] [--repeats R] [--out FILE.csv] [--progress] [--json]
 // KKT verification of reduced solutions against the Ipopt reference (DESIGN §5):
 // for every validation parameter of the database's training set and every method,
@@ -58,7 +58,7 @@ const rom::OnlineSolverRegistrar full_dictionary_registrar("full-dictionary", ba
 constexpr double kReducedPenetrationSlack = 1e-10;
 
 struct VerifyArgs {
-  std::string db, methods, reference = "ipopt", out, tau_scaling = "absolute";
+  std::string db, methods, reference = "ipopt", out, tau_scaling = "absolute", inner_solve;
   double delta = 1e-8, tau = -1.0, cpg_tolerance = -1.0;
   int threads = 0, max_iterations = 50, limit = 0, repeats = 3;
   bool json = false, progress = false, bench = false;
@@ -247,6 +247,7 @@ void run_verify(const VerifyArgs& a) {
   options.tau_scaling = a.tau_scaling;
   options.max_iterations = a.max_iterations;
   if (a.cpg_tolerance >= 0.0) options.extra["cpg_tolerance"] = format_double(a.cpg_tolerance);
+  if (!a.inner_solve.empty()) options.extra["inner_solve"] = a.inner_solve;
   std::vector<std::unique_ptr<rom::OnlineSolver>> solvers;
   for (const std::string& m : methods) solvers.push_back(rom::make_online_solver(m, model, options));
 
@@ -411,6 +412,9 @@ CommandRegistrar reg("verify", [](CLI::App& app) {
   sub->add_option("--cpg-tolerance", args->cpg_tolerance,
                   "CPG cone-projection tolerance (default: 1e-2 hertz, 5e-2 ironing/ironing2, 1e-2 otherwise)")
       ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--inner-solve", args->inner_solve,
+                  "cpg/full-dictionary saddle-point solve: nonnegative (default) | equality (textbook PDAS)")
+      ->check(CLI::IsMember({"nonnegative", "equality"}));
   sub->add_option("--reference", args->reference, "reference solver: ipopt (default) | fom (custom active set)");
   sub->add_option("--threads", args->threads, "threads for the reference solves (default: hardware concurrency)")
       ->check(CLI::Range(1, 1024));
