@@ -253,7 +253,7 @@ SnapshotDatabase read_database(const std::string& path) {
     throw InputError("database '" + path + "' is not an HDF5 file (expected one written by contactrom offline)");
   SnapshotDatabase db;
   try {
-    Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, "file open");
+    Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, "the file structure");
     const hid_t f = file.id();
     if (!has_attribute(f, "format_version"))
       throw InputError("database '" + path + "' has no format_version attribute; not a contactrom database");

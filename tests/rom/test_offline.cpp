@@ -1,0 +1,214 @@
+// Offline stage (rom/offline.hpp) and the offline/online CLI: parallel snapshots are
+// bit-identical whatever the thread count, snapshots are u − u_lift with exact zeros
+// on Dirichlet dofs, parallel_for visits every task once and propagates errors, and
+// the CLI refuses bad input with one line, a non-zero exit and no partial output.
+#define BOOST_TEST_MODULE rom_offline
+#include <boost/test/unit_test.hpp>
+
+#include <atomic>
+#include <cstring>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "common/run_command.hpp"
+#include "fom/active_set_solver.hpp"
+#include "fom/problem.hpp"
+#include "rom/offline.hpp"
+#include "rom/snapshot_database.hpp"
+
+namespace fs = std::filesystem;
+using contactrom::Status;
+using contactrom::test::run_command;
+
+namespace {
+
+const std::string exe = CONTACTROM_EXE;
+
+int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+bool bitwise_equal(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0;
+}
+
+const contactrom::fom::Problem& hertz() {
+  static auto p = contactrom::fom::make_problem("hertz");
+  return *p;
+}
+
+const std::string& work_dir() {
+  static const std::string dir = contactrom::test::temp_dir();
+  return dir;
+}
+
+struct Cleanup {
+  ~Cleanup() {
+    std::error_code ec;
+    fs::remove_all(work_dir(), ec);
+  }
+} cleanup;
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(snapshots_are_bit_identical_for_any_thread_count) {
+  contactrom::rom::OfflineOptions one, two, three;
+  one.threads = 1;
+  two.threads = 2;
+  three.threads = 3;
+  const auto a = contactrom::rom::generate_snapshots(hertz(), 8, one);
+  const auto b = contactrom::rom::generate_snapshots(hertz(), 8, two);
+  const auto c = contactrom::rom::generate_snapshots(hertz(), 8, three);
+  BOOST_TEST(a.num_snapshots() == 8);
+  BOOST_TEST(b.threads == 2);
+  for (const auto* other : {&b, &c}) {
+    BOOST_TEST(bitwise_equal(a.primal, other->primal));
+    BOOST_TEST(bitwise_equal(a.dual, other->dual));
+    BOOST_TEST(bitwise_equal(a.parameters, other->parameters));
+    BOOST_TEST(a.status == other->status);
+    BOOST_TEST(a.iterations == other->iterations, boost::test_tools::per_element());
+  }
+  // ... and survive the file bitwise.
+  const std::string path = work_dir() + "/hertz8.h5";
+  contactrom::rom::write_database(path, b);
+  const auto back = contactrom::rom::read_database(path);
+  BOOST_TEST(bitwise_equal(a.primal, back.primal));
+  BOOST_TEST(bitwise_equal(a.dual, back.dual));
+  BOOST_TEST(back.training_kind == "train");
+  BOOST_TEST(back.training_size == 8);
+  BOOST_TEST(back.mesh_fingerprint == hertz().fingerprint());
+}
+
+BOOST_AUTO_TEST_CASE(snapshot_is_fom_solution_minus_lifting) {
+  contactrom::rom::OfflineOptions options;
+  options.threads = 2;
+  const auto db = contactrom::rom::generate_snapshots(hertz(), 4, options);
+  const contactrom::fom::ActiveSetSolver solver(hertz());
+  for (int j = 0; j < db.num_snapshots(); ++j) {
+    BOOST_TEST(db.status[j] == Status::Success);
+    const auto sol = solver.solve(db.parameter(j));
+    const Eigen::VectorXd u = db.primal.col(j) + hertz().lifting(db.parameter(j));
+    BOOST_TEST((u - sol.u).cwiseAbs().maxCoeff() <= 1e-15 * sol.u.cwiseAbs().maxCoeff());
+    BOOST_TEST(bitwise_equal(db.dual.col(j), sol.lambda));
+    double dirichlet_max = 0.0;
+    for (int i = 0; i < hertz().num_dofs(); ++i)
+      if (hertz().is_dirichlet()[i]) dirichlet_max = std::max(dirichlet_max, std::abs(db.primal(i, j)));
+    BOOST_TEST(dirichlet_max == 0.0);
+    BOOST_TEST(db.dual.col(j).maxCoeff() > 0.0);  // hertz always touches for d > 0
+  }
+}
+
+BOOST_AUTO_TEST_CASE(parallel_for_visits_every_task_once_and_reports_progress) {
+  const int n = 1000;
+  std::vector<std::atomic<int>> visits(n);
+  int last = 0, calls = 0;
+  bool monotone = true;
+  contactrom::rom::parallel_for(
+      n, 3, [&](int i) { visits[i]++; },
+      [&](int done, int total) {
+        monotone = monotone && done > last && total == n;
+        last = done;
+        ++calls;
+      });
+  int wrong = 0;
+  for (auto& v : visits) wrong += v.load() != 1;
+  BOOST_TEST(wrong == 0);
+  BOOST_TEST(monotone);
+  BOOST_TEST(last == n);
+  BOOST_TEST(calls >= 1);
+}
+
+BOOST_AUTO_TEST_CASE(parallel_for_rethrows_the_first_error) {
+  BOOST_CHECK_THROW(contactrom::rom::parallel_for(50, 2,
+                                                  [](int i) {
+                                                    if (i == 17) throw std::runtime_error("task 17 failed");
+                                                  }),
+                    std::runtime_error);
+  contactrom::rom::parallel_for(0, 2, [](int) { throw std::runtime_error("never called"); });  // no tasks
+}
+
+BOOST_AUTO_TEST_CASE(cli_offline_then_online_validation) {
+  const std::string db = work_dir() + "/hertz12.h5", csv = work_dir() + "/hertz12.csv";
+  auto r = run_command(exe + " offline --problem hertz --train 12 --out " + db + " --threads 2 --json");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  auto j = nlohmann::json::parse(r.out);
+  BOOST_TEST(j["snapshots"].get<int>() == 12);
+  BOOST_TEST(j["failed"].get<int>() == 0);
+  BOOST_TEST(r.err.find('\r') == std::string::npos);  // no progress bar when stderr is not a terminal
+
+  r = run_command(exe + " online --db " + db + " --method greedy --delta 1e-8 --validation --out " + csv + " --json");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  BOOST_TEST(lines(r.out) == 1);  // exactly one JSON object
+  j = nlohmann::json::parse(r.out);
+  for (const char* key : {"method", "delta", "dictionary_size", "primal_rank", "mean_primal_error", "mean_dual_error",
+                          "mean_sparsity", "mean_iterations", "mean_time_s", "nonconverged"})
+    BOOST_TEST(j.contains(key), key);
+  BOOST_TEST(j["method"] == "greedy");
+  BOOST_TEST(j["dictionary_size"].get<int>() == 12);
+  BOOST_TEST(j["mean_dual_error"].get<double>() < 0.2);
+  const std::string table = contactrom::test::slurp(csv);
+  BOOST_TEST(table.rfind("d,primal_h1_error,dual_l2_error,sparsity,iterations,time_s,converged,status,selected\n", 0) ==
+             0);
+  BOOST_TEST(lines(table) == 1 + 119);
+
+  // One query with field output.
+  r = run_command(exe + " online --db " + db + " --param 0.15 --out " + work_dir() + "/fields --json");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  j = nlohmann::json::parse(r.out);
+  BOOST_TEST(j["primal_error"].get<double>() < 0.05);
+  BOOST_TEST(fs::exists(work_dir() + "/fields/hertz_greedy.vtu"));
+  BOOST_TEST(fs::exists(work_dir() + "/fields/hertz_greedy_surface.csv"));
+}
+
+BOOST_AUTO_TEST_CASE(cli_missing_database_is_one_line_error) {
+  const std::string out = work_dir() + "/missing.csv";
+  const auto r = run_command(exe + " online --db " + work_dir() + "/nope.h5 --method greedy --out " + out);
+  BOOST_TEST(r.exit_code != 0);
+  BOOST_TEST(lines(r.err) == 1);
+  BOOST_TEST(r.err.find("nope.h5") != std::string::npos);
+  BOOST_TEST(r.out.empty());
+  BOOST_TEST(!fs::exists(out));
+}
+
+BOOST_AUTO_TEST_CASE(cli_unknown_method_lists_known_ones) {
+  const std::string db = work_dir() + "/hertz3.h5", out = work_dir() + "/unknown.csv";
+  auto r = run_command(exe + " offline --problem hertz --train 3 --out " + db);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  r = run_command(exe + " online --db " + db + " --method lasso --out " + out);
+  BOOST_TEST(r.exit_code != 0);
+  BOOST_TEST(lines(r.err) == 1);
+  BOOST_TEST(r.err.find("lasso") != std::string::npos);
+  BOOST_TEST(r.err.find("greedy") != std::string::npos);
+  BOOST_TEST(!fs::exists(out));
+}
+
+BOOST_AUTO_TEST_CASE(cli_offline_bad_input_leaves_no_file) {
+  const std::string db = work_dir() + "/bad.h5";
+  for (const std::string args : {"--problem cylinder --train 3", "--problem hertz --level 3", "--problem ironing --train 5",
+                                 "--problem hertz --train 0", "--problem hertz"}) {
+    const auto r = run_command(exe + " offline " + args + " --out " + db);
+    BOOST_TEST_CONTEXT(args) {
+      BOOST_TEST(r.exit_code != 0);
+      BOOST_TEST(lines(r.err) == 1);
+      BOOST_TEST(!fs::exists(db));
+    }
+  }
+  // Unwritable target: the snapshots are computed, the file is refused, nothing is left.
+  const auto r = run_command(exe + " offline --problem hertz --train 2 --out " + work_dir() + "/no/such/dir/x.h5");
+  BOOST_TEST(r.exit_code != 0);
+  BOOST_TEST(lines(r.err) == 1);
+  BOOST_TEST(r.err.find("no/such/dir/x.h5") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(cli_database_of_another_mesh_is_refused) {
+  // A database whose fingerprint does not match the current hertz mesh.
+  const std::string db = work_dir() + "/foreign.h5";
+  contactrom::rom::SnapshotDatabase d = contactrom::rom::generate_snapshots(hertz(), 2);
+  d.mesh_fingerprint = "00000000deadbeef";
+  contactrom::rom::write_database(db, d);
+  const auto r = run_command(exe + " online --db " + db + " --method greedy");
+  BOOST_TEST(r.exit_code != 0);
+  BOOST_TEST(lines(r.err) == 1);
+  BOOST_TEST(r.err.find("was built for mesh fingerprint 00000000deadbeef but the current hertz mesh is " +
+                        hertz().fingerprint()) != std::string::npos);
+}

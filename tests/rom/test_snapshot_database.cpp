@@ -1,0 +1,238 @@
+// HDF5 snapshot database (rom/snapshot_database.hpp): bitwise round trip, the
+// layout seen from h5py, and one-line refusals of a missing file, a non-HDF5 file,
+// a truncated file, another format_version, and a database built for another
+// mesh or problem.
+#define BOOST_TEST_MODULE rom_snapshot_database
+#include <boost/test/unit_test.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <unistd.h>
+
+#include "fom/errors.hpp"
+#include "fom/problem.hpp"
+#include "rom/snapshot_database.hpp"
+
+namespace fs = std::filesystem;
+using contactrom::InputError;
+using contactrom::Status;
+using contactrom::rom::SnapshotDatabase;
+
+namespace {
+
+/// A fresh folder for this test run, removed at the end.
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    path = fs::temp_directory_path() / ("contactrom_test_db_" + std::to_string(::getpid()));
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+};
+
+TempDir& temp() {
+  static TempDir dir;
+  return dir;
+}
+
+/// A synthetic database with random data (no FOM needed).
+SnapshotDatabase synthetic(int n_snap, int n_dofs, int n_c) {
+  std::mt19937 gen(42);
+  std::normal_distribution<double> dist;
+  SnapshotDatabase db;
+  db.problem = "hertz";
+  db.mesh_fingerprint = "0123456789abcdef";
+  db.created_by = "contactrom test";
+  db.training_kind = "train";
+  db.training_size = n_snap;
+  db.param_names = {"d"};
+  db.parameters.resize(1, n_snap);
+  db.primal.resize(n_dofs, n_snap);
+  db.dual.resize(n_c, n_snap);
+  for (int j = 0; j < n_snap; ++j) {
+    db.parameters(0, j) = 0.3 * (j + 1) / n_snap;
+    for (int i = 0; i < n_dofs; ++i) db.primal(i, j) = dist(gen);
+    for (int i = 0; i < n_c; ++i) db.dual(i, j) = std::abs(dist(gen));
+    db.status.push_back(j == 2 ? Status::NoConvergence : Status::Success);
+    db.iterations.push_back(10 + j);
+    db.pairing_iterations.push_back(3 + j);
+    db.time_s.push_back(1e-3 * (j + 1));
+  }
+  db.setup_time_s = 0.25;
+  db.wall_time_s = 1.5;
+  db.threads = 2;
+  return db;
+}
+
+bool bitwise_equal(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0;
+}
+
+/// The message of the InputError thrown by f (empty if none).
+template <typename F>
+std::string input_error_of(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool have_h5py() { return std::system("/usr/bin/python3 -c 'import h5py, numpy' > /dev/null 2>&1") == 0; }
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(round_trip_is_bitwise) {
+  const SnapshotDatabase db = synthetic(7, 301, 23);
+  const std::string path = temp().file("round_trip.h5");
+  contactrom::rom::write_database(path, db);
+  const SnapshotDatabase back = contactrom::rom::read_database(path);
+  BOOST_TEST(back.problem == db.problem);
+  BOOST_TEST(back.mesh_fingerprint == db.mesh_fingerprint);
+  BOOST_TEST(back.created_by == db.created_by);
+  BOOST_TEST(back.training_kind == db.training_kind);
+  BOOST_TEST(back.training_size == db.training_size);
+  BOOST_TEST(back.param_names == db.param_names, boost::test_tools::per_element());
+  BOOST_TEST(bitwise_equal(back.parameters, db.parameters));
+  BOOST_TEST(bitwise_equal(back.primal, db.primal));
+  BOOST_TEST(bitwise_equal(back.dual, db.dual));
+  BOOST_TEST(back.status == db.status);
+  BOOST_TEST(back.iterations == db.iterations, boost::test_tools::per_element());
+  BOOST_TEST(back.pairing_iterations == db.pairing_iterations, boost::test_tools::per_element());
+  BOOST_TEST(back.time_s == db.time_s, boost::test_tools::per_element());
+  BOOST_TEST(back.setup_time_s == db.setup_time_s);
+  BOOST_TEST(back.threads == db.threads);
+  BOOST_TEST(back.successful_snapshots().size() == 6u);
+  // No temporary file is left next to the database.
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(temp().path))
+    if (entry.path().filename().string().rfind("round_trip.h5", 0) == 0) ++files;
+  BOOST_TEST(files == 1);
+}
+
+BOOST_AUTO_TEST_CASE(layout_as_seen_from_h5py) {
+  if (!have_h5py()) {
+    BOOST_TEST_MESSAGE("skipped: /usr/bin/python3 with h5py and numpy not available");
+    return;
+  }
+  const SnapshotDatabase db = synthetic(5, 40, 9);
+  const std::string path = temp().file("layout.h5");
+  contactrom::rom::write_database(path, db);
+  // /primal is n_snap × n_dofs, row j = snapshot j; attributes are Python str/int.
+  char script[2048];
+  std::snprintf(script, sizeof script,
+                "/usr/bin/python3 -c \"import h5py, numpy as np; f = h5py.File('%s', 'r'); "
+                "assert f['primal'].shape == (5, 40), f['primal'].shape; "
+                "assert f['dual'].shape == (5, 9); assert f['parameters'].shape == (5, 1); "
+                "assert f['status'].shape == (5,); assert list(f['status'][:]) == [0, 0, 1, 0, 0]; "
+                "assert int(f.attrs['format_version']) == 1; assert f.attrs['problem'] == 'hertz'; "
+                "assert f.attrs['mesh_fingerprint'] == '0123456789abcdef'; "
+                "assert abs(f['primal'][3, 17] - (%.17g)) == 0; assert abs(f['dual'][4, 8] - (%.17g)) == 0; "
+                "assert abs(f['parameters'][1, 0] - (%.17g)) == 0\"",
+                path.c_str(), db.primal(17, 3), db.dual(8, 4), db.parameters(0, 1));
+  BOOST_TEST(std::system(script) == 0);
+}
+
+BOOST_AUTO_TEST_CASE(missing_file_is_refused) {
+  const std::string path = temp().file("does_not_exist.h5");
+  const std::string msg = input_error_of([&] { contactrom::rom::read_database(path); });
+  BOOST_TEST(msg.find(path) != std::string::npos);
+  BOOST_TEST(msg.find("not found") != std::string::npos);
+  BOOST_TEST(msg.find('\n') == std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(non_hdf5_file_is_refused) {
+  const std::string path = temp().file("text.h5");
+  std::ofstream(path) << "d,primal\n0.1,2\n";
+  const std::string msg = input_error_of([&] { contactrom::rom::read_database(path); });
+  BOOST_TEST(msg.find(path) != std::string::npos);
+  BOOST_TEST(msg.find("not an HDF5 file") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(truncated_file_is_refused) {
+  const SnapshotDatabase db = synthetic(20, 2000, 79);
+  const std::string path = temp().file("truncated.h5");
+  contactrom::rom::write_database(path, db);
+  const auto size = fs::file_size(path);
+  fs::resize_file(path, size / 2);
+  const std::string msg = input_error_of([&] { contactrom::rom::read_database(path); });
+  BOOST_TEST_MESSAGE("truncated file: " << msg);
+  BOOST_TEST(msg.find(path) != std::string::npos);
+  BOOST_TEST(msg.find("truncated or corrupt") != std::string::npos);
+  BOOST_TEST(msg.find('\n') == std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(other_format_version_is_refused) {
+  if (!have_h5py()) {
+    BOOST_TEST_MESSAGE("skipped: /usr/bin/python3 with h5py and numpy not available");
+    return;
+  }
+  const std::string path = temp().file("version2.h5");
+  contactrom::rom::write_database(path, synthetic(3, 10, 4));
+  const std::string cmd = "/usr/bin/python3 -c \"import h5py; f = h5py.File('" + path +
+                          "', 'r+'); f.attrs['format_version'] = 2; f.close()\"";
+  BOOST_REQUIRE(std::system(cmd.c_str()) == 0);
+  const std::string msg = input_error_of([&] { contactrom::rom::read_database(path); });
+  BOOST_TEST(msg.find(path) != std::string::npos);
+  BOOST_TEST(msg.find("format_version 2") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(foreign_hdf5_file_is_refused) {
+  if (!have_h5py()) {
+    BOOST_TEST_MESSAGE("skipped: /usr/bin/python3 with h5py and numpy not available");
+    return;
+  }
+  const std::string path = temp().file("foreign.h5");
+  const std::string cmd =
+      "/usr/bin/python3 -c \"import h5py, numpy; f = h5py.File('" + path + "', 'w'); f['x'] = numpy.zeros(3)\"";
+  BOOST_REQUIRE(std::system(cmd.c_str()) == 0);
+  const std::string msg = input_error_of([&] { contactrom::rom::read_database(path); });
+  BOOST_TEST(msg.find("no format_version") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(database_of_another_mesh_or_problem_is_refused) {
+  auto hertz = contactrom::fom::make_problem("hertz");
+  SnapshotDatabase db;
+  db.problem = "hertz";
+  db.mesh_fingerprint = hertz->fingerprint();
+  db.param_names = {"d"};
+  db.parameters = Eigen::MatrixXd::Zero(1, 1);
+  db.primal = Eigen::MatrixXd::Zero(hertz->num_dofs(), 1);
+  db.dual = Eigen::MatrixXd::Zero(hertz->contact().num_constraints(), 1);
+  BOOST_CHECK_NO_THROW(contactrom::rom::check_database(db, *hertz, "ok.h5"));
+
+  SnapshotDatabase other_mesh = db;
+  other_mesh.mesh_fingerprint = "ffffffffffffffff";
+  const std::string msg = input_error_of([&] { contactrom::rom::check_database(other_mesh, *hertz, "db.h5"); });
+  BOOST_TEST_MESSAGE(msg);
+  BOOST_TEST(msg.find("database 'db.h5' was built for mesh fingerprint ffffffffffffffff but the current hertz mesh is " +
+                      hertz->fingerprint()) != std::string::npos);
+
+  SnapshotDatabase other_problem = db;
+  other_problem.problem = "ironing";
+  const std::string msg2 = input_error_of([&] { contactrom::rom::check_database(other_problem, *hertz, "db.h5"); });
+  BOOST_TEST(msg2.find("built for problem 'ironing'") != std::string::npos);
+
+  // Same fingerprint but inconsistent sizes (a hand-edited file).
+  SnapshotDatabase other_size = db;
+  other_size.dual = Eigen::MatrixXd::Zero(3, 1);
+  BOOST_CHECK_THROW(contactrom::rom::check_database(other_size, *hertz, "db.h5"), InputError);
+}
+
+BOOST_AUTO_TEST_CASE(unwritable_target_throws_input_error) {
+  const std::string path = temp().file("no_such_folder/db.h5");
+  const std::string msg = input_error_of([&] { contactrom::rom::write_database(path, synthetic(2, 5, 3)); });
+  BOOST_TEST(msg.find(path) != std::string::npos);
+  BOOST_TEST(!fs::exists(path));
+}
