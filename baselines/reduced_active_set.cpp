@@ -90,8 +90,8 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   const Eigen::VectorXd lift_s = m_model.surface_lifting(mu);
   const Eigen::VectorXd u_free = inv_theta * llt->solve(f_hat);
 
-  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, u_s, g, c0, v, violation, rhs;
-  Eigen::MatrixXd c_phi, c_hat_i, z, schur;
+  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, u_s, g, y, v, violation, rhs;
+  Eigen::MatrixXd c_hat_i, z, schur;
   fom::ConstraintMatrix c;
   std::vector<int> active, next, solved;  // positions in W
   std::vector<char> in_active(mw, 0);
@@ -101,14 +101,13 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   bool small_step = true;  // û = u_free is exact for I = ∅
 
   for (int k = 0;; ++k) {
-    // 1. Operators at the current û (surface rows only) and the violation of every column.
+    // 1. Operators at the current û (surface rows only) and the violation of every
+    //    column, Ĉû − ĝ = Wᵀ(C_s u_s − g).
     u_s.noalias() = phi_s * u_hat;
     u_s += lift_s;
     contact.assemble(contact.search(u_s), c, g);
-    c_phi.noalias() = c * phi_s;  // C_s Φ_s
-    c0.noalias() = g - c * lift_s;  // g − C_s u_lift,s
-    v.noalias() = c_phi * u_hat;
-    v -= c0;  // C_s u_s − g
+    v.noalias() = c * u_s;
+    v -= g;
     violation.noalias() = m_w.transpose() * v;
 
     // 2. Primal–dual update: drop the columns whose multiplier left the cone, add every
@@ -146,8 +145,12 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
       c_hat_i.resize(na, r);
       rhs.resize(na);
       for (int i = 0; i < na; ++i) {
-        c_hat_i.row(i).noalias() = m_w.col(active[i]).transpose() * c_phi;  // Ĉ_I = W_Iᵀ C_s Φ_s
-        rhs(i) = m_w.col(active[i]).dot(c0);                                // ĝ_I
+        // Row of Ĉ_I = W_Iᵀ C_s Φ_s and entry of ĝ_I = W_Iᵀ (g − C_s u_lift,s) through
+        // y = C_sᵀ w_p: O(nnz(C) + n_s r) per active column, never C_s Φ_s itself.
+        const auto w = m_w.col(active[i]);
+        y.noalias() = c.transpose() * w;
+        c_hat_i.row(i).noalias() = y.transpose() * phi_s;
+        rhs(i) = w.dot(g) - y.dot(lift_s);
       }
       z = inv_theta * llt->solve(c_hat_i.transpose());  // K̂⁻¹ Ĉ_Iᵀ
       schur.noalias() = c_hat_i * z;

@@ -1,13 +1,14 @@
 // contactrom verify --db DB.h5 --method M[,M2,...] [--delta D] [--tau T] [--tau-scaling S]
-//                   [--cpg-tolerance E] [--inner-solve nonnegative|equality] [--reference ipopt|fom] [--threads T] [--limit N]
-//                   [--bench] [--repeats R] [--out FILE.csv] [--progress] [--json]
+//                   [--cpg-tolerance E] [--inner-solve nonnegative|equality]
+//                   [--reference ipopt|fom] [--threads T] [--limit N] [--bench] [--repeats R] [--out FILE.csv] [--progress] [--json]
 // KKT verification of reduced solutions against the Ipopt reference (DESIGN §5):
 // for every validation parameter of the database's training set and every method,
-//  - the FOM KKT residuals of the reduced solution (fom::kkt_residuals: pairing
-//    recomputed from u; stationarity, penetration, negative pressure,
-//    complementarity — full-order values, reported as they are),
+//  - the FOM KKT residuals of the reduced solution (baselines::verify_solution, i.e.
+//    fom::kkt_residuals with the pairing recomputed from u: stationarity,
+//    penetration, negative pressure, complementarity — full-order values, reported
+//    as they are),
 //  - its errors against the reference solution (primal H¹, dual L²(Γc), active-set
-//    differences; fom::compare_solutions),
+//    differences; fom::compare_solutions through verify_solution),
 //  - the reduced-level penetration max_p W_pᵀ(C(u)u − g(u)) over the method's dual
 //    columns (greedy and full-dictionary: every dictionary column; cpg: its basis),
 //    against the method's threshold τ (acceptance: ≤ τ + 1e-10),
@@ -35,6 +36,7 @@
 #include "baselines/cpg.hpp"
 #include "baselines/full_dictionary.hpp"
 #include "baselines/ipopt_qp.hpp"
+#include "baselines/kkt_verifier.hpp"
 #include "baselines/reduced_active_set.hpp"
 #include "fom/active_set_solver.hpp"
 #include "fom/atomic_file.hpp"
@@ -66,8 +68,7 @@ struct VerifyArgs {
 
 /// Per-parameter outcome of one method.
 struct MethodRow {
-  fom::KktResiduals kkt;
-  fom::SolutionErrors errors;
+  baselines::VerificationReport report;  // KKT residuals and errors against the reference
   double reduced_penetration = 0.0;
   Status status = Status::Success;
   bool converged = false;
@@ -82,23 +83,13 @@ struct MethodReport {
   double tau = 0.0;
   std::vector<MethodRow> rows;
   // Summary.
-  fom::KktResiduals max_kkt;
-  double max_primal = 0.0, mean_primal = 0.0, max_dual = 0.0, mean_dual = 0.0;
+  baselines::VerificationSummary summary;
   double max_reduced_penetration = -std::numeric_limits<double>::infinity();
-  int reduced_violations = 0, nonconverged = 0, max_active_set_differences = 0;
+  int reduced_violations = 0, nonconverged = 0;
   double mean_time_s = 0.0, mean_sparsity = 0.0, mean_iterations = 0.0;
   rom::OnlineTiming timing;
   double basis_time_s = 0.0;  // CPG offline construction
 };
-
-fom::KktResiduals max_of(const fom::KktResiduals& a, const fom::KktResiduals& b) {
-  fom::KktResiduals m;
-  m.stationarity = std::max(a.stationarity, b.stationarity);
-  m.penetration = std::max(a.penetration, b.penetration);
-  m.negative_pressure = std::max(a.negative_pressure, b.negative_pressure);
-  m.complementarity = std::max(a.complementarity, b.complementarity);
-  return m;
-}
 
 std::vector<std::string> split_methods(const std::string& text) {
   std::vector<std::string> out;
@@ -167,12 +158,13 @@ nlohmann::json method_json(const MethodReport& r, const rom::ReducedModel& model
   j["dual_basis_size"] = r.dual_columns.size();
   j["tau"] = r.tau;
   j["reduced_constraint"] = r.reduced_constraint;
-  j["max_kkt"] = kkt_json(r.max_kkt);
-  j["max_primal_error"] = r.max_primal;
-  j["mean_primal_error"] = r.mean_primal;
-  j["max_dual_error"] = r.max_dual;
-  j["mean_dual_error"] = r.mean_dual;
-  j["max_active_set_differences"] = r.max_active_set_differences;
+  j["max_kkt"] = kkt_json(r.summary.max_kkt);
+  j["max_primal_error"] = r.summary.max_primal_h1;
+  j["mean_primal_error"] = r.summary.mean_primal_h1;
+  j["max_dual_error"] = r.summary.max_dual_l2;
+  j["mean_dual_error"] = r.summary.mean_dual_l2;
+  j["max_active_set_differences"] = r.summary.max_active_set_differences;
+  j["invalid"] = r.summary.invalid;
   j["max_reduced_penetration"] = r.max_reduced_penetration;
   j["reduced_penetration_violations"] = r.reduced_violations;
   j["reduced_penetration_ok"] = r.reduced_violations == 0;
@@ -190,7 +182,7 @@ nlohmann::json method_json(const MethodReport& r, const rom::ReducedModel& model
 }
 
 void write_csv(const std::string& path, const fom::Problem& problem, const std::vector<fom::Param>& params,
-               const std::vector<fom::FomSolution>& refs, const std::vector<fom::KktResiduals>& ref_kkt,
+               const std::vector<fom::FomSolution>& refs, const std::vector<baselines::VerificationReport>& ref_reports,
                const std::string& ref_name, const std::vector<MethodReport>& reports) {
   write_file_atomically(path, [&](std::ostream& out) {
     out << "method,";
@@ -203,7 +195,7 @@ void write_csv(const std::string& path, const fom::Problem& problem, const std::
       return s;
     };
     for (size_t i = 0; i < params.size(); ++i) {
-      const fom::KktResiduals& k = ref_kkt[i];
+      const fom::KktResiduals& k = ref_reports[i].kkt;
       out << ref_name << ',' << params_text(i) << "0,0,0," << format_double(k.stationarity) << ','
           << format_double(k.penetration) << ',' << format_double(k.negative_pressure) << ','
           << format_double(k.complementarity) << ",,," << (refs[i].status == Status::Success ? 1 : 0) << ','
@@ -213,10 +205,12 @@ void write_csv(const std::string& path, const fom::Problem& problem, const std::
     for (const MethodReport& r : reports)
       for (size_t i = 0; i < params.size(); ++i) {
         const MethodRow& row = r.rows[i];
-        out << r.name << ',' << params_text(i) << format_double(row.errors.primal_h1) << ','
-            << format_double(row.errors.dual_l2) << ',' << row.errors.active_set_differences << ','
-            << format_double(row.kkt.stationarity) << ',' << format_double(row.kkt.penetration) << ','
-            << format_double(row.kkt.negative_pressure) << ',' << format_double(row.kkt.complementarity) << ','
+        const fom::SolutionErrors& e = row.report.errors;
+        const fom::KktResiduals& k = row.report.kkt;
+        out << r.name << ',' << params_text(i) << format_double(e.primal_h1) << ',' << format_double(e.dual_l2)
+            << ',' << e.active_set_differences << ',' << format_double(k.stationarity) << ','
+            << format_double(k.penetration) << ',' << format_double(k.negative_pressure) << ','
+            << format_double(k.complementarity) << ','
             << format_double(row.reduced_penetration) << ',' << format_double(r.tau) << ',' << (row.converged ? 1 : 0)
             << ',' << to_string(row.status) << ',' << row.iterations << ',' << row.sparsity << ','
             << format_double(row.time_s) << '\n';
@@ -259,7 +253,7 @@ void run_verify(const VerifyArgs& a) {
   // serialised by a process-wide mutex, so threads overlap only the pairing loop,
   // assembly and residual work around them.
   std::vector<fom::FomSolution> refs(params.size());
-  std::vector<fom::KktResiduals> ref_kkt(params.size());
+  std::vector<baselines::VerificationReport> ref_reports(params.size());
   const auto t_ref = std::chrono::steady_clock::now();
   {
     rom::ProgressBar bar(std::cerr, "verify: " + a.reference + " references", show);
@@ -270,7 +264,7 @@ void run_verify(const VerifyArgs& a) {
           n, a.threads,
           [&](int i) {
             refs[i] = ipopt.solve(params[i]);
-            ref_kkt[i] = fom::kkt_residuals(*problem, params[i], refs[i].u, refs[i].lambda);
+            ref_reports[i] = baselines::verify_solution(*problem, refs[i]);
           },
           progress);
     } else {
@@ -279,19 +273,18 @@ void run_verify(const VerifyArgs& a) {
           n, a.threads,
           [&](int i) {
             refs[i] = fom_solver.solve(params[i]);
-            ref_kkt[i] = fom::kkt_residuals(*problem, params[i], refs[i].u, refs[i].lambda);
+            ref_reports[i] = baselines::verify_solution(*problem, refs[i]);
           },
           progress);
     }
     bar.finish();
   }
   const double ref_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ref).count();
-  fom::KktResiduals ref_max;
+  const baselines::VerificationSummary ref_summary = baselines::summarize(ref_reports);
+  const fom::KktResiduals& ref_max = ref_summary.max_kkt;
   int ref_failures = 0;
-  for (int i = 0; i < n; ++i) {
-    ref_max = max_of(ref_max, ref_kkt[i]);
+  for (int i = 0; i < n; ++i)
     if (refs[i].status != Status::Success) ++ref_failures;
-  }
 
   // Reduced solutions, sequentially per method (timings undisturbed); the residual
   // work after each solve does not enter the reported times.
@@ -306,20 +299,14 @@ void run_verify(const VerifyArgs& a) {
     for (int i = 0; i < n; ++i) {
       const rom::OnlineResult res = solver.solve(params[i]);
       MethodRow& row = r.rows[i];
-      row.kkt = fom::kkt_residuals(*problem, params[i], res.u, res.lambda);
-      row.errors = fom::compare_solutions(*problem, res.u, res.lambda, refs[i].u, refs[i].lambda);
+      row.report = baselines::verify_solution(*problem, params[i], res.u, res.lambda, &refs[i]);
+      r.summary.add(row.report);
       row.reduced_penetration = baselines::reduced_penetration(model, r.dual_columns, res.u);
       row.status = res.status;
       row.converged = res.converged;
       row.iterations = res.iterations;
       row.sparsity = static_cast<int>(res.selected.size());
       row.time_s = res.time_s;
-      r.max_kkt = max_of(r.max_kkt, row.kkt);
-      r.max_primal = std::max(r.max_primal, row.errors.primal_h1);
-      r.max_dual = std::max(r.max_dual, row.errors.dual_l2);
-      r.mean_primal += row.errors.primal_h1 / n;
-      r.mean_dual += row.errors.dual_l2 / n;
-      r.max_active_set_differences = std::max(r.max_active_set_differences, row.errors.active_set_differences);
       r.max_reduced_penetration = std::max(r.max_reduced_penetration, row.reduced_penetration);
       if (row.reduced_penetration > r.tau + kReducedPenetrationSlack) ++r.reduced_violations;
       if (!row.converged || row.status != Status::Success) ++r.nonconverged;
@@ -334,7 +321,7 @@ void run_verify(const VerifyArgs& a) {
   }
   double fom_time = 0.0;
   if (a.bench) fom_time = rom::time_fom(fom::ActiveSetSolver(*problem), params, 1);
-  if (!a.out.empty()) write_csv(a.out, *problem, params, refs, ref_kkt, a.reference, reports);
+  if (!a.out.empty()) write_csv(a.out, *problem, params, refs, ref_reports, a.reference, reports);
 
   if (a.json) {
     nlohmann::json j;
@@ -374,12 +361,13 @@ void run_verify(const VerifyArgs& a) {
             << cell("-", 10) << ref_failures << "\n";
   for (const MethodReport& r : reports)
     std::cout << cell(r.name, 18) << cell(std::to_string(r.dual_columns.size()), 6)
-              << cell(sci(r.max_kkt.stationarity), 11) << cell(sci(r.max_kkt.penetration), 10)
-              << cell(sci(r.max_kkt.negative_pressure), 11) << cell(sci(r.max_kkt.complementarity), 10)
-              << cell(sci(r.max_primal), 11) << cell(sci(r.max_dual), 10) << cell(sci(r.max_reduced_penetration), 11)
+              << cell(sci(r.summary.max_kkt.stationarity), 11) << cell(sci(r.summary.max_kkt.penetration), 10)
+              << cell(sci(r.summary.max_kkt.negative_pressure), 11) << cell(sci(r.summary.max_kkt.complementarity), 10)
+              << cell(sci(r.summary.max_primal_h1), 11) << cell(sci(r.summary.max_dual_l2), 10) << cell(sci(r.max_reduced_penetration), 11)
               << cell(sci(r.tau), 10) << r.nonconverged << "\n";
   for (const MethodReport& r : reports) {
-    std::cout << r.name << ": mean primal error " << sci(r.mean_primal) << ", mean dual error " << sci(r.mean_dual)
+    std::cout << r.name << ": mean primal error " << sci(r.summary.mean_primal_h1) << ", mean dual error "
+              << sci(r.summary.mean_dual_l2)
               << ", mean |I| " << std::setprecision(3) << r.mean_sparsity << ", mean iterations " << r.mean_iterations
               << ", mean time " << r.mean_time_s * 1e6 << " us";
     if (r.reduced_constraint)

@@ -1,0 +1,168 @@
+// `contactrom verify` (tools/cmd_verify.cpp) end to end on hertz 12 and ironing
+// level 4 for greedy, cpg and full-dictionary against the Ipopt reference (a subset
+// of the validation set keeps the test short; the full-size runs are recorded in
+// docs/baselines.md): JSON contract, reduced-level penetration ≤ τ + 1e-10, the
+// reference's own KKT residuals, the summary table, the CSV file, --bench, and
+// `contactrom online --method cpg|full-dictionary` through the registry. Bad input
+// ends with one line on stderr, exit code 2 and no output file.
+#define BOOST_TEST_MODULE baselines_verify_cli
+#include <boost/test/unit_test.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "common/run_command.hpp"
+
+namespace fs = std::filesystem;
+using contactrom::test::run_command;
+using nlohmann::json;
+
+namespace {
+
+const std::string exe = CONTACTROM_EXE;
+
+/// Databases built once for the whole file.
+struct Databases {
+  std::string dir = contactrom::test::temp_dir();
+  std::string hertz = dir + "/hertz12.h5", ironing = dir + "/ironing4.h5";
+  Databases() {
+    const auto a = run_command(exe + " offline --problem hertz --train 12 --threads 2 --out " + hertz);
+    BOOST_REQUIRE_MESSAGE(a.exit_code == 0, a.err);
+    const auto b = run_command(exe + " offline --problem ironing --level 4 --threads 2 --out " + ironing);
+    BOOST_REQUIRE_MESSAGE(b.exit_code == 0, b.err);
+  }
+  ~Databases() {
+    std::error_code ignored;
+    fs::remove_all(dir, ignored);
+  }
+};
+
+Databases& dbs() {
+  static Databases d;
+  return d;
+}
+
+json run_json(const std::string& args) {
+  const auto r = run_command(exe + " " + args + " --json");
+  BOOST_REQUIRE_MESSAGE(r.exit_code == 0, args + ": " + r.err);
+  return json::parse(r.out);  // exactly one JSON object
+}
+
+void check_report(const json& j, const std::string& problem, int n) {
+  BOOST_TEST(j["problem"] == problem);
+  BOOST_TEST(j["validation_size"] == n);
+  const json& ref = j["reference"];
+  BOOST_TEST(ref["solver"] == "ipopt");
+  BOOST_TEST(ref["failures"] == 0);
+  // The Ipopt solution itself satisfies the FOM KKT conditions.
+  BOOST_TEST(ref["max_kkt"]["stationarity"].get<double>() <= 1e-8);
+  BOOST_TEST(ref["max_kkt"]["penetration"].get<double>() <= 1e-8);
+  BOOST_TEST(ref["max_kkt"]["negative_pressure"].get<double>() <= 1e-8);
+  BOOST_TEST(ref["max_kkt"]["complementarity"].get<double>() <= 1e-8);
+  for (const char* m : {"greedy", "cpg", "full-dictionary"}) {
+    BOOST_TEST_CONTEXT(problem << " " << m) {
+      const json& r = j["methods"][m];
+      BOOST_REQUIRE(r.is_object());
+      for (const char* k : {"stationarity", "penetration", "negative_pressure", "complementarity"})
+        BOOST_TEST(r["max_kkt"][k].is_number());
+      BOOST_TEST(r["nonconverged"] == 0);
+      BOOST_TEST(r["reduced_constraint"] == true);
+      BOOST_TEST(r["tau"].get<double>() == 1e-8);
+      // Reduced level: max_p W_pᵀ(Cu − g) ≤ τ + 1e-10 (greedy: over all dictionary columns).
+      BOOST_TEST(r["max_reduced_penetration"].get<double>() <= r["tau"].get<double>() + 1e-10);
+      BOOST_TEST(r["reduced_penetration_ok"] == true);
+      // A ROM has no negative pressure (λ = Wλ̂, W ≥ 0, λ̂ ≥ 0); the full-order
+      // penetration is reported as it is — positive and small.
+      BOOST_TEST(r["max_kkt"]["negative_pressure"].get<double>() == 0.0);
+      BOOST_TEST(r["max_kkt"]["penetration"].get<double>() > 0.0);
+      BOOST_TEST(r["max_kkt"]["penetration"].get<double>() < 0.1);
+      BOOST_TEST(r["max_primal_error"].get<double>() < 0.5);
+      BOOST_TEST(r["mean_primal_error"].get<double>() <= r["max_primal_error"].get<double>());
+      BOOST_TEST(r["dual_basis_size"].get<int>() >= 1);
+      BOOST_TEST(r["dual_basis_size"].get<int>() <= r["dictionary_size"].get<int>());
+    }
+  }
+  BOOST_TEST(j["methods"]["full-dictionary"]["dual_basis_size"] == j["methods"]["full-dictionary"]["dictionary_size"]);
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(hertz_greedy_cpg_full_dictionary_against_ipopt) {
+  const json j = run_json("verify --db " + dbs().hertz + " --method greedy,cpg,full-dictionary --limit 5 --threads 2");
+  check_report(j, "hertz", 5);
+  BOOST_TEST(j["train"] == 12);
+}
+
+BOOST_AUTO_TEST_CASE(ironing_greedy_cpg_full_dictionary_against_ipopt) {
+  const json j = run_json("verify --db " + dbs().ironing + " --method greedy,cpg,full-dictionary --limit 5 --threads 2");
+  check_report(j, "ironing", 5);
+  BOOST_TEST(j["level"] == 4);
+  // The ironing default CPG tolerance is 5e-2: fewer vectors than the dictionary.
+  BOOST_TEST(j["methods"]["cpg"]["dual_basis_size"].get<int>() < j["methods"]["cpg"]["dictionary_size"].get<int>());
+}
+
+BOOST_AUTO_TEST_CASE(summary_table_and_csv) {
+  const std::string csv = dbs().dir + "/verify.csv";
+  const auto r = run_command(exe + " verify --db " + dbs().hertz + " --method cpg,greedy --limit 3 --out " + csv);
+  BOOST_REQUIRE_MESSAGE(r.exit_code == 0, r.err);
+  for (const char* text : {"ipopt reference", "greedy", "cpg", "stationar.", "red. pen.", "reduced penetration <= tau"})
+    BOOST_TEST(r.out.find(text) != std::string::npos, "missing '" << text << "' in\n" << r.out);
+  std::istringstream in(contactrom::test::slurp(csv));
+  std::string line;
+  std::getline(in, line);
+  BOOST_TEST(line.rfind("method,d,primal_h1_error,dual_l2_error", 0) == 0u, line);
+  int rows = 0, ipopt = 0;
+  while (std::getline(in, line)) {
+    ++rows;
+    if (line.rfind("ipopt,", 0) == 0) ++ipopt;
+  }
+  BOOST_TEST(rows == 9);  // 3 parameters × (reference + 2 methods)
+  BOOST_TEST(ipopt == 3);
+}
+
+BOOST_AUTO_TEST_CASE(bench_with_the_fom_reference) {
+  const json j = run_json("verify --db " + dbs().hertz + " --method greedy,cpg --reference fom --bench --repeats 1");
+  BOOST_TEST(j["reference"]["solver"] == "fom");
+  BOOST_TEST(j["validation_size"] == 119);
+  BOOST_TEST(j["fom_median_time_s"].get<double>() > 0.0);
+  for (const char* m : {"greedy", "cpg"}) {
+    BOOST_TEST(j["methods"][m]["median_time_s"].get<double>() > 0.0);
+    BOOST_TEST(j["methods"][m]["speedup_vs_fom"].get<double>() > 1.0);
+    BOOST_TEST(j["methods"][m]["nonconverged"] == 0);
+  }
+  BOOST_TEST(j["methods"]["cpg"]["basis_time_s"].get<double>() >= 0.0);
+}
+
+BOOST_AUTO_TEST_CASE(online_runs_cpg_and_full_dictionary) {
+  for (const char* m : {"cpg", "full-dictionary"}) {
+    const json j = run_json("online --db " + dbs().hertz + " --method " + m + " --validation --threads 2");
+    BOOST_TEST(j["method"] == m);
+    for (const char* k : {"delta", "dictionary_size", "primal_rank", "mean_primal_error", "mean_dual_error",
+                          "mean_sparsity", "mean_iterations", "mean_time_s", "nonconverged"})
+      BOOST_TEST(j.contains(k), m << " misses " << k);
+    BOOST_TEST(j["nonconverged"] == 0);
+    BOOST_TEST(j["mean_primal_error"].get<double>() < 0.1);
+  }
+}
+
+BOOST_AUTO_TEST_CASE(bad_input_is_one_line_exit_2_and_no_file) {
+  const std::string csv = dbs().dir + "/bad.csv";
+  const std::string cases[] = {
+      "verify --db " + dbs().hertz + " --method nosuch --out " + csv,
+      "verify --db " + dbs().hertz + " --method greedy,greedy --out " + csv,
+      "verify --db " + dbs().dir + "/missing.h5 --method cpg --out " + csv,
+      "verify --db " + dbs().hertz + " --method cpg --reference nosuch --out " + csv,
+      "verify --db " + dbs().hertz + " --method cpg --cpg-tolerance 2 --out " + csv,
+      "verify --db " + dbs().hertz + " --out " + csv,
+  };
+  for (const std::string& c : cases) {
+    const auto r = run_command(exe + " " + c);
+    BOOST_TEST(r.exit_code == 2, c << ": exit " << r.exit_code);
+    BOOST_TEST(std::count(r.err.begin(), r.err.end(), '\n') == 1, c << ": " << r.err);
+    BOOST_TEST(r.err.rfind("contactrom: error: ", 0) == 0u, c << ": " << r.err);
+    BOOST_TEST(!fs::exists(csv), c);
+  }
+}
