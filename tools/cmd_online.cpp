@@ -1,5 +1,6 @@
 // contactrom online --db DB.h5 --method greedy [--delta D] [--tau T] [--validation] [--param V]
-//                   [--out FILE.csv|DIR] [--json] [--threads T] [--kkt]
+//                   [--out FILE.csv|DIR] [--json] [--threads T] [--kkt] [--lifting harmonic|dirichlet]
+//                   [--tau-scaling absolute|relative] [--max-iterations K]
 // Builds the reduced model (POD basis with tolerance δ, dual dictionary) from a
 // snapshot database and evaluates an online method:
 //  - --validation (default without --param): at every validation parameter of the
@@ -27,7 +28,7 @@ namespace contactrom::cli {
 namespace {
 
 struct OnlineArgs {
-  std::string db, method = "greedy", param, out, tau_scaling = "absolute";
+  std::string db, method = "greedy", param, out, tau_scaling = "absolute", lifting = "harmonic";
   double delta = 1e-8, tau = -1.0;
   int threads = 0, max_iterations = 50;
   bool validation = false, json = false, kkt = false;
@@ -158,6 +159,7 @@ void run_online(const OnlineArgs& a) {
   }
   rom::ReducedModelOptions model_options;
   model_options.delta = a.delta;
+  model_options.lifting = a.lifting == "dirichlet" ? rom::LiftingKind::Dirichlet : rom::LiftingKind::Harmonic;
   const rom::ReducedModel model(*problem, db, model_options);
   const auto solver = rom::make_online_solver(a.method, model, options);
   if (!a.param.empty())
@@ -177,6 +179,9 @@ CommandRegistrar reg("online", [](CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--tau-scaling", args->tau_scaling, "absolute (default, paper) | relative")
       ->check(CLI::IsMember({"absolute", "relative"}));
+  sub->add_option("--lifting", args->lifting,
+                  "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet")
+      ->check(CLI::IsMember({"harmonic", "dirichlet"}));
   sub->add_option("--max-iterations", args->max_iterations, "iteration cap k_max (default 50)")
       ->check(CLI::Range(1, 100000));
   sub->add_flag("--validation", args->validation, "evaluate on the validation set (default without --param)");
