@@ -130,9 +130,9 @@ CpgBasis build_cpg_basis(const rom::ReducedModel& model, const CpgOptions& optio
 
 CpgActiveSet::CpgActiveSet(const rom::ReducedModel& model, const CpgOptions& cpg,
                            const ReducedActiveSetOptions& options)
-    : CpgActiveSet(model, build_cpg_basis(model, cpg), options) {}
+    : CpgActiveSet(build_cpg_basis(model, cpg), model, options) {}
 
-CpgActiveSet::CpgActiveSet(const rom::ReducedModel& model, CpgBasis basis, const ReducedActiveSetOptions& options)
+CpgActiveSet::CpgActiveSet(CpgBasis&& basis, const rom::ReducedModel& model, const ReducedActiveSetOptions& options)
     : ReducedActiveSet("cpg", model, basis.columns, options), m_basis(std::move(basis)) {}
 
 CpgOptions cpg_options(const rom::OnlineSolverOptions& options) {

@@ -106,7 +106,7 @@ class CpgActiveSet final : public ReducedActiveSet {
   const CpgBasis& basis() const { return m_basis; }
 
  private:
-  CpgActiveSet(const rom::ReducedModel& model, CpgBasis basis, const ReducedActiveSetOptions& options);
+  CpgActiveSet(CpgBasis&& basis, const rom::ReducedModel& model, const ReducedActiveSetOptions& options);
   CpgBasis m_basis;
 };
 
