@@ -1,0 +1,331 @@
+// Convex-hull subcommands (rom/convex_hull.hpp, rom/chls.hpp; docs/convex_hull.md):
+//
+//   contactrom chls --db DB.h5 [--out FILE.csv] [--json]
+//     Leave-one-out convex-hull least squares (CHLS) of every primal snapshot
+//     against the others; CSV: parameter columns, chls_error, status,
+//     iterations, support. JSON keys: errors (list), max_error, mean_error, ...
+//     Plotting is not done here (the CLI stays pure C++): tools/rope_experiments.py
+//     plots the CSV.
+//
+//   contactrom hull-report --db DB.h5 [--set training|validation] [--delta D]
+//                          [--basis svd|random] [--rank-l L] [--seed S]
+//                          [--sum-weight W] [--no-polish] [--option KEY=VALUE ...]
+//                          [--out FILE.csv] [--json]
+//                          [--time [--repeats N]]
+//     Convex-hull ROM on the training or validation set against the FOM, with the
+//     method's statistics and the KKT compliance of every query: |1ᵀα − 1|,
+//     penetration, complementarity (relative, as fom/kkt.hpp, and absolute),
+//     errors, sparsity, selected snapshots and coefficients. --time also measures
+//     the median online time per query with rom::time_online.
+//
+// This file also registers the online method "convex-hull" (a static registrar in
+// a file that is always linked into the CLI; see rom/online_evaluation.hpp), so
+// `contactrom online --method convex-hull` works.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "fom/active_set_solver.hpp"
+#include "fom/atomic_file.hpp"
+#include "fom/errors.hpp"
+#include "fom/kkt.hpp"
+#include "rom/chls.hpp"
+#include "rom/convex_hull.hpp"
+#include "rom/online_evaluation.hpp"
+#include "rom/reduced_model.hpp"
+#include "rom/snapshot_database.hpp"
+#include "tools/cli.hpp"
+#include "tools/cli_common.hpp"
+
+namespace contactrom::cli {
+namespace {
+
+const rom::OnlineSolverRegistrar convex_hull_registrar("convex-hull", rom::make_convex_hull_solver);
+
+std::string format_double(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// ---------------------------------------------------------------- chls
+
+struct ChlsArgs {
+  std::string db, out;
+  bool json = false;
+};
+
+void run_chls(const ChlsArgs& a) {
+  const rom::SnapshotDatabase db = rom::read_database(a.db);
+  auto problem = fom::make_problem(db.problem);
+  rom::check_database(db, *problem, a.db);
+  const std::vector<int> used = db.successful_snapshots();
+  if (used.size() < 2)
+    throw InputError("database " + a.db + " holds " + std::to_string(used.size()) +
+                     " successful snapshots; CHLS needs at least 2");
+  Eigen::MatrixXd primal(db.num_dofs(), static_cast<Eigen::Index>(used.size()));
+  for (std::size_t c = 0; c < used.size(); ++c) primal.col(static_cast<Eigen::Index>(c)) = db.primal.col(used[c]);
+  const rom::ChlsResult r = rom::chls_leave_one_out(primal);
+
+  auto support_text = [&](std::size_t k) {
+    std::string s;
+    for (std::size_t j = 0; j < used.size(); ++j)
+      if (r.coefficients(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)) > 0.0)
+        s += (s.empty() ? "" : " ") + std::to_string(used[j]);
+    return s;
+  };
+  if (!a.out.empty()) {
+    write_file_atomically(a.out, [&](std::ostream& out) {
+      for (const std::string& name : db.param_names) out << name << ',';
+      out << "chls_error,status,iterations,support\n";
+      for (std::size_t k = 0; k < used.size(); ++k) {
+        const fom::Param mu = db.parameter(used[k]);
+        for (Eigen::Index i = 0; i < mu.size(); ++i) out << format_double(mu(i)) << ',';
+        out << format_double(r.errors(static_cast<Eigen::Index>(k))) << ',' << to_string(r.status[k]) << ','
+            << r.iterations[k] << ',' << support_text(k) << '\n';
+      }
+    });
+  }
+  nlohmann::json j;
+  j["problem"] = db.problem;
+  j["snapshots"] = used.size();
+  j["errors"] = std::vector<double>(r.errors.data(), r.errors.data() + r.errors.size());
+  nlohmann::json params = nlohmann::json::array();
+  for (int s : used) params.push_back(param_json(db.parameter(s)));
+  j["params"] = params;
+  j["max_error"] = r.max_error;
+  j["mean_error"] = r.mean_error;
+  j["nonconverged"] = std::count_if(r.status.begin(), r.status.end(), [](Status s) { return s != Status::Success; });
+  j["time_s"] = r.time_s;
+  if (a.json) {
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::cout << "CHLS (leave-one-out convex hull least squares) of " << used.size() << " " << db.problem
+            << " primal snapshots\n"
+            << std::setprecision(3);
+  for (std::size_t k = 0; k < used.size(); ++k)
+    std::cout << "  " << param_json(db.parameter(used[k])).dump() << "  error " << r.errors(static_cast<Eigen::Index>(k))
+              << "  support [" << support_text(k) << "]\n";
+  std::cout << "max error " << r.max_error << ", mean error " << r.mean_error << ", time " << r.time_s * 1e3
+            << " ms\n";
+  if (!a.out.empty()) std::cout << "written to " << a.out << "\n";
+}
+
+CommandRegistrar reg_chls("chls", [](CLI::App& app) {
+  auto args = std::make_shared<ChlsArgs>();
+  auto* sub = app.add_subcommand("chls", "Leave-one-out convex hull least squares of the primal snapshots");
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
+  sub->add_option("--out", args->out, "CSV file: parameter columns, chls_error, status, iterations, support");
+  sub->add_flag("--json", args->json, "print one JSON object");
+  sub->callback([args] { run_chls(*args); });
+});
+
+// ---------------------------------------------------------------- hull-report
+
+struct HullArgs {
+  std::string db, set = "validation", basis = "svd", out;
+  double delta = 1e-8, basis_delta = -1.0, sum_weight = 1.0;
+  int rank_l = 0, threads = 0, repeats = 3, max_pairing_iterations = 20;
+  long long seed = 42;
+  bool no_polish = false, json = false, time = false;
+  std::vector<std::string> options;
+};
+
+struct HullRow {
+  fom::Param mu;
+  rom::ConvexHullResult r;
+  double primal_error = 0.0, dual_error = 0.0;
+  fom::KktResiduals kkt;
+  double penetration_abs = 0.0, complementarity_abs = 0.0;
+};
+
+void run_hull_report(const HullArgs& a) {
+  const rom::SnapshotDatabase db = rom::read_database(a.db);
+  auto problem = fom::make_problem(db.problem);
+  rom::check_database(db, *problem, a.db);
+  rom::check_convex_hull_applicable(*problem);
+  rom::ReducedModelOptions model_options;
+  model_options.delta = a.delta;
+  const rom::ReducedModel model(*problem, db, model_options);
+  // One parsing path for the settings: the flags and every --option KEY=VALUE go
+  // through OnlineSolverOptions::extra, as for `contactrom online`.
+  rom::OnlineSolverOptions generic;
+  generic.extra["basis"] = a.basis;
+  if (a.basis_delta >= 0.0) generic.extra["basis_delta"] = format_double(a.basis_delta);
+  if (a.rank_l > 0) generic.extra["rank_l"] = std::to_string(a.rank_l);
+  generic.extra["seed"] = std::to_string(a.seed);
+  generic.extra["sum_weight"] = format_double(a.sum_weight);
+  generic.extra["polish"] = a.no_polish ? "0" : "1";
+  generic.extra["max_pairing_iterations"] = std::to_string(a.max_pairing_iterations);
+  for (const std::string& kv : a.options) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError("--option '" + kv + "' malformed; expected KEY=VALUE");
+    generic.extra[kv.substr(0, eq)] = kv.substr(eq + 1);
+  }
+  const rom::ConvexHullOptions options = rom::convex_hull_options(generic);
+  const rom::ConvexHullSolver solver(model, options);
+
+  const std::vector<fom::Param> params =
+      a.set == "training" ? rom::database_training_set(db, *problem) : rom::database_validation_set(db, *problem);
+  const fom::ActiveSetSolver fom_solver(*problem);
+  const std::vector<fom::FomSolution> refs = rom::compute_references(fom_solver, params, a.threads);
+  const Eigen::VectorXd& w = problem->contact().weights();
+
+  std::vector<HullRow> rows;
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    HullRow row;
+    row.mu = params[i];
+    row.r = solver.solve_detailed(params[i]);
+    const rom::OnlineResult& on = row.r.online;
+    row.primal_error = fom::relative_h1_error(*problem, on.u, refs[i].u);
+    row.dual_error = fom::relative_l2_pressure_error(*problem, on.lambda, refs[i].lambda);
+    row.kkt = fom::kkt_residuals(*problem, params[i], on.u, on.lambda);
+    // Absolute compliance: largest penetration (length) and |λᵀ(Cu − g)| = |Σ w_s λ_s gap_s|.
+    const Eigen::VectorXd gaps = fom::normal_gaps(*problem, on.u);
+    double comp = 0.0;
+    for (Eigen::Index s = 0; s < gaps.size(); ++s) {
+      if (!std::isfinite(gaps(s))) continue;
+      row.penetration_abs = std::max(row.penetration_abs, -gaps(s));
+      comp += w(s) * on.lambda(s) * gaps(s);
+    }
+    row.complementarity_abs = std::abs(comp);
+    rows.push_back(std::move(row));
+  }
+
+  auto selected_text = [&](const rom::OnlineResult& on, bool coefficients) {
+    std::string s;
+    for (std::size_t k = 0; k < on.selected.size(); ++k) {
+      s += k ? " " : "";
+      s += coefficients ? format_double(on.coefficients(static_cast<Eigen::Index>(k)))
+                        : std::to_string(model.dictionary_snapshots()[static_cast<std::size_t>(on.selected[k])]);
+    }
+    return s;
+  };
+  if (!a.out.empty()) {
+    write_file_atomically(a.out, [&](std::ostream& out) {
+      for (const std::string& name : problem->param_names()) out << name << ',';
+      out << "primal_h1_error,dual_l2_error,sparsity,sum_violation,penetration,penetration_abs,complementarity,"
+             "complementarity_abs,stationarity,negative_pressure,projected_residual,iterations,pairing_iterations,"
+             "converged,status,time_s,selected,coefficients\n";
+      for (const HullRow& row : rows) {
+        const rom::OnlineResult& on = row.r.online;
+        for (Eigen::Index k = 0; k < row.mu.size(); ++k) out << format_double(row.mu(k)) << ',';
+        out << format_double(row.primal_error) << ',' << format_double(row.dual_error) << ',' << on.selected.size()
+            << ',' << format_double(row.r.sum_violation) << ',' << format_double(row.kkt.penetration) << ','
+            << format_double(row.penetration_abs) << ',' << format_double(row.kkt.complementarity) << ','
+            << format_double(row.complementarity_abs) << ',' << format_double(row.kkt.stationarity) << ','
+            << format_double(row.kkt.negative_pressure) << ',' << format_double(row.r.projected_residual) << ','
+            << on.iterations << ',' << row.r.pairing_iterations << ',' << (on.converged ? 1 : 0) << ','
+            << to_string(on.status) << ',' << format_double(on.time_s) << ',' << selected_text(on, false) << ','
+            << selected_text(on, true) << '\n';
+      }
+    });
+  }
+
+  auto max_of = [&](auto get) {
+    double v = 0.0;
+    for (const HullRow& row : rows) v = std::max(v, static_cast<double>(get(row)));
+    return v;
+  };
+  auto mean_of = [&](auto get) {
+    double v = 0.0;
+    for (const HullRow& row : rows) v += static_cast<double>(get(row));
+    return rows.empty() ? 0.0 : v / static_cast<double>(rows.size());
+  };
+  nlohmann::json j;
+  j["problem"] = problem->name();
+  j["method"] = "convex-hull";
+  j["set"] = a.set;
+  j["queries"] = rows.size();
+  j["delta"] = model.delta();
+  j["basis"] = a.basis;
+  j["projection_rank"] = solver.dictionary().projection_rank();
+  j["dictionary_size"] = solver.dictionary().size();
+  j["mean_primal_error"] = mean_of([](const HullRow& r) { return r.primal_error; });
+  j["max_primal_error"] = max_of([](const HullRow& r) { return r.primal_error; });
+  j["mean_dual_error"] = mean_of([](const HullRow& r) { return r.dual_error; });
+  j["max_dual_error"] = max_of([](const HullRow& r) { return r.dual_error; });
+  j["mean_sparsity"] = mean_of([](const HullRow& r) { return r.r.online.selected.size(); });
+  j["max_sparsity"] = max_of([](const HullRow& r) { return r.r.online.selected.size(); });
+  j["max_sum_violation"] = max_of([](const HullRow& r) { return r.r.sum_violation; });
+  j["max_penetration"] = max_of([](const HullRow& r) { return r.kkt.penetration; });
+  j["max_penetration_abs"] = max_of([](const HullRow& r) { return r.penetration_abs; });
+  j["max_complementarity"] = max_of([](const HullRow& r) { return r.kkt.complementarity; });
+  j["max_complementarity_abs"] = max_of([](const HullRow& r) { return r.complementarity_abs; });
+  j["max_stationarity"] = max_of([](const HullRow& r) { return r.kkt.stationarity; });
+  j["max_projected_residual"] = max_of([](const HullRow& r) { return r.r.projected_residual; });
+  j["mean_iterations"] = mean_of([](const HullRow& r) { return r.r.online.iterations; });
+  j["mean_pairing_iterations"] = mean_of([](const HullRow& r) { return r.r.pairing_iterations; });
+  j["nonconverged"] = std::count_if(rows.begin(), rows.end(), [](const HullRow& r) { return !r.r.online.converged; });
+  if (a.time) {
+    const rom::OnlineTiming t = rom::time_online(solver, params, a.repeats);
+    j["median_time_s"] = t.median_core_s;
+    j["median_total_time_s"] = t.median_total_s;
+    j["timed_queries"] = t.queries;
+  }
+  if (a.json) {
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::cout << "convex-hull on " << problem->name() << " (" << db.training_kind << " " << db.training_size << "), "
+            << a.set << " set: " << rows.size() << " queries\n"
+            << "dictionary " << j["dictionary_size"] << " columns, projection basis " << a.basis << " of rank "
+            << j["projection_rank"] << " (delta " << model.delta() << ")\n"
+            << std::setprecision(3) << std::left << std::setw(28) << "" << std::setw(12) << "mean" << "max\n"
+            << std::setw(28) << "primal H1 error" << std::setw(12) << j["mean_primal_error"].get<double>()
+            << j["max_primal_error"].get<double>() << "\n"
+            << std::setw(28) << "dual L2 error" << std::setw(12) << j["mean_dual_error"].get<double>()
+            << j["max_dual_error"].get<double>() << "\n"
+            << std::setw(28) << "sparsity" << std::setw(12) << j["mean_sparsity"].get<double>()
+            << j["max_sparsity"].get<double>() << "\n"
+            << std::setw(28) << "|1'alpha - 1|" << std::setw(12) << "" << j["max_sum_violation"].get<double>() << "\n"
+            << std::setw(28) << "penetration (rel / abs)" << std::setw(12) << j["max_penetration"].get<double>()
+            << j["max_penetration_abs"].get<double>() << "\n"
+            << std::setw(28) << "complementarity (rel / abs)" << std::setw(12) << j["max_complementarity"].get<double>()
+            << j["max_complementarity_abs"].get<double>() << "\n"
+            << "not converged: " << j["nonconverged"] << " of " << rows.size() << "\n";
+  if (a.time)
+    std::cout << "median online time per query " << j["median_time_s"].get<double>() * 1e6 << " us (with full field "
+              << j["median_total_time_s"].get<double>() * 1e6 << " us)\n";
+  if (!a.out.empty()) std::cout << "per-query results written to " << a.out << "\n";
+}
+
+CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
+  auto args = std::make_shared<HullArgs>();
+  auto* sub = app.add_subcommand("hull-report", "Convex-hull ROM errors, sparsity and KKT compliance per query");
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
+  sub->add_option("--set", args->set, "training | validation (default)")
+      ->check(CLI::IsMember({"training", "validation"}));
+  sub->add_option("--delta", args->delta, "POD/SVD energy tolerance (default 1e-8; paper rope: 1e-7)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--basis", args->basis, "projection basis: svd (default) | random")
+      ->check(CLI::IsMember({"svd", "random"}));
+  sub->add_option("--basis-delta", args->basis_delta, "SVD tolerance of the projection basis (default: --delta)");
+  sub->add_option("--rank-l", args->rank_l, "random basis: number of combinations L (default: SVD rank)")
+      ->check(CLI::Range(1, 100000));
+  sub->add_option("--seed", args->seed, "random basis: seed of std::mt19937_64 (default 42)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--sum-weight", args->sum_weight, "weight of the convexity row, relative (default 1)")
+      ->check(CLI::PositiveNumber);
+  sub->add_flag("--no-polish", args->no_polish, "keep the plain nnFOCUSS coefficients (no exact simplex re-solve)");
+  sub->add_option("--max-pairing-iterations", args->max_pairing_iterations, "pairing fixed-point cap (default 20)")
+      ->check(CLI::Range(1, 100000));
+  sub->add_option("--option", args->options,
+                  "further convex-hull setting KEY=VALUE (repeatable; keys: see rom/convex_hull.hpp)");
+  sub->add_option("--out", args->out, "CSV file, one row per query");
+  sub->add_option("--threads", args->threads, "threads for the FOM references (default: hardware concurrency)")
+      ->check(CLI::Range(1, 1024));
+  sub->add_flag("--time", args->time, "also time the online solve (rom::time_online)");
+  sub->add_option("--repeats", args->repeats, "passes over the set for --time (default 3)")->check(CLI::Range(1, 1000));
+  sub->add_flag("--json", args->json, "print one JSON object");
+  sub->callback([args] { run_hull_report(*args); });
+});
+
+}  // namespace
+}  // namespace contactrom::cli
