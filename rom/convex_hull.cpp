@@ -293,6 +293,7 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
   std::vector<Index> support_prev;
   std::vector<VectorXd> hist_g, hist_f;  // Anderson history: g(x_i), g(x_i) − x_i
   double last_change = std::numeric_limits<double>::infinity();
+  int full_solves = 0;
   for (int it = 0; it < cap; ++it) {
     if (pairing) {
       if (x.size() == 0)
@@ -304,12 +305,16 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
     } else {
       a = bk + *dict.constant_contact();
     }
-    if (!frozen) {
+    auto full_solve = [&] {
       ProjectedSolve step = solve_projected(a, bf, opt);
       res.focuss_iterations += step.focuss_iterations;
       res.nnls_iterations += step.nnls_iterations;
-      res.alpha = std::move(step.alpha);
+      ++full_solves;
       status = step.status;
+      return std::move(step.alpha);
+    };
+    if (!frozen) {
+      res.alpha = full_solve();
     } else {
       ProjectedSolve step = solve_projected(select_columns(a, support_prev), bf, opt);
       res.focuss_iterations += step.focuss_iterations;
@@ -326,12 +331,27 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
     // without any effect on u).
     const VectorXd u_next = lift_s + dict.surface_primal() * res.alpha;
     const double change = (u_next - u_s).norm() / std::max(u_next.norm(), std::numeric_limits<double>::min());
-    const bool same_support = it > 0 && support == support_prev;
+    bool same_support = it > 0 && support == support_prev;
     if (same_support && change <= opt.pairing_tolerance) {
-      settled = true;
-      break;
+      if (!frozen || full_solves >= opt.selection_iterations) {
+        settled = true;
+        break;
+      }
+      // Settled on a frozen support that was selected under an earlier pairing:
+      // re-select once under the converged pairing. Same support: done; otherwise
+      // continue the fixed point from the new selection.
+      VectorXd reselected = full_solve();
+      if (status == Status::NumericalIssue) break;
+      std::vector<Index> support_new = nonzeros(reselected);
+      if (support_new == support) {
+        settled = true;
+        break;
+      }
+      res.alpha = std::move(reselected);
+      support = std::move(support_new);
+      same_support = false;
     }
-    if (!frozen && (same_support || it + 1 >= opt.selection_iterations)) frozen = true;
+    if (!frozen && (same_support || full_solves >= opt.selection_iterations)) frozen = true;
     // Anderson safeguard: restart the history when the support changed or the
     // residual grew (the map is only piecewise smooth: pairing segments switch).
     if (!frozen || !same_support || change > last_change) hist_g.clear(), hist_f.clear();
