@@ -86,6 +86,13 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   // Surface displacement of the current iterate, u_s = Φ_s û + u_off,s: the only
   // place the primal enters the contact operators.
   Eigen::VectorXd u_s = phi_s * u_hat + lift_s;
+  // Best iterate with λ̂ ≥ 0 (smallest largest violation), for the iteration cap.
+  struct {
+    bool valid = false;
+    double violation = 0.0;
+    Eigen::VectorXd u_hat, lambda_i;
+    std::vector<int> selected;
+  } best_iterate;
 
   for (int k = 0; k < m_options.max_iterations; ++k) {
     // 1. Contact operators at the previous iterate, from the surface rows only.
@@ -147,6 +154,13 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
       violation.noalias() = dict.transpose() * v;
       int add = -1;
       if (m > 0) max_violation = violation.maxCoeff();
+      if (m_options.best_iterate_on_failure && (!best_iterate.valid || max_violation < best_iterate.violation)) {
+        best_iterate.valid = true;
+        best_iterate.violation = max_violation;
+        best_iterate.u_hat = u_hat;
+        best_iterate.lambda_i = lambda_i;
+        best_iterate.selected = solved;
+      }
       double best = m_threshold;  // (·)^{+,τ}: entries ≤ τ count as zero
       for (int p = 0; p < m; ++p)
         if (!in_active[p] && violation(p) > best) best = violation(p), add = p;
@@ -176,13 +190,19 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
     }
   }
 
+  if (!res.converged && res.status == Status::Success && best_iterate.valid) {
+    u_hat = best_iterate.u_hat;
+    lambda_i = best_iterate.lambda_i;
+    solved = best_iterate.selected;
+  }
   res.u_hat = u_hat;
   res.selected = solved;
   res.coefficients = lambda_i;
   res.lambda = m_model.reconstruct_dual(solved, lambda_i);
   if (res.status == Status::Success && !res.converged) {
     res.status = Status::NoConvergence;
-    res.message = "greedy active set did not converge in " + std::to_string(m_options.max_iterations) + " iterations";
+    res.message = "greedy active set did not converge in " + std::to_string(m_options.max_iterations) + " iterations" +
+                  (best_iterate.valid && m_options.best_iterate_on_failure ? "; best iterate with non-negative multipliers returned" : "");
   }
   const auto t1 = clock::now();
   res.time_s = std::chrono::duration<double>(t1 - t0).count();

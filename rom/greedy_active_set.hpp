@@ -22,7 +22,8 @@
 ///     most negative \f$ \hat\lambda_p \f$;
 ///  4. stops when nothing was added or removed and
 ///     \f$ \|\hat u^k - \hat u^{k-1}\| \le \epsilon\,\|\hat u^k\| \f$ (ε = 1e-5), or
-///     after k_max = 50 iterations (converged = false).
+///     after k_max = 50 iterations (converged = false; by default the best iterate
+///     with λ̂ ≥ 0 is then returned, see GreedyOptions::best_iterate_on_failure).
 /// Only Ĉ_I (|I| rows) is formed; the violation of all m columns is evaluated as
 /// \f$ D_d^T (C_s u_s - g) \f$, which equals \f$ \hat C\hat u - \hat g \f$. Every
 /// operation costs O(n_s r + n_c (r |I| + m) + r²|I|): nothing scales with the mesh
@@ -55,6 +56,11 @@ struct GreedyOptions {
   /// (reciprocal condition estimate of its LDLᵀ); the system is then solved in the
   /// least-squares, minimum-norm sense. Default 1e-13.
   double singular_tolerance = 1e-13;
+  /// When the iteration cap is reached (add/remove cycles, paper §4.1), return the
+  /// iterate with non-negative multipliers and the smallest largest violation seen,
+  /// instead of the last one (which may carry negative multipliers). The result is
+  /// still flagged converged = false. Default true.
+  bool best_iterate_on_failure = true;
   /// If set, one line per iteration (|I|, action, largest violation, step) is
   /// written here; for diagnosis only (not thread-safe). Default nullptr.
   std::ostream* trace = nullptr;
