@@ -29,7 +29,7 @@
 ///     x = \begin{bmatrix} B^T f(\mu) \\ \omega \end{bmatrix},\quad
 ///     K_{mono} = K(\mu) D_p + C^T D_d, \f]
 /// the convexity row weighted by \f$ \omega = \omega_0 \max_j \|B^T K_{mono}[:,j]\| \f$
-/// (ω₀ = `sum_weight`, default 1), then "polished": the equality-constrained least squares
+/// (ω₀ = `sum_weight`, default 0.1), then "polished": the equality-constrained least squares
 /// \f$ \min \|B^T r(\alpha)\| \f$ s.t. \f$ \alpha \ge 0, \mathbf 1^T\alpha = 1 \f$
 /// is solved exactly (SimplexLeastSquares, rom/chls.hpp) on the support nnFOCUSS
 /// selected, so that \f$ |\mathbf 1^T\alpha - 1| \sim 10^{-16} \f$ (see
@@ -91,8 +91,10 @@ struct ConvexHullOptions {
   /// Seed of the std::mt19937_64 that draws R. Default 42.
   std::uint64_t seed = 42;
   /// ω₀, weight of the convexity row relative to the largest column norm of
-  /// \f$ B^T K_{mono} \f$ (dimensionless). Default 1 (docs/convex_hull.md).
-  double sum_weight = 1.0;
+  /// \f$ B^T K_{mono} \f$ (dimensionless). Default 0.1: small enough for the Gram-form
+  /// NNLS start to resolve the residual rows, the exact polish enforcing 1ᵀα = 1;
+  /// without polish use ≥ 1e2 (docs/convex_hull.md).
+  double sum_weight = 0.1;
   /// Re-solve the exact simplex-constrained least squares on the nnFOCUSS support.
   /// Default true.
   bool polish = true;

@@ -129,7 +129,7 @@ CommandRegistrar reg_chls("chls", [](CLI::App& app) {
 
 struct HullArgs {
   std::string db, set = "validation", basis = "svd", out;
-  double delta = 1e-8, basis_delta = -1.0, sum_weight = 1.0;
+  double delta = 1e-8, basis_delta = -1.0, sum_weight = 0.1;
   int rank_l = 0, threads = 0, repeats = 3, max_pairing_iterations = 20;
   long long seed = 42;
   bool no_polish = false, json = false, time = false;
@@ -311,7 +311,7 @@ CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
       ->check(CLI::Range(1, 100000));
   sub->add_option("--seed", args->seed, "random basis: seed of std::mt19937_64 (default 42)")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--sum-weight", args->sum_weight, "weight of the convexity row, relative (default 1)")
+  sub->add_option("--sum-weight", args->sum_weight, "weight of the convexity row, relative (default 0.1)")
       ->check(CLI::PositiveNumber);
   sub->add_flag("--no-polish", args->no_polish, "keep the plain nnFOCUSS coefficients (no exact simplex re-solve)");
   sub->add_option("--max-pairing-iterations", args->max_pairing_iterations, "pairing fixed-point cap (default 20)")

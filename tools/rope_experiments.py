@@ -151,8 +151,8 @@ def main():
             path = out("rope_hull_%s%s.csv" % (name, suffix))
             args = ["hull-report", "--db", db, "--set", name, "--delta", a.delta, "--out", path,
                     "--threads", a.threads]
-            if not polish:
-                args.append("--no-polish")
+            if not polish:  # the paper's variant: convexity only through the weighted row (weight 1)
+                args += ["--no-polish", "--sum-weight", 1]
             summary["hull_%s%s" % (name, suffix)] = run_json(a.exe, args, commands)
             sets[name + suffix] = read_csv(path)
     summary["online_validation"] = run_json(
