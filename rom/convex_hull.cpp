@@ -283,7 +283,9 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
   // lets near-tied supports alternate forever. The frozen phase converges linearly
   // (rate 0.3–0.6 on hertz) and is accelerated by Anderson mixing, which keeps
   // 1ᵀα = 1 (a combination of iterates with weights summing to one) and is
-  // abandoned for a plain step whenever it would make a coefficient negative.
+  // abandoned for a plain step whenever it would make a coefficient negative. Once
+  // it settles, one more full solve (budget permitting) checks the selection under
+  // the converged pairing.
   const int cap = pairing ? opt.max_pairing_iterations : 1;
   fom::ConstraintMatrix c;
   VectorXd g, x;  // x: the α that defines the pairing (empty: centroid of the hull)
