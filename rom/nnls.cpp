@@ -11,6 +11,7 @@ using Eigen::VectorXd;
 
 MatrixXd gram_matrix(const MatrixXd& a) {
   MatrixXd gram = MatrixXd::Zero(a.cols(), a.cols());
+  if (a.size() == 0) return gram;  // no rows or no columns (Eigen's kernel must not see null data)
   gram.selfadjointView<Eigen::Lower>().rankUpdate(a.transpose());
   gram.triangularView<Eigen::StrictlyUpper>() = gram.transpose();
   return gram;
@@ -267,6 +268,7 @@ Nnls& Nnls::compute(const MatrixXd& a) {
   if (!m_computed) {
     m_qp.compute_from_owned(MatrixXd::Zero(a.cols(), a.cols()));
     m_qp.m_computed = false;
+    m_qp.m_info = Status::InvalidInput;
     m_info = Status::InvalidInput;
     return *this;
   }

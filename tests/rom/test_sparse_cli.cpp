@@ -249,7 +249,6 @@ BOOST_AUTO_TEST_CASE(bad_input_gives_a_one_line_error_and_exit_code_2) {
   write_text(dir.file("ragged.csv"), "1,2,3\n4,5\n");
   write_text(dir.file("text.csv"), "1,2,3\n4,five,6\n");
   write_text(dir.file("empty.csv"), "");
-  write_text(dir.file("matrix_signal.csv"), "1,2\n3,4\n");
   const std::string d = dir.file("D.csv");
   const std::string x = dir.file("x.csv");
   struct Case {
@@ -262,9 +261,7 @@ BOOST_AUTO_TEST_CASE(bad_input_gives_a_one_line_error_and_exit_code_2) {
       {sparse_args("nnls", d, dir.file("x3.csv")), "has 3 values, expected 2 (the rows of dictionary"},
       {sparse_args("lasso", d, x), "unknown --method 'lasso': expected nnls, omp, focuss or nnfocuss"},
       {sparse_args("nnls", dir.file("empty.csv"), x), "empty.csv: no values (empty file)"},
-      {sparse_args("omp", d, dir.file("matrix_signal.csv")), "expected one column or one row"},
       {sparse_args("nnls", d, x, "--atoms 2"), "--atoms applies to --method omp only"},
-      {sparse_args("omp", d, x, "--tol -1"), "expected a finite tolerance >= 0"},
       {"bench-sparse --repeats 0", "--repeats 0: expected a count >= 1"},
   };
   std::vector<std::string> args;
