@@ -24,12 +24,13 @@ SparseMatrix free_block(const SparseMatrix& k, const std::vector<int>& free, con
   return kff;
 }
 
-/// S Cᵀ (n_s x n_c) for the sparse constraint rows: column a is the sum of the
-/// columns of the symmetric S picked by row a's (at most six) entries.
-void delassus_parts(const ConstraintMatrix& c, const Eigen::MatrixXd& s, Eigen::MatrixXd& sct) {
-  sct.resize(s.rows(), c.rows());
-  for (int a = 0; a < c.outerSize(); ++a) {
-    ConstraintMatrix::InnerIterator it(c, a);
+/// S C_Wᵀ (n_s x |W|) for the constraint rows W: column a is the sum of the
+/// columns of the symmetric S picked by row W[a]'s (at most six) entries.
+void delassus_parts(const ConstraintMatrix& c, const std::vector<int>& rows, const Eigen::MatrixXd& s,
+                    Eigen::MatrixXd& sct) {
+  sct.resize(s.rows(), static_cast<Eigen::Index>(rows.size()));
+  for (size_t a = 0; a < rows.size(); ++a) {
+    ConstraintMatrix::InnerIterator it(c, rows[a]);
     if (!it) {
       sct.col(a).setZero();
       continue;
@@ -37,6 +38,17 @@ void delassus_parts(const ConstraintMatrix& c, const Eigen::MatrixXd& s, Eigen::
     sct.col(a).noalias() = it.value() * s.col(it.col());
     for (++it; it; ++it) sct.col(a).noalias() += it.value() * s.col(it.col());
   }
+}
+
+/// G_W = C_W S C_Wᵀ from S C_Wᵀ (|W| x |W|).
+Eigen::MatrixXd delassus(const ConstraintMatrix& c, const std::vector<int>& rows, const Eigen::MatrixXd& sct) {
+  const int nw = static_cast<int>(rows.size());
+  Eigen::MatrixXd g(nw, nw);
+  for (int a = 0; a < nw; ++a) {
+    g.row(a).setZero();
+    for (ConstraintMatrix::InnerIterator it(c, rows[a]); it; ++it) g.row(a).noalias() += it.value() * sct.row(it.col());
+  }
+  return g;
 }
 
 bool pairing_settled(const ConstraintMatrix& c, const Eigen::VectorXd& g, const ConstraintMatrix& c_next,
@@ -146,7 +158,9 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
   DualQpSolver qp(m_options.qp);
   ConstraintMatrix c;
   Eigen::VectorXd g;
-  Eigen::MatrixXd sct;  // S Cᵀ, n_s x n_c
+  Eigen::MatrixXd sct;  // S C_Wᵀ, n_s x |W|
+  const double margin = m_options.working_set_margin * m_problem.displacement_scale();
+  const bool all_rows = m_options.working_set_margin < 0.0;
   bool converged = false;
   // Fixed point x -> F(x) on the surface displacement: pairing from x, exact dual
   // QP for that pairing, F(x) = resulting surface displacement. Anderson
@@ -157,20 +171,62 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
   for (int it = 0; it < m_options.max_pairing_iterations; ++it) {
     ++sol.pairing_iterations;
     contact.assemble(pairing, c, g);
-    delassus_parts(c, cond.s, sct);
-    const Eigen::MatrixXd delassus = c * sct;
     const Eigen::VectorXd h = c * u0_s - g;
-    std::vector<char> eligible(nc, 1);
-    for (int s = 0; s < nc; ++s)
-      if (contact.has_pairing() && pairing.segment[s] < 0) eligible[s] = 0;
-    lambda = qp.solve(delassus, h, eligible, lambda);
-    sol.iterations += qp.iterations();
-    if (qp.info() != Status::Success) {
+    // Working set W: the rows that are active or, at the current iterate x,
+    // within the margin of contact. The QP is solved on W; rows outside W are
+    // then checked at the solution and the violated ones join W (repeat), so
+    // λ solves the QP of all rows while the Delassus matrix is only |W| x |W|.
+    std::vector<char> in_w(nc, 0);
+    std::vector<int> w_rows;
+    {
+      const Eigen::VectorXd gap = c * x - g;
+      for (int s = 0; s < nc; ++s) {
+        const bool paired = !contact.has_pairing() || pairing.segment[s] >= 0;
+        if (paired && (all_rows || lambda(s) > 0.0 || gap(s) > -margin * contact.weights()(s) || h(s) > 0.0))
+          in_w[s] = 1, w_rows.push_back(s);
+      }
+    }
+    Eigen::VectorXd lambda_w, f;
+    bool qp_ok = true;
+    for (;;) {
+      delassus_parts(c, w_rows, cond.s, sct);
+      const Eigen::MatrixXd g_w = delassus(c, w_rows, sct);
+      const int nw = static_cast<int>(w_rows.size());
+      Eigen::VectorXd h_w(nw), warm_w(nw);
+      for (int a = 0; a < nw; ++a) h_w(a) = h(w_rows[a]), warm_w(a) = lambda(w_rows[a]);
+      if (nw > 0) {
+        lambda_w = qp.solve(g_w, h_w, {}, warm_w);
+        sol.iterations += qp.iterations();
+      } else {
+        lambda_w.resize(0);
+      }
+      if (nw > 0 && qp.info() != Status::Success) {
+        qp_ok = false;
+        break;
+      }
+      f = u0_s - sct * lambda_w;
+      // Rows outside W must not penetrate at f (same tolerance as the QP's).
+      const double tol = m_options.qp.relative_tolerance * std::max(h_w.size() ? h_w.cwiseAbs().maxCoeff() : 0.0,
+                                                                    h.cwiseAbs().maxCoeff());
+      const Eigen::VectorXd v = c * f - g;
+      bool grown = false;
+      for (int s = 0; s < nc; ++s) {
+        const bool paired = !contact.has_pairing() || pairing.segment[s] >= 0;
+        if (!in_w[s] && paired && v(s) > tol) in_w[s] = 1, grown = true;
+      }
+      if (!grown) break;
+      for (int a = 0; a < nw; ++a) lambda(w_rows[a]) = lambda_w(a);
+      w_rows.clear();
+      for (int s = 0; s < nc; ++s)
+        if (in_w[s]) w_rows.push_back(s);
+    }
+    if (!qp_ok) {
       sol.status = qp.info();
       sol.message = "dual active-set QP failed: " + std::string(to_string(qp.info()));
       break;
     }
-    const Eigen::VectorXd f = u0_s - sct * lambda;
+    lambda.setZero();
+    for (size_t a = 0; a < w_rows.size(); ++a) lambda(w_rows[a]) = lambda_w(a);
     if (!contact.has_pairing()) {
       converged = true;
       break;
@@ -178,7 +234,7 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
     // Converged when re-pairing at F(x) no longer changes the KKT system of
     // this solution: the forces Cᵀλ, the gaps of active/penetrating rows and
     // the penetration, each to `pairing_tolerance` (relative).
-    const Pairing next = contact.search(f);
+    const Pairing next = contact.search_rows(f, nullptr, &pairing);
     ConstraintMatrix c_next;
     Eigen::VectorXd g_next;
     contact.assemble(next, c_next, g_next);
@@ -198,12 +254,21 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
     r_prev = r;
     x = f;
     if (!d_r.empty() && m_options.anderson_depth > 0) {
-      Eigen::MatrixXd dr(r.size(), d_r.size()), df(r.size(), d_f.size());
-      for (size_t k = 0; k < d_r.size(); ++k) dr.col(k) = d_r[k], df.col(k) = d_f[k];
-      const Eigen::VectorXd gamma = dr.colPivHouseholderQr().solve(r);
-      if (gamma.allFinite()) x = f - df * gamma;
+      // Least-squares γ = argmin |r − ΔR γ| by the normal equations (m ≤ depth
+      // columns; a rank-revealing LDLᵀ drops dependent differences).
+      const int m = static_cast<int>(d_r.size());
+      Eigen::MatrixXd gram(m, m);
+      Eigen::VectorXd rhs(m);
+      for (int a = 0; a < m; ++a) {
+        rhs(a) = d_r[a].dot(r);
+        for (int b = 0; b <= a; ++b) gram(a, b) = gram(b, a) = d_r[a].dot(d_r[b]);
+      }
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(gram);
+      const Eigen::VectorXd gamma = ldlt.solve(rhs);
+      if (ldlt.info() == Eigen::Success && gamma.allFinite())
+        for (int a = 0; a < m; ++a) x.noalias() -= gamma(a) * d_f[a];
     }
-    pairing = contact.search(x);
+    pairing = contact.search_rows(x, nullptr, &next);
   }
   if (!converged && sol.status == Status::Success) {
     sol.status = Status::NoConvergence;
@@ -212,7 +277,12 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
   }
   // The constraint operator of the returned solution is the one λ was solved with;
   // on convergence the pairing recomputed from u agrees with it to the tolerance.
-  sol.u = u0 - cond.z_surface * (c.transpose() * lambda);
+  // u = u0 − Z_s Cᵀλ over the non-zero entries of Cᵀλ only (the surface dofs of
+  // the active rows): Z_s is n x n_s and dense, the full product dominates a query.
+  sol.u = u0;
+  const Eigen::VectorXd force = c.transpose() * lambda;
+  for (int j = 0; j < force.size(); ++j)
+    if (force(j) != 0.0) sol.u.noalias() -= force(j) * cond.z_surface.col(j);
   sol.lambda = lambda;
   sol.pairing = pairing;
   sol.active = static_cast<int>((lambda.array() > 0.0).count());

@@ -45,6 +45,11 @@ struct ActiveSetOptions {
   /// contact forces Cᵀλ (relative to |Cᵀλ|), the gaps of active rows and the
   /// penetration (relative to the displacement scale) by at most this; default 1e-12.
   double pairing_tolerance = 1e-12;
+  /// The dual QP is solved on a working set: rows active or with a gap above
+  /// −margin·U at the current iterate (U: displacement scale), grown until no
+  /// other row penetrates; the result is the QP solution on all rows. < 0: all
+  /// rows. Default 0.05.
+  double working_set_margin = 0.05;
   int anderson_depth = 10;          ///< Anderson acceleration depth of the pairing fixed point (0: plain), default 10
   DualQpOptions qp;                 ///< options of the dual QP solve
 };

@@ -1,5 +1,6 @@
 #include "fom/contact_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -62,63 +63,87 @@ NodeToSegmentContact::NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const 
   }
 }
 
-Pairing NodeToSegmentContact::search(const Eigen::VectorXd& u_surface) const {
+Pairing NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
+                                          const Pairing* hint) const {
   const int ns = static_cast<int>(m_slave.size()), nm = static_cast<int>(m_master.size());
-  Eigen::Matrix2Xd xs = m_slave_x, xm = m_master_x;
-  for (int k = 0; k < ns; ++k) xs.col(k) += u_surface.segment<2>(2 * k);
+  Eigen::Matrix2Xd xm = m_master_x;
   for (int j = 0; j < nm; ++j) xm.col(j) += u_surface.segment<2>(2 * (ns + j));
 
   // Nodal normals of the deformed master surface (average of the adjacent
   // segments' outward normals): interpolating them along a segment gives a
   // normal field that is continuous across master nodes, so the constraint row
   // does not jump when a slave node passes from one segment to the next.
-  Eigen::Matrix2Xd seg_normal(2, std::max(nm - 1, 0)), node_normal = Eigen::Matrix2Xd::Zero(2, nm);
-  for (int j = 0; j + 1 < nm; ++j) {
+  const int nseg = std::max(nm - 1, 0);
+  Eigen::Matrix2Xd node_normal = Eigen::Matrix2Xd::Zero(2, nm);
+  Eigen::Matrix2Xd seg_t(2, nseg), mid(2, nseg);
+  Eigen::VectorXd inv_len2(nseg), half(nseg);
+  for (int j = 0; j < nseg; ++j) {
     const Eigen::Vector2d t = xm.col(j + 1) - xm.col(j);
-    seg_normal.col(j) = m_orientation[j] * Eigen::Vector2d(t.y(), -t.x()).normalized();
-    node_normal.col(j) += seg_normal.col(j);
-    node_normal.col(j + 1) += seg_normal.col(j);
+    const double len = t.norm();
+    const Eigen::Vector2d n = (m_orientation[j] / len) * Eigen::Vector2d(t.y(), -t.x());
+    node_normal.col(j) += n;
+    node_normal.col(j + 1) += n;
+    seg_t.col(j) = t;
+    mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
+    inv_len2(j) = 1.0 / (len * len);
+    half(j) = 0.5 * len;
   }
   for (int j = 0; j < nm; ++j) node_normal.col(j).normalize();
+  // Bounding circles of blocks of m_block consecutive segments (centre, radius):
+  // a block is skipped when its circle is farther than the best distance found.
+  const int nblock = (nseg + m_block - 1) / m_block;
+  Eigen::Matrix2Xd block_c(2, nblock);
+  Eigen::VectorXd block_r(nblock);
+  for (int b = 0; b < nblock; ++b) {
+    const int j0 = b * m_block, j1 = std::min(nseg, j0 + m_block);  // vertices j0..j1
+    block_c.col(b) = xm.middleCols(j0, j1 - j0 + 1).rowwise().mean();
+    double r2 = 0.0;
+    for (int j = j0; j <= j1; ++j) r2 = std::max(r2, (xm.col(j) - block_c.col(b)).squaredNorm());
+    block_r(b) = std::sqrt(r2);
+  }
 
   Pairing p;
   p.segment.assign(ns, -1);
   p.xi.assign(ns, 0.0);
   p.normal = Eigen::Matrix2Xd::Zero(2, ns);
-  // Segment data once per search; the inner loop uses squared distances only and
-  // skips a segment whose bounding circle (centre `mid`, radius `half`) is
-  // farther than the best distance found so far. The previous slave node's
-  // segment is tried first: neighbouring slave nodes have neighbouring pairs.
-  const int nseg = std::max(nm - 1, 0);
-  Eigen::Matrix2Xd seg_t(2, nseg), mid(2, nseg);
-  Eigen::VectorXd inv_len2(nseg), half(nseg);
-  for (int j = 0; j < nseg; ++j) {
-    seg_t.col(j) = xm.col(j + 1) - xm.col(j);
-    mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
-    inv_len2(j) = 1.0 / seg_t.col(j).squaredNorm();
-    half(j) = 0.5 * seg_t.col(j).norm();
-  }
+  // Exact closest segment per slave node. Squared distances only; the segment of
+  // the previous slave node is tried first (neighbouring slave nodes have
+  // neighbouring pairs), then every block whose circle may hold a closer point,
+  // then within it every segment whose circle (centre mid, radius half) may.
+  // Ties (a slave node exactly at a master node) go to the lower segment index.
   int guess = 0;
-  for (int k = 0; k < ns; ++k) {
-    const double px = xs(0, k), py = xs(1, k);
+  const int nrows = rows ? static_cast<int>(rows->size()) : ns;
+  for (int r = 0; r < nrows; ++r) {
+    const int k = rows ? (*rows)[r] : r;
+    const double px = m_slave_x(0, k) + u_surface(2 * k), py = m_slave_x(1, k) + u_surface(2 * k + 1);
     double best = std::numeric_limits<double>::max(), best_root = std::numeric_limits<double>::max();
     int best_seg = -1;
     double best_xi = 0.0, best_raw = 0.0;
-    for (int step = -1; step < nseg; ++step) {
-      const int j = step < 0 ? guess : step;
-      if (step >= 0 && j == guess) continue;
-      if (best_seg >= 0) {
-        const double mx = px - mid(0, j), my = py - mid(1, j);
-        if (mx * mx + my * my > best + half(j) * (2.0 * best_root + half(j))) continue;
-      }
+    auto try_segment = [&](int j) {
       const double dx = px - xm(0, j), dy = py - xm(1, j), tx = seg_t(0, j), ty = seg_t(1, j);
       const double raw = (dx * tx + dy * ty) * inv_len2(j);
       const double xi = raw < 0.0 ? 0.0 : (raw > 1.0 ? 1.0 : raw);
       const double ex = dx - xi * tx, ey = dy - xi * ty;
       const double dist2 = ex * ex + ey * ey;
-      // Ties (a slave node exactly at a master node) go to the lower segment index.
-      if (dist2 < best * (1.0 - 1e-14) || (best_seg >= 0 && dist2 <= best * (1.0 + 1e-14) && j < best_seg)) {
+      if (dist2 < best * (1.0 - 1e-14) || (best_seg >= 0 && dist2 <= best * (1.0 + 1e-14) && j < best_seg))
         best = dist2, best_root = std::sqrt(dist2), best_seg = j, best_xi = xi, best_raw = raw;
+    };
+    if (hint && hint->segment.size() == static_cast<size_t>(ns) && hint->segment[k] >= 0) guess = hint->segment[k];
+    if (nseg > 0) {
+      // The guess and its neighbours first: a good first distance prunes the rest.
+      try_segment(guess);
+      if (guess > 0) try_segment(guess - 1);
+      if (guess + 1 < nseg) try_segment(guess + 1);
+    }
+    for (int b = 0; b < nblock; ++b) {
+      const double bx = px - block_c(0, b), by = py - block_c(1, b), reach = best_root + block_r(b);
+      if (bx * bx + by * by > reach * reach * (1.0 + 1e-12)) continue;
+      const int j1 = std::min(nseg, (b + 1) * m_block);
+      for (int j = b * m_block; j < j1; ++j) {
+        if (j >= guess - 1 && j <= guess + 1) continue;
+        const double mx = px - mid(0, j), my = py - mid(1, j), sreach = best_root + half(j);
+        if (mx * mx + my * my > sreach * sreach * (1.0 + 1e-12)) continue;
+        try_segment(j);
       }
     }
     if (best_seg >= 0) guess = best_seg;
@@ -133,24 +158,27 @@ Pairing NodeToSegmentContact::search(const Eigen::VectorXd& u_surface) const {
 
 void NodeToSegmentContact::assemble(const Pairing& p, ConstraintMatrix& c, Eigen::VectorXd& g) const {
   const int ns = static_cast<int>(m_slave.size());
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(6 * ns);
   g = Eigen::VectorXd::Zero(ns);
+  // Row-major storage filled in order: a row's columns (slave node k, master
+  // nodes j and j+1, ascending since master columns follow all slave columns).
+  c.resize(ns, static_cast<int>(m_surface_dofs.size()));
+  c.reserve(6 * ns);
   for (int k = 0; k < ns; ++k) {
+    c.startVec(k);
     const int j = p.segment[k];
     if (j < 0) continue;
     const double w = m_weights(k), xi = p.xi[k];
     const Eigen::Vector2d n = p.normal.col(k);
     const Eigen::Vector2d xm = (1.0 - xi) * m_master_x.col(j) + xi * m_master_x.col(j + 1);
     g(k) = w * n.dot(m_slave_x.col(k) - xm);
-    for (int d = 0; d < 2; ++d) {
-      trip.emplace_back(k, 2 * k + d, -w * n(d));
-      trip.emplace_back(k, 2 * (ns + j) + d, w * (1.0 - xi) * n(d));
-      trip.emplace_back(k, 2 * (ns + j + 1) + d, w * xi * n(d));
-    }
+    c.insertBack(k, 2 * k) = -w * n(0);
+    c.insertBack(k, 2 * k + 1) = -w * n(1);
+    c.insertBack(k, 2 * (ns + j)) = w * (1.0 - xi) * n(0);
+    c.insertBack(k, 2 * (ns + j) + 1) = w * (1.0 - xi) * n(1);
+    c.insertBack(k, 2 * (ns + j + 1)) = w * xi * n(0);
+    c.insertBack(k, 2 * (ns + j + 1) + 1) = w * xi * n(1);
   }
-  c.resize(ns, static_cast<int>(m_surface_dofs.size()));
-  c.setFromTriplets(trip.begin(), trip.end());
+  c.finalize();
 }
 
 ObstacleContact::ObstacleContact(const Eigen::VectorXd& x, const Eigen::VectorXd& psi,

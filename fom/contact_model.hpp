@@ -52,9 +52,16 @@ class ContactModel {
   /// Whether C and g depend on the displacement through a pairing.
   virtual bool has_pairing() const = 0;
 
-  /// \brief Contact search in the deformed configuration.
+  /// \brief Contact search in the deformed configuration, every row.
   /// \param u_surface full displacement restricted to surface_dofs()
-  virtual Pairing search(const Eigen::VectorXd& u_surface) const = 0;
+  Pairing search(const Eigen::VectorXd& u_surface) const { return search_rows(u_surface, nullptr, nullptr); }
+  /// \brief Same, for the listed rows only (ascending; nullptr: every row). The
+  /// other rows are left unpaired, i.e. zero rows of C after assemble(). A reduced
+  /// model whose dual dictionary vanishes outside a set of rows needs only those.
+  /// `hint` (may be nullptr): a nearby pairing (e.g. of the previous iterate) whose
+  /// segments are tried first; it speeds the search up and never changes its result.
+  virtual Pairing search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
+                              const Pairing* hint) const = 0;
 
   /// \brief Constraint operator for a pairing: C (n_c x surface dofs) and g (n_c).
   virtual void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const = 0;
@@ -79,7 +86,8 @@ class NodeToSegmentContact final : public ContactModel {
                        const std::vector<int>& master_chain, const std::vector<Eigen::Vector2d>& master_inside);
 
   bool has_pairing() const override { return true; }
-  Pairing search(const Eigen::VectorXd& u_surface) const override;
+  Pairing search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
+                      const Pairing* hint) const override;
   void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const override;
 
   const std::vector<int>& slave_nodes() const { return m_slave; }
@@ -89,6 +97,7 @@ class NodeToSegmentContact final : public ContactModel {
   std::vector<int> m_slave, m_master;
   Eigen::Matrix2Xd m_slave_x, m_master_x;  // reference coordinates
   std::vector<double> m_orientation;       // +1/-1 per master segment: outward normal sign
+  int m_block = 8;                         // segments per bounding circle of the search
 };
 
 /// \brief Scalar obstacle constraint \f$ u_i \ge \psi(x_i) \f$ on 1D nodes (rope).
@@ -98,7 +107,7 @@ class ObstacleContact final : public ContactModel {
   /// \param weights tributary lengths (the dof of node i is i).
   ObstacleContact(const Eigen::VectorXd& x, const Eigen::VectorXd& psi, const Eigen::VectorXd& weights);
   bool has_pairing() const override { return false; }
-  Pairing search(const Eigen::VectorXd&) const override { return {}; }
+  Pairing search_rows(const Eigen::VectorXd&, const std::vector<int>*, const Pairing*) const override { return {}; }
   void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const override;
 
  private:

@@ -2,7 +2,9 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ostream>
 
 namespace contactrom::rom {
@@ -27,6 +29,10 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
 
 GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& options)
     : m_model(model), m_options(options) {
+  m_rows = model.dictionary_support();
+  m_phi_s_rm = model.surface_basis();
+  m_dict_r.resize(static_cast<Eigen::Index>(m_rows.size()), model.dictionary_size());
+  for (size_t i = 0; i < m_rows.size(); ++i) m_dict_r.row(i) = model.dictionary().row(m_rows[i]);
   const double tau = options.tau < 0.0 ? model.delta() : options.tau;
   m_threshold = tau;
   if (options.tau_scaling == TauScaling::Relative) {
@@ -79,7 +85,11 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
 
   Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, g, y, v, violation, rhs;
   Eigen::MatrixXd c_hat_i, w, schur;
+  const int nr = static_cast<int>(m_rows.size());
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> a_r(nr, r);
+  Eigen::VectorXd b_r(nr);
   fom::ConstraintMatrix c;
+  fom::Pairing pairing;
   std::vector<int> active, solved;
   std::vector<char> in_active(m, 0);
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
@@ -94,19 +104,46 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
     std::vector<int> selected;
   } best_iterate;
 
-  for (int k = 0; k < m_options.max_iterations; ++k) {
+  bool pending = false;  // converged in the sense of Alg. 1, to be confirmed
+  for (int k = 0; k <= m_options.max_iterations; ++k) {
     // 1. Contact operators at the previous iterate, from the surface rows only.
-    contact.assemble(contact.search(u_s), c, g);
+    pairing = contact.search_rows(u_s, &m_rows, k > 0 ? &pairing : nullptr);
+    contact.assemble(pairing, c, g);
+    // On the support rows R: A = (C_s Φ_s)_R (|R| x r) and b = (C_s u_off,s − g)_R,
+    // so that C_s u_s − g = A û + b there and zero elsewhere. O(|R| r).
+    for (int i = 0; i < nr; ++i) {
+      a_r.row(i).setZero();
+      b_r(i) = -g(m_rows[i]);
+      for (fom::ConstraintMatrix::InnerIterator it(c, m_rows[i]); it; ++it) {
+        a_r.row(i).noalias() += it.value() * m_phi_s_rm.row(it.col());
+        b_r(i) += it.value() * lift_s(it.col());
+      }
+    }
+    if (pending) {
+      // Alg. 1 found no change and a settled û^k, but judged û^k with the operators
+      // of û^{k−1}. Confirm at the pairing of û^k itself that no dictionary column
+      // is violated by more than τ (selected columns included), so the returned
+      // solution meets the reduced constraint at its own pairing; else go on.
+      v.noalias() = a_r * u_hat;
+      v += b_r;
+      violation.noalias() = m_dict_r.transpose() * v;
+      const double worst = m > 0 ? violation.maxCoeff() : 0.0;
+      if (m_options.trace) *m_options.trace << "greedy check at fresh pairing: max(violation)=" << worst << "\n";
+      if (worst <= m_threshold) {
+        res.converged = true;
+        break;
+      }
+      pending = false;
+    }
+    if (k == m_options.max_iterations) break;
     const int na = static_cast<int>(active.size());
     c_hat_i.resize(na, r);
     rhs.resize(na);
     for (int i = 0; i < na; ++i) {
-      // Row of Ĉ_I = D_Iᵀ C_s Φ_s and entry of ĝ_I = D_Iᵀ (g − C_s u_off,s),
-      // through y = C_sᵀ d_p (n_s): O(nnz(C) + n_s r) per selected column.
-      const auto d = dict.col(active[i]);
-      y.noalias() = c.transpose() * d;
-      c_hat_i.row(i).noalias() = y.transpose() * phi_s;
-      rhs(i) = d.dot(g) - y.dot(lift_s);
+      // Row of Ĉ_I = D_Iᵀ C_s Φ_s and entry of ĝ_I = D_Iᵀ (g − C_s u_off,s).
+      const auto d = m_dict_r.col(active[i]);
+      c_hat_i.row(i).noalias() = d.transpose() * a_r;
+      rhs(i) = -d.dot(b_r);
     }
 
     // 2. Saddle-point system by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ.
@@ -148,10 +185,11 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
       active.erase(active.begin() + remove);
       changed = true;
     } else {
-      // Ĉ û − ĝ for every column = D_dᵀ (C_s u_s − g) with the operators of step 1.
-      v.noalias() = c * u_s;
-      v -= g;
-      violation.noalias() = dict.transpose() * v;
+      // Ĉ û − ĝ for every column = D_dᵀ (C_s u_s − g) = D_Rᵀ (A û + b) with the
+      // operators of step 1.
+      v.noalias() = a_r * u_hat;
+      v += b_r;
+      violation.noalias() = m_dict_r.transpose() * v;
       int add = -1;
       if (m > 0) max_violation = violation.maxCoeff();
       if (m_options.best_iterate_on_failure && (!best_iterate.valid || max_violation < best_iterate.violation)) {
@@ -184,10 +222,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
         *m_options.trace << "no change";
       *m_options.trace << "\n";
     }
-    if (!changed && step <= m_options.step_tolerance * size) {
-      res.converged = true;
-      break;
-    }
+    if (!changed && step <= m_options.step_tolerance * size) pending = true;
   }
 
   if (!res.converged && res.status == Status::Success && best_iterate.valid) {

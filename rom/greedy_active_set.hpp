@@ -21,14 +21,20 @@
 ///     (entries ≤ τ count as zero; nothing is added if all are), else it removes the
 ///     most negative \f$ \hat\lambda_p \f$;
 ///  4. stops when nothing was added or removed and
-///     \f$ \|\hat u^k - \hat u^{k-1}\| \le \epsilon\,\|\hat u^k\| \f$ (ε = 1e-5), or
-///     after k_max = 50 iterations (converged = false; by default the best iterate
+///     \f$ \|\hat u^k - \hat u^{k-1}\| \le \epsilon\,\|\hat u^k\| \f$ (ε = 1e-5) and,
+///     beyond Alg. 1, the operators rebuilt at û^k itself confirm that no column
+///     (selected ones included) is violated by more than τ — otherwise iterating
+///     goes on with those operators, so a converged result meets the reduced
+///     constraint \f$ D_d^T (C(u) u - g(u)) \le \tau \f$ at its own pairing;
+///     or after k_max = 50 iterations (converged = false; by default the best iterate
 ///     with λ̂ ≥ 0 is then returned, see GreedyOptions::best_iterate_on_failure).
 /// Only Ĉ_I (|I| rows) is formed; the violation of all m columns is evaluated as
 /// \f$ D_d^T (C_s u_s - g) \f$, which equals \f$ \hat C\hat u - \hat g \f$. Every
 /// operation costs O(n_s r + n_c (r |I| + m) + r²|I|): nothing scales with the mesh
 /// beyond the contact surface. The returned (û, λ̂_I) solve the saddle-point system
-/// of the last iteration (with the I used there).
+/// of the last iteration (with the I used there). The contact search runs only for
+/// the rows where some dictionary column is non-zero (ReducedModel::dictionary_support):
+/// the other rows of C never enter Ĉ or the violation.
 #include <iosfwd>
 
 #include "rom/online_evaluation.hpp"
@@ -87,6 +93,9 @@ class GreedyActiveSet final : public OnlineSolver {
   const ReducedModel& m_model;
   Options m_options;
   double m_threshold = 0.0;
+  std::vector<int> m_rows;    // contact rows R where the dictionary is not zero
+  Eigen::MatrixXd m_dict_r;   // D_d restricted to R (|R| x m)
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m_phi_s_rm;  // Φ_s, row-major
 };
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,

@@ -70,6 +70,8 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
     m_dict.col(c) = db.dual.col(j);
     m_dict_params.push_back(db.parameter(j));
   }
+  for (int s = 0; s < nc; ++s)
+    if ((m_dict.row(s).array() != 0.0).any()) m_support.push_back(s);
   // The database stores u − u_lift; the reduced displacement is measured from the
   // offset: u − u_off = (u − u_lift) − Σ_k φ_k (L̃_k − L_k).
   if (options.lifting != LiftingKind::Dirichlet) {

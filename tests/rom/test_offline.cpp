@@ -37,17 +37,19 @@ const contactrom::fom::Problem& hertz() {
   return *p;
 }
 
-const std::string& work_dir() {
-  static const std::string dir = contactrom::test::temp_dir();
-  return dir;
-}
-
-struct Cleanup {
-  ~Cleanup() {
+/// A temporary folder for this test run, removed when the program ends.
+struct WorkDir {
+  std::string path = contactrom::test::temp_dir();
+  ~WorkDir() {
     std::error_code ec;
-    fs::remove_all(work_dir(), ec);
+    fs::remove_all(path, ec);
   }
-} cleanup;
+};
+
+const std::string& work_dir() {
+  static const WorkDir dir;
+  return dir.path;
+}
 
 }  // namespace
 
