@@ -112,6 +112,7 @@ class ReducedActiveSet : public rom::OnlineSolver {
 
   /// Dictionary columns forming W, in the order of W's columns.
   const std::vector<int>& dual_columns() const { return m_columns; }
+  int dual_basis_size() const override { return static_cast<int>(m_columns.size()); }
   /// W = D_d[:, dual_columns()] (n_c × |W|).
   const Eigen::MatrixXd& dual_basis() const { return m_w; }
   /// The threshold τ actually used (same units as \f$ W^T (Cu - g) \f$).

@@ -23,6 +23,7 @@ Registry& registry() {
   static Registry* r = [] {
     auto* reg = new Registry;  // never destroyed: registrars may outlive static destruction order
     reg->factories["greedy"] = [](const ReducedModel& model, const OnlineSolverOptions& options) {
+      check_extra_options(options, "greedy", {});
       return std::unique_ptr<OnlineSolver>(std::make_unique<GreedyActiveSet>(model, greedy_options(options)));
     };
     return reg;
@@ -42,6 +43,17 @@ void register_online_solver(const std::string& name, OnlineSolverFactory factory
   Registry& r = registry();
   std::lock_guard<std::mutex> lock(r.mutex);
   r.factories[name] = std::move(factory);
+}
+
+void check_extra_options(const OnlineSolverOptions& options, const std::string& method,
+                         const std::vector<std::string>& known) {
+  for (const auto& entry : options.extra) {
+    if (std::find(known.begin(), known.end(), entry.first) != known.end()) continue;
+    std::string list;
+    for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+    throw InputError("online method '" + method + "' has no option '" + entry.first + "'; it knows: " +
+                     (list.empty() ? "none" : list));
+  }
 }
 
 std::vector<std::string> online_solver_names() {
@@ -97,6 +109,7 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
   s.method = solver.name();
   s.delta = model.delta();
   s.dictionary_size = model.dictionary_size();
+  s.dual_basis_size = solver.dual_basis_size();
   s.primal_rank = model.primal_rank();
   std::vector<double> times;
   for (size_t i = 0; i < params.size(); ++i) {

@@ -64,6 +64,9 @@ class OnlineSolver {
   virtual const ReducedModel& model() const = 0;
   /// \brief Solves the reduced problem at μ (range-checked by the caller).
   virtual OnlineResult solve(const fom::Param& mu) const = 0;
+  /// Number of dual columns the method draws from (the whole dictionary unless the
+  /// method builds its own dual basis, e.g. CPG).
+  virtual int dual_basis_size() const { return model().dictionary_size(); }
 };
 
 /// \brief Settings shared by the online methods (each documents which it reads).
@@ -99,6 +102,11 @@ struct OnlineSolverRegistrar {
 
 /// \brief Registered method names, sorted.
 std::vector<std::string> online_solver_names();
+
+/// \brief Refuses method-specific settings (OnlineSolverOptions::extra) that `method`
+/// does not know. \throws InputError "online method 'm' has no option 'k'; it knows: ...".
+void check_extra_options(const OnlineSolverOptions& options, const std::string& method,
+                         const std::vector<std::string>& known);
 
 /// \brief Builds the solver registered as `name`.
 /// \throws InputError "unknown online method 'x'; expected one of: ..." for an unknown name.
@@ -137,6 +145,7 @@ struct EvaluationSummary {
   std::string method;
   double delta = 0.0;
   int dictionary_size = 0;
+  int dual_basis_size = 0;  ///< OnlineSolver::dual_basis_size()
   int primal_rank = 0;
   std::vector<EvaluationRow> rows;
   double mean_primal_error = 0.0, max_primal_error = 0.0;

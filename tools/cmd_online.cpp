@@ -1,6 +1,6 @@
 // contactrom online --db DB.h5 --method greedy [--delta D] [--tau T] [--validation] [--param V]
 //                   [--out FILE.csv|DIR] [--json] [--threads T] [--kkt] [--lifting harmonic|dirichlet]
-//                   [--tau-scaling absolute|relative] [--max-iterations K]
+//                   [--tau-scaling absolute|relative] [--max-iterations K] [--option KEY=VALUE]...
 // Builds the reduced model (POD basis with tolerance δ, dual dictionary) from a
 // snapshot database and evaluates an online method:
 //  - --validation (default without --param): at every validation parameter of the
@@ -32,6 +32,7 @@ struct OnlineArgs {
   double delta = 1e-8, tau = -1.0;
   int threads = 0, max_iterations = 50;
   bool validation = false, json = false, kkt = false;
+  std::vector<std::string> options;  // KEY=VALUE method settings
 };
 
 nlohmann::json selected_json(const std::vector<int>& selected) { return selected; }
@@ -59,6 +60,7 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
   j["param"] = param_json(mu);
   j["delta"] = model.delta();
   j["dictionary_size"] = model.dictionary_size();
+  j["dual_basis_size"] = solver.dual_basis_size();
   j["primal_rank"] = model.primal_rank();
   j["status"] = to_string(res.status);
   j["converged"] = res.converged;
@@ -104,6 +106,7 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
   j["method"] = s.method;
   j["delta"] = s.delta;
   j["dictionary_size"] = s.dictionary_size;
+  j["dual_basis_size"] = s.dual_basis_size;
   j["primal_rank"] = s.primal_rank;
   j["validation_size"] = s.rows.size();
   j["mean_primal_error"] = s.mean_primal_error;
@@ -124,7 +127,8 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
   }
   std::cout << "online " << s.method << " on " << problem.name() << " (" << db.training_kind << " "
             << db.training_size << "): " << s.rows.size() << " validation parameters\n"
-            << "dictionary " << s.dictionary_size << " columns, primal rank " << s.primal_rank << " (delta "
+            << "dictionary " << s.dictionary_size << " columns (dual basis " << s.dual_basis_size
+            << "), primal rank " << s.primal_rank << " (delta "
             << s.delta << ")\n"
             << std::setprecision(3) << std::left << std::setw(22) << "" << std::setw(12) << "mean" << "max\n"
             << std::setw(22) << "primal H1 error" << std::setw(12) << s.mean_primal_error << s.max_primal_error << "\n"
@@ -150,6 +154,12 @@ void run_online(const OnlineArgs& a) {
   options.tau = a.tau;
   options.tau_scaling = a.tau_scaling;
   options.max_iterations = a.max_iterations;
+  for (const std::string& kv : a.options) {
+    const size_t eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError("--option '" + kv + "' invalid; expected KEY=VALUE (e.g. cpg_tolerance=1e-2)");
+    options.extra[kv.substr(0, eq)] = kv.substr(eq + 1);
+  }
   // Validate the method name before the (more expensive) model construction.
   const std::vector<std::string> names = rom::online_solver_names();
   if (std::find(names.begin(), names.end(), a.method) == names.end()) {
@@ -184,6 +194,9 @@ CommandRegistrar reg("online", [](CLI::App& app) {
       ->check(CLI::IsMember({"harmonic", "dirichlet"}));
   sub->add_option("--max-iterations", args->max_iterations, "iteration cap k_max (default 50)")
       ->check(CLI::Range(1, 100000));
+  sub->add_option("--option", args->options,
+                  "method setting KEY=VALUE, repeatable: cpg_tolerance, cpg_max_size, inner_solve (cpg); "
+                  "inner_solve (full-dictionary); basis, rank_l, seed, ... (convex-hull; see docs/convex_hull.md)");
   sub->add_flag("--validation", args->validation, "evaluate on the validation set (default without --param)");
   sub->add_option("--param", args->param, "one query V or V1,V2");
   sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)");

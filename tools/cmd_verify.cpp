@@ -240,10 +240,15 @@ void run_verify(const VerifyArgs& a) {
   options.tau = a.tau;
   options.tau_scaling = a.tau_scaling;
   options.max_iterations = a.max_iterations;
-  if (a.cpg_tolerance >= 0.0) options.extra["cpg_tolerance"] = format_double(a.cpg_tolerance);
-  if (!a.inner_solve.empty()) options.extra["inner_solve"] = a.inner_solve;
+  // --cpg-tolerance concerns cpg, --inner-solve the reduced active sets (cpg,
+  // full-dictionary); each method gets only the settings it knows.
   std::vector<std::unique_ptr<rom::OnlineSolver>> solvers;
-  for (const std::string& m : methods) solvers.push_back(rom::make_online_solver(m, model, options));
+  for (const std::string& m : methods) {
+    rom::OnlineSolverOptions o = options;
+    if (m == "cpg" && a.cpg_tolerance >= 0.0) o.extra["cpg_tolerance"] = format_double(a.cpg_tolerance);
+    if ((m == "cpg" || m == "full-dictionary") && !a.inner_solve.empty()) o.extra["inner_solve"] = a.inner_solve;
+    solvers.push_back(rom::make_online_solver(m, model, o));
+  }
 
   const std::vector<fom::Param> params = subsample(rom::database_validation_set(db, *problem), a.limit);
   const int n = static_cast<int>(params.size());

@@ -145,7 +145,24 @@ BOOST_AUTO_TEST_CASE(online_runs_cpg_and_full_dictionary) {
       BOOST_TEST(j.contains(k), m << " misses " << k);
     BOOST_TEST(j["nonconverged"] == 0);
     BOOST_TEST(j["mean_primal_error"].get<double>() < 0.1);
+    // The dual basis: all columns for the full dictionary, a subset for CPG.
+    if (std::string(m) == "full-dictionary")
+      BOOST_TEST(j["dual_basis_size"] == j["dictionary_size"]);
+    else
+      BOOST_TEST(j["dual_basis_size"].get<int>() <= j["dictionary_size"].get<int>());
   }
+}
+
+BOOST_AUTO_TEST_CASE(online_option_reaches_the_method) {
+  // A looser CPG tolerance can only give a basis of at most the same size; cpg_max_size
+  // caps it exactly, so the option demonstrably reaches the method.
+  const std::string base = "online --db " + dbs().hertz + " --method cpg --validation --threads 2";
+  const json tight = run_json(base + " --option cpg_tolerance=1e-3");
+  const json loose = run_json(base + " --option cpg_tolerance=0.2");
+  const json capped = run_json(base + " --option cpg_max_size=2");
+  BOOST_TEST(loose["dual_basis_size"].get<int>() <= tight["dual_basis_size"].get<int>());
+  BOOST_TEST(loose["dual_basis_size"].get<int>() < tight["dual_basis_size"].get<int>());
+  BOOST_TEST(capped["dual_basis_size"] == 2);
 }
 
 BOOST_AUTO_TEST_CASE(bad_input_is_one_line_exit_2_and_no_file) {
@@ -157,6 +174,9 @@ BOOST_AUTO_TEST_CASE(bad_input_is_one_line_exit_2_and_no_file) {
       "verify --db " + dbs().hertz + " --method cpg --reference nosuch --out " + csv,
       "verify --db " + dbs().hertz + " --method cpg --cpg-tolerance 2 --out " + csv,
       "verify --db " + dbs().hertz + " --out " + csv,
+      "online --db " + dbs().hertz + " --method greedy --option foo=1 --out " + csv,
+      "online --db " + dbs().hertz + " --method cpg --option cpg_tolerance --out " + csv,
+      "online --db " + dbs().hertz + " --method cpg --option cpg_tolerance=x --out " + csv,
   };
   for (const std::string& c : cases) {
     const auto r = run_command(exe + " " + c);
