@@ -124,6 +124,8 @@ class ReducedActiveSet : public rom::OnlineSolver {
   const rom::ReducedModel& m_model;
   std::vector<int> m_columns;
   Eigen::MatrixXd m_w;
+  std::vector<int> m_rows;  // contact rows where W is not zero
+  Eigen::MatrixXd m_w_r;    // W restricted to m_rows
   Options m_options;
   double m_threshold = 0.0;
 };

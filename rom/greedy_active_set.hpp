@@ -95,7 +95,6 @@ class GreedyActiveSet final : public OnlineSolver {
   double m_threshold = 0.0;
   std::vector<int> m_rows;    // contact rows R where the dictionary is not zero
   Eigen::MatrixXd m_dict_r;   // D_d restricted to R (|R| x m)
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m_phi_s_rm;  // Φ_s, row-major
 };
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
