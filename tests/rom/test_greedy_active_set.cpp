@@ -143,6 +143,21 @@ BOOST_AUTO_TEST_CASE(hertz30_mean_primal_error_meets_paper_target, *boost::unit_
   BOOST_TEST(s.mean_primal_error <= 2e-3);
 }
 
+BOOST_AUTO_TEST_CASE(hertz30_mean_primal_error_inside_the_training_range) {
+  // The validation set of DESIGN §1 starts at d = 0.00375, below the first of the 30
+  // training parameters (d = 0.01): three queries extrapolate, with primal errors
+  // 0.02–0.12 that the POD space itself cannot do much better on. Over the 116
+  // validation points inside the training range the paper's target holds.
+  const rom::EvaluationSummary s = hertz().evaluate(30, 1e-10);
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& row : s.rows)
+    if (row.mu(0) >= 0.01) sum += row.primal_error, ++n;
+  BOOST_TEST(n == 116);
+  BOOST_TEST_MESSAGE("hertz 30, delta 1e-10: mean primal error inside the training range " << sum / n);
+  BOOST_TEST(sum / n <= 2e-3);
+}
+
 BOOST_AUTO_TEST_CASE(hertz_dual_error_falls_tenfold_from_12_to_120_snapshots) {
   const rom::EvaluationSummary s12 = hertz().evaluate(12, 1e-10);
   const rom::EvaluationSummary s120 = hertz().evaluate(120, 1e-10);
@@ -180,7 +195,7 @@ BOOST_AUTO_TEST_CASE(converged_solution_satisfies_reduced_kkt_conditions) {
       BOOST_TEST(!res.selected.empty());
       BOOST_TEST(res.coefficients.minCoeff() >= 0.0);  // λ̂ ≥ 0
       // Operators at the final iterate (they differ from the last iteration's by
-      // the step tolerance only).
+      // the step tolerance only; the greedy confirms the reduced constraint at them).
       const Eigen::VectorXd lift_s = model.surface_lifting(mu);
       const Eigen::VectorXd u_s = model.surface_basis() * res.u_hat + lift_s;
       fom::ConstraintMatrix c;
@@ -189,7 +204,7 @@ BOOST_AUTO_TEST_CASE(converged_solution_satisfies_reduced_kkt_conditions) {
       const Eigen::VectorXd violation = model.dictionary().transpose() * (c * u_s - g);
       const double scale = violation.cwiseAbs().maxCoeff();
       for (int p = 0; p < model.dictionary_size(); ++p)
-        BOOST_TEST(violation(p) <= greedy.threshold() + 1e-4 * scale, "column " << p);  // (Ĉû − ĝ) ≤ τ
+        BOOST_TEST(violation(p) <= greedy.threshold() + 1e-12 * scale, "column " << p);  // (Ĉû − ĝ) ≤ τ
       for (int p : res.selected) BOOST_TEST(std::abs(violation(p)) <= 1e-4 * scale);  // active: equality
       // Reduced equilibrium K̂û + Ĉ_Iᵀλ̂ = f̂.
       Eigen::VectorXd force = Eigen::VectorXd::Zero(model.primal_rank());
@@ -202,6 +217,34 @@ BOOST_AUTO_TEST_CASE(converged_solution_satisfies_reduced_kkt_conditions) {
       BOOST_TEST((res.lambda - model.reconstruct_dual(res.selected, res.coefficients)).norm() == 0.0);
       BOOST_TEST((res.u - model.basis() * res.u_hat - model.offset(mu)).norm() <= 1e-14 * res.u.norm());
     }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(reduced_constraint_holds_at_the_solutions_own_pairing) {
+  // Every converged query of the hertz-30 and ironing-129 validation sets:
+  // max_p D_pᵀ(C(u)u − g(u)) ≤ τ with the pairing searched at the returned u (not
+  // the one of the last iteration; issue #7 found 6/128 ironing violations before).
+  Setup ironing("ironing");
+  for (auto [setup, n] : {std::pair<Setup*, int>{&hertz(), 30}, std::pair<Setup*, int>{&ironing, 7}}) {
+    rom::ReducedModelOptions options;
+    options.delta = 1e-8;
+    const rom::ReducedModel model(*setup->problem, setup->db(n), options);
+    const rom::GreedyActiveSet greedy(model);
+    const fom::ContactModel& contact = setup->problem->contact();
+    const std::vector<fom::Param> params = setup->problem->validation_set(n);
+    int converged = 0;
+    for (const fom::Param& mu : params) {
+      const rom::OnlineResult res = greedy.solve(mu);
+      if (!res.converged) continue;
+      ++converged;
+      const Eigen::VectorXd u_s = contact.restrict_to_surface(res.u);
+      fom::ConstraintMatrix c;
+      Eigen::VectorXd g;
+      contact.assemble(contact.search(u_s), c, g);
+      const Eigen::VectorXd violation = model.dictionary().transpose() * (c * u_s - g);
+      BOOST_TEST(violation.maxCoeff() <= greedy.threshold() + 1e-10, setup->problem->name() << " mu = " << mu(0));
+    }
+    BOOST_TEST(converged == static_cast<int>(params.size()), setup->problem->name());
   }
 }
 
