@@ -182,7 +182,7 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
       const Eigen::VectorXd gap = c * x - g;
       for (int s = 0; s < nc; ++s) {
         const bool paired = !contact.has_pairing() || pairing.segment[s] >= 0;
-        if (paired && (all_rows || lambda(s) > 0.0 || gap(s) > -margin * contact.weights()(s) || h(s) > 0.0))
+        if (paired && (all_rows || lambda(s) > 0.0 || gap(s) > -margin * contact.weights()(s)))
           in_w[s] = 1, w_rows.push_back(s);
       }
     }

@@ -32,6 +32,7 @@ void run_fom(const FomArgs& a) {
     sol = solver.solve(mu);
   } else {
     baselines::IpoptQpSolver solver(*problem);
+    setup = solver.setup_time();
     sol = solver.solve(mu);
   }
   const fom::KktResiduals kkt = fom::kkt_residuals(*problem, mu, sol.u, sol.lambda);

@@ -3,9 +3,11 @@
 #define BOOST_TEST_MODULE fom_active_set_solver
 #include <Eigen/SparseCholesky>
 #include <boost/test/unit_test.hpp>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
+#include <tuple>
 
 #include "fom/active_set_solver.hpp"
 #include "fom/kkt.hpp"
@@ -183,4 +185,93 @@ BOOST_AUTO_TEST_CASE(parameter_outside_range_is_rejected) {
   BOOST_CHECK_THROW(s.solve(p1(0.31)), InputError);
   BOOST_CHECK_THROW(parse_param(s.problem(), "abc"), InputError);
   BOOST_CHECK_THROW(make_problem("nonsense"), InputError);
+}
+
+BOOST_AUTO_TEST_CASE(working_set_gives_the_all_rows_solution) {
+  // The dual QP on the working set (default) and on every row (margin < 0) are the
+  // same QP solution; so the pairing loops take the same path (up to round-off at
+  // the stopping tolerance) and the solutions agree, for a tiny margin too (the
+  // working set then grows by the penetration check).
+  for (const std::string name : {"hertz", "ironing", "rope"}) {
+    const Problem& problem = fixture().solver(name).problem();
+    ActiveSetOptions all_rows, tiny;
+    all_rows.working_set_margin = -1.0;
+    tiny.working_set_margin = 1e-9;
+    const ActiveSetSolver reference(problem, all_rows), small(problem, tiny);
+    const ActiveSetSolver& standard = fixture().solver(name);
+    const double lo = problem.param_lower()(0), hi = problem.param_upper()(0);
+    for (double t : {0.05, 0.5, 1.0}) {
+      const Param mu = p1(lo + t * (hi - lo));
+      const FomSolution a = reference.solve(mu);
+      BOOST_TEST_CONTEXT(name << " at " << mu(0)) {
+        BOOST_REQUIRE(a.status == Status::Success);
+        for (const ActiveSetSolver* s : {&standard, &small}) {
+          const FomSolution b = s->solve(mu);
+          BOOST_REQUIRE(b.status == Status::Success);
+          BOOST_TEST(std::abs(b.pairing_iterations - a.pairing_iterations) <= 1);
+          BOOST_TEST((b.u - a.u).norm() <= 1e-10 * a.u.norm());
+          BOOST_TEST((b.lambda - a.lambda).norm() <= 1e-9 * a.lambda.norm());
+        }
+      }
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(working_set_grows_to_rows_that_penetrate) {
+  // Warm-started from another parameter with a tiny margin, the first working set
+  // (rows active there or touching there) misses rows that penetrate at the new
+  // parameter. For `rope` (no pairing loop to catch them later) the penetration check
+  // after the QP must add them; for `hertz` either that or the pairing loop does.
+  for (const auto& [name, from, to] : {std::tuple<std::string, double, double>{"rope", 50.0, 10.0},
+                                       std::tuple<std::string, double, double>{"rope", 10.0, 50.0},
+                                       std::tuple<std::string, double, double>{"hertz", 0.1, 0.3}}) {
+    const Problem& problem = fixture().solver(name).problem();
+    ActiveSetOptions all_rows, tiny;
+    all_rows.working_set_margin = -1.0;
+    tiny.working_set_margin = 1e-9;
+    const ActiveSetSolver reference(problem, all_rows), small(problem, tiny);
+    const FomSolution warm = reference.solve(p1(from));
+    const FomSolution a = reference.solve(p1(to));
+    const FomSolution b = small.solve(p1(to), &warm);
+    BOOST_TEST_CONTEXT(name << " from " << from << " to " << to) {
+      BOOST_REQUIRE(b.status == Status::Success);
+      BOOST_TEST(b.active == a.active);
+      BOOST_TEST((b.u - a.u).norm() <= 1e-10 * a.u.norm());
+      BOOST_TEST((b.lambda - a.lambda).norm() <= 1e-9 * a.lambda.norm());
+      const KktResiduals k = kkt_residuals(problem, p1(to), b.u, b.lambda);
+      BOOST_TEST(k.penetration <= 1e-10);
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(row_subset_and_hint_do_not_change_the_search) {
+  // search_rows(u, rows, hint) pairs the listed rows exactly as search(u) does,
+  // whatever the hint (here: the pairing of a perturbed displacement).
+  const Problem& problem = fixture().solver("hertz").problem();
+  const ContactModel& contact = problem.contact();
+  const FomSolution sol = fixture().solver("hertz").solve(p1(0.2));
+  const Eigen::VectorXd base = contact.restrict_to_surface(sol.u);
+  std::vector<int> rows;
+  for (int k = 5; k < contact.num_constraints(); k += 3) rows.push_back(k);
+  unsigned state = 12345u;
+  auto noise = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return (static_cast<double>(state >> 8) / 16777216.0) - 0.5;
+  };
+  for (int trial = 0; trial < 200; ++trial) {
+    const double scale = std::pow(10.0, -1.0 - 4.0 * (trial % 50) / 50.0);
+    Eigen::VectorXd a = base, b = base;
+    for (Eigen::Index i = 0; i < a.size(); ++i) a(i) += scale * noise(), b(i) += scale * noise();
+    const Pairing hint = contact.search(a);
+    const Pairing full = contact.search(b);
+    const Pairing with_hint = contact.search_rows(b, nullptr, &hint);
+    const Pairing subset = contact.search_rows(b, &rows, &hint);
+    for (int k = 0; k < contact.num_constraints(); ++k) {
+      BOOST_TEST(with_hint.segment[k] == full.segment[k]);
+      BOOST_TEST(with_hint.xi[k] == full.xi[k]);
+      const bool listed = std::find(rows.begin(), rows.end(), k) != rows.end();
+      BOOST_TEST(subset.segment[k] == (listed ? full.segment[k] : -1));
+      if (listed) BOOST_TEST((subset.normal.col(k) - full.normal.col(k)).norm() == 0.0);
+    }
+  }
 }
