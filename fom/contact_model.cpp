@@ -66,7 +66,14 @@ NodeToSegmentContact::NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const 
 Pairing NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
                                           const Pairing* hint) const {
   const int ns = static_cast<int>(m_slave.size()), nm = static_cast<int>(m_master.size());
-  Eigen::Matrix2Xd xm = m_master_x;
+  // Per-thread scratch arrays: a search takes a few microseconds inside the online
+  // loops, where allocating them on every call would be a visible share.
+  thread_local struct {
+    Eigen::Matrix2Xd xm, node_normal, seg_t, mid, block_c;
+    Eigen::VectorXd inv_len2, half, block_r;
+  } scratch;
+  Eigen::Matrix2Xd& xm = scratch.xm;
+  xm = m_master_x;
   for (int j = 0; j < nm; ++j) xm.col(j) += u_surface.segment<2>(2 * (ns + j));
 
   // Nodal normals of the deformed master surface (average of the adjacent
@@ -74,9 +81,16 @@ Pairing NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, cons
   // normal field that is continuous across master nodes, so the constraint row
   // does not jump when a slave node passes from one segment to the next.
   const int nseg = std::max(nm - 1, 0);
-  Eigen::Matrix2Xd node_normal = Eigen::Matrix2Xd::Zero(2, nm);
-  Eigen::Matrix2Xd seg_t(2, nseg), mid(2, nseg);
-  Eigen::VectorXd inv_len2(nseg), half(nseg);
+  Eigen::Matrix2Xd& node_normal = scratch.node_normal;
+  Eigen::Matrix2Xd& seg_t = scratch.seg_t;
+  Eigen::Matrix2Xd& mid = scratch.mid;
+  Eigen::VectorXd& inv_len2 = scratch.inv_len2;
+  Eigen::VectorXd& half = scratch.half;
+  node_normal.setZero(2, nm);
+  seg_t.resize(2, nseg);
+  mid.resize(2, nseg);
+  inv_len2.resize(nseg);
+  half.resize(nseg);
   for (int j = 0; j < nseg; ++j) {
     const Eigen::Vector2d t = xm.col(j + 1) - xm.col(j);
     const double len = t.norm();
@@ -92,8 +106,10 @@ Pairing NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, cons
   // Bounding circles of blocks of m_block consecutive segments (centre, radius):
   // a block is skipped when its circle is farther than the best distance found.
   const int nblock = (nseg + m_block - 1) / m_block;
-  Eigen::Matrix2Xd block_c(2, nblock);
-  Eigen::VectorXd block_r(nblock);
+  Eigen::Matrix2Xd& block_c = scratch.block_c;
+  Eigen::VectorXd& block_r = scratch.block_r;
+  block_c.resize(2, nblock);
+  block_r.resize(nblock);
   for (int b = 0; b < nblock; ++b) {
     const int j0 = b * m_block, j1 = std::min(nseg, j0 + m_block);  // vertices j0..j1
     block_c.col(b) = xm.middleCols(j0, j1 - j0 + 1).rowwise().mean();
