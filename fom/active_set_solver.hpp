@@ -12,7 +12,12 @@
 ///     configuration) → \f$ C, g \f$ → Delassus \f$ G = C S C^T \f$,
 ///     \f$ h = C u_{0,s} - g \f$ → dual QP (DualQpSolver) →
 ///     \f$ u_s = u_{0,s} - S C^T\lambda \f$ } until re-pairing no longer changes the KKT system;
-///     then \f$ u = u_0 - Z_s C^T \lambda \f$.
+///     then \f$ u = u_0 - Z_s C^T \lambda \f$ (over the non-zero entries of Cᵀλ).
+///     The dual QP runs on a working set W of rows (active, or within
+///     working_set_margin·U of contact at the current iterate): G_W = C_W S C_Wᵀ,
+///     then rows outside W that penetrate join W and the QP is solved again, so λ
+///     is the QP solution of all rows at a cost set by |W|. The pairing fixed point is
+///     Anderson-accelerated; each search is seeded by the previous pairing.
 /// solve() is const and thread-safe (no factorisation state is touched per query
 /// when the stiffness is parameter-independent).
 #include <Eigen/Dense>
