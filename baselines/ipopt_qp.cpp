@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "fom/anderson.hpp"
 #include "fom/kkt.hpp"
 
 namespace contactrom::baselines {
@@ -228,40 +229,6 @@ Status map_status(Ipopt::ApplicationReturnStatus s, double nlp_error, double acc
   }
 }
 
-/// \brief Anderson acceleration (type II, Walker & Ni 2011, "Anderson acceleration for
-/// fixed-point iterations") of x = F(x), with a restart when the residual grows: the
-/// scheme of fom::ActiveSetSolver's pairing loop. The QP is always solved exactly; the
-/// extrapolated x only chooses the next pairing.
-class AndersonMixer {
- public:
-  explicit AndersonMixer(int depth) : m_depth(std::max(depth, 0)) {}
-
-  /// \returns the next iterate given the current one and its image f = F(x).
-  Eigen::VectorXd next(const Eigen::VectorXd& x, const Eigen::VectorXd& f) {
-    const Eigen::VectorXd r = f - x;
-    if (m_started) {
-      if (r.norm() > m_r_prev.norm()) m_df.clear(), m_dr.clear();
-      m_df.push_back(f - m_f_prev);
-      m_dr.push_back(r - m_r_prev);
-      if (static_cast<int>(m_df.size()) > m_depth) m_df.erase(m_df.begin()), m_dr.erase(m_dr.begin());
-    }
-    m_started = true;
-    m_f_prev = f;
-    m_r_prev = r;
-    if (m_dr.empty()) return f;
-    Eigen::MatrixXd dr(r.size(), m_dr.size()), df(r.size(), m_df.size());
-    for (size_t k = 0; k < m_dr.size(); ++k) dr.col(k) = m_dr[k], df.col(k) = m_df[k];
-    const Eigen::VectorXd gamma = dr.colPivHouseholderQr().solve(r);
-    return gamma.allFinite() ? Eigen::VectorXd(f - df * gamma) : f;
-  }
-
- private:
-  int m_depth;
-  bool m_started = false;
-  Eigen::VectorXd m_f_prev, m_r_prev;
-  std::vector<Eigen::VectorXd> m_df, m_dr;
-};
-
 /// Ipopt 3.11 with the sequential MUMPS build is not known to be re-entrant (MUMPS'
 /// fake MPI layer keeps global state), so concurrent solves are serialised.
 std::mutex& ipopt_mutex() {
@@ -406,7 +373,9 @@ FomSolution IpoptQpSolver::solve(const Param& mu, const FomSolution* warm) const
   if (warm_fits) sol.lambda = warm->lambda;
   bool have_multipliers = warm_fits;
   Eigen::VectorXd gap = Eigen::VectorXd::Constant(nc, std::numeric_limits<double>::infinity());
-  AndersonMixer mixer(opt.anderson_depth);
+  // Anderson-accelerated pairing fixed point, as in fom::ActiveSetSolver: the QP is
+  // always solved exactly; the extrapolated x only chooses the next pairing.
+  fom::AndersonMixer mixer(opt.anderson_depth);
 
   bool converged = false;
   for (int it = 0; it < opt.max_pairing_iterations; ++it) {

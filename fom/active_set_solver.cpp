@@ -3,6 +3,8 @@
 #include <Eigen/CholmodSupport>
 #include <chrono>
 
+#include "fom/anderson.hpp"
+
 namespace contactrom::fom {
 namespace {
 
@@ -166,8 +168,7 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
   // QP for that pairing, F(x) = resulting surface displacement. Anderson
   // acceleration (Walker & Ni 2011, type II) on x; the QP is always solved exactly,
   // so the extrapolated x only chooses the pairing.
-  Eigen::VectorXd f_prev, r_prev;
-  std::vector<Eigen::VectorXd> d_f, d_r;
+  AndersonMixer mixer(m_options.anderson_depth);
   for (int it = 0; it < m_options.max_pairing_iterations; ++it) {
     ++sol.pairing_iterations;
     contact.assemble(pairing, c, g);
@@ -243,31 +244,7 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
       converged = true;
       break;
     }
-    const Eigen::VectorXd r = f - x;
-    if (it > 0) {
-      if (r.norm() > r_prev.norm()) d_f.clear(), d_r.clear();  // restart on growth
-      d_f.push_back(f - f_prev);
-      d_r.push_back(r - r_prev);
-      if (static_cast<int>(d_f.size()) > m_options.anderson_depth) d_f.erase(d_f.begin()), d_r.erase(d_r.begin());
-    }
-    f_prev = f;
-    r_prev = r;
-    x = f;
-    if (!d_r.empty() && m_options.anderson_depth > 0) {
-      // Least-squares γ = argmin |r − ΔR γ| by the normal equations (m ≤ depth
-      // columns; a rank-revealing LDLᵀ drops dependent differences).
-      const int m = static_cast<int>(d_r.size());
-      Eigen::MatrixXd gram(m, m);
-      Eigen::VectorXd rhs(m);
-      for (int a = 0; a < m; ++a) {
-        rhs(a) = d_r[a].dot(r);
-        for (int b = 0; b <= a; ++b) gram(a, b) = gram(b, a) = d_r[a].dot(d_r[b]);
-      }
-      const Eigen::LDLT<Eigen::MatrixXd> ldlt(gram);
-      const Eigen::VectorXd gamma = ldlt.solve(rhs);
-      if (ldlt.info() == Eigen::Success && gamma.allFinite())
-        for (int a = 0; a < m; ++a) x.noalias() -= gamma(a) * d_f[a];
-    }
+    x = mixer.next(x, f);
     pairing = contact.search_rows(x, nullptr, &next);
   }
   if (!converged && sol.status == Status::Success) {
