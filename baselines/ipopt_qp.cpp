@@ -49,17 +49,8 @@ struct FreeStiffness {
 
 std::unique_ptr<FreeStiffness> extract_free_stiffness(const SparseMatrix& k, const std::vector<int>& free,
                                                      const std::vector<int>& free_index, bool factorise) {
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(k.nonZeros());
-  for (int col = 0; col < k.outerSize(); ++col) {
-    if (free_index[col] < 0) continue;
-    for (SparseMatrix::InnerIterator it(k, col); it; ++it)
-      if (free_index[it.row()] >= 0) trip.emplace_back(free_index[it.row()], free_index[col], it.value());
-  }
-  const int nf = static_cast<int>(free.size());
   auto out = std::make_unique<FreeStiffness>();
-  out->kff.resize(nf, nf);
-  out->kff.setFromTriplets(trip.begin(), trip.end());
+  out->kff = fom::free_block(k, free_index, static_cast<int>(free.size()));
   for (int col = 0; col < out->kff.outerSize(); ++col)
     for (SparseMatrix::InnerIterator it(out->kff, col); it; ++it)
       if (it.row() >= col) {

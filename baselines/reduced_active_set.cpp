@@ -46,10 +46,7 @@ ReducedActiveSet::ReducedActiveSet(std::string name, const rom::ReducedModel& mo
   m_w.resize(model.dictionary().rows(), static_cast<Eigen::Index>(m_columns.size()));
   for (size_t i = 0; i < m_columns.size(); ++i) m_w.col(static_cast<Eigen::Index>(i)) = model.dictionary().col(m_columns[i]);
   // Support rows of W, as in the greedy: only they enter Ĉ and the violation.
-  for (Eigen::Index s = 0; s < m_w.rows(); ++s)
-    if ((m_w.row(s).array() != 0.0).any()) m_rows.push_back(static_cast<int>(s));
-  m_w_r.resize(static_cast<Eigen::Index>(m_rows.size()), m_w.cols());
-  for (size_t i = 0; i < m_rows.size(); ++i) m_w_r.row(static_cast<Eigen::Index>(i)) = m_w.row(m_rows[i]);
+  m_support = rom::SupportRows(m_w);
   if (options.max_iterations < 1)
     throw InputError("max iterations " + std::to_string(options.max_iterations) + " invalid; expected >= 1");
   // τ exactly as the greedy applies it (same default, same relative scale), so the
@@ -111,15 +108,9 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
     //    column, Ĉû − ĝ = Wᵀ(C_s u_s − g).
     u_s.noalias() = phi_s * u_hat;
     u_s += lift_s;
-    pairing = contact.search_rows(u_s, &m_rows, k > 0 ? &pairing : nullptr);
+    pairing = contact.search_rows(u_s, &m_support.rows, k > 0 ? &pairing : nullptr);
     contact.assemble(pairing, c, g);
-    v.resize(static_cast<Eigen::Index>(m_rows.size()));
-    for (size_t i = 0; i < m_rows.size(); ++i) {
-      double acc = -g(m_rows[i]);
-      for (fom::ConstraintMatrix::InnerIterator it(c, m_rows[i]); it; ++it) acc += it.value() * u_s(it.col());
-      v(static_cast<Eigen::Index>(i)) = acc;
-    }
-    violation.noalias() = m_w_r.transpose() * v;
+    m_support.violation(c, g, u_s, v, violation);
 
     // 2. Primal–dual update: drop the columns whose multiplier left the cone, add every
     //    violated column. With the non-negative inner solve a zero multiplier on a

@@ -58,6 +58,7 @@
 #include "rom/nnls.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
+#include "rom/support_rows.hpp"
 
 namespace contactrom::baselines {
 
@@ -124,8 +125,7 @@ class ReducedActiveSet : public rom::OnlineSolver {
   const rom::ReducedModel& m_model;
   std::vector<int> m_columns;
   Eigen::MatrixXd m_w;
-  std::vector<int> m_rows;  // contact rows where W is not zero
-  Eigen::MatrixXd m_w_r;    // W restricted to m_rows
+  rom::SupportRows m_support;  // contact rows where W is not zero, W on them
   Options m_options;
   double m_threshold = 0.0;
 };

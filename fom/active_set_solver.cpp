@@ -12,20 +12,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-SparseMatrix free_block(const SparseMatrix& k, const std::vector<int>& free, const std::vector<int>& free_index) {
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(k.nonZeros());
-  for (int col = 0; col < k.outerSize(); ++col) {
-    if (free_index[col] < 0) continue;
-    for (SparseMatrix::InnerIterator it(k, col); it; ++it)
-      if (free_index[it.row()] >= 0) trip.emplace_back(free_index[it.row()], free_index[col], it.value());
-  }
-  const int n = static_cast<int>(free.size());
-  SparseMatrix kff(n, n);
-  kff.setFromTriplets(trip.begin(), trip.end());
-  return kff;
-}
-
 /// S C_Wᵀ (n_s x |W|) for the constraint rows W: column a is the sum of the
 /// columns of the symmetric S picked by row W[a]'s (at most six) entries.
 void delassus_parts(const ConstraintMatrix& c, const std::vector<int>& rows, const Eigen::MatrixXd& s,
@@ -75,7 +61,7 @@ bool condense(const Problem& problem, const Param& mu, Condensation& out) {
   std::vector<int> free_index(n, -1);
   for (int i = 0; i < nf; ++i) free_index[free[i]] = i;
   const SparseMatrix k = problem.stiffness(mu);
-  Eigen::CholmodSupernodalLLT<SparseMatrix> llt(free_block(k, free, free_index));
+  Eigen::CholmodSupernodalLLT<SparseMatrix> llt(free_block(k, free_index, nf));
   if (llt.info() != Eigen::Success) return false;
 
   const std::vector<int>& surf = problem.contact().surface_dofs();

@@ -290,6 +290,19 @@ Eigen::VectorXd Problem::rhs(const Param& mu) const {
   return f;
 }
 
+SparseMatrix free_block(const SparseMatrix& k, const std::vector<int>& free_index, int num_free) {
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(k.nonZeros());
+  for (int col = 0; col < k.outerSize(); ++col) {
+    if (free_index[col] < 0) continue;
+    for (SparseMatrix::InnerIterator it(k, col); it; ++it)
+      if (free_index[it.row()] >= 0) trip.emplace_back(free_index[it.row()], free_index[col], it.value());
+  }
+  SparseMatrix kff(num_free, num_free);
+  kff.setFromTriplets(trip.begin(), trip.end());
+  return kff;
+}
+
 const std::vector<std::string>& problem_names() {
   static const std::vector<std::string> names = {"rope", "hertz", "ironing", "ironing2"};
   return names;

@@ -122,6 +122,11 @@ class Problem {
   double m_u_scale = 1.0;
 };
 
+/// \brief The free-dof block K_ff of a matrix on all dofs (Dirichlet rows and columns
+/// dropped). \param free_index position of each dof among the free dofs (−1: Dirichlet)
+/// \param num_free number of free dofs
+SparseMatrix free_block(const SparseMatrix& k, const std::vector<int>& free_index, int num_free);
+
 /// Names accepted by make_problem, for help texts and error messages.
 const std::vector<std::string>& problem_names();
 

@@ -28,10 +28,7 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
 }
 
 GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& options)
-    : m_model(model), m_options(options) {
-  m_rows = model.dictionary_support();
-  m_dict_r.resize(static_cast<Eigen::Index>(m_rows.size()), model.dictionary_size());
-  for (size_t i = 0; i < m_rows.size(); ++i) m_dict_r.row(i) = model.dictionary().row(m_rows[i]);
+    : m_model(model), m_options(options), m_support(model.dictionary()) {
   const double tau = options.tau < 0.0 ? model.delta() : options.tau;
   m_threshold = tau;
   if (options.tau_scaling == TauScaling::Relative) {
@@ -84,8 +81,6 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
 
   Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, g, y, v, violation, rhs;
   Eigen::MatrixXd c_hat_i, w, schur;
-  const int nr = static_cast<int>(m_rows.size());
-  v.resize(nr);
   fom::ConstraintMatrix c;
   fom::Pairing pairing;
   std::vector<int> active, solved;
@@ -105,24 +100,14 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   bool pending = false;  // converged in the sense of Alg. 1, to be confirmed
   for (int k = 0; k <= m_options.max_iterations; ++k) {
     // 1. Contact operators at the previous iterate, from the surface rows only.
-    pairing = contact.search_rows(u_s, &m_rows, k > 0 ? &pairing : nullptr);
+    pairing = contact.search_rows(u_s, &m_support.rows, k > 0 ? &pairing : nullptr);
     contact.assemble(pairing, c, g);
-    // C_s u_s − g on the support rows R (zero elsewhere): the violation of every
-    // column is D_Rᵀ of it, O(|R| (6 + m)).
-    auto support_gap = [&] {
-      for (int i = 0; i < nr; ++i) {
-        double acc = -g(m_rows[i]);
-        for (fom::ConstraintMatrix::InnerIterator it(c, m_rows[i]); it; ++it) acc += it.value() * u_s(it.col());
-        v(i) = acc;
-      }
-    };
     if (pending) {
       // Alg. 1 found no change and a settled û^k, but judged û^k with the operators
       // of û^{k−1}. Confirm at the pairing of û^k itself that no dictionary column
       // is violated by more than τ (selected columns included), so the returned
       // solution meets the reduced constraint at its own pairing; else go on.
-      support_gap();
-      violation.noalias() = m_dict_r.transpose() * v;
+      m_support.violation(c, g, u_s, v, violation);
       const double worst = m > 0 ? violation.maxCoeff() : 0.0;
       if (m_options.trace) *m_options.trace << "greedy check at fresh pairing: max(violation)=" << worst << "\n";
       if (worst <= m_threshold) {
@@ -183,10 +168,9 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
       active.erase(active.begin() + remove);
       changed = true;
     } else {
-      // Ĉ û − ĝ for every column = D_dᵀ (C_s u_s − g) = D_Rᵀ (C_s u_s − g)_R with
+      // Ĉ û − ĝ for every column = D_dᵀ (C_s u_s − g), from the support rows, with
       // the operators of step 1.
-      support_gap();
-      violation.noalias() = m_dict_r.transpose() * v;
+      m_support.violation(c, g, u_s, v, violation);
       int add = -1;
       if (m > 0) max_violation = violation.maxCoeff();
       if (m_options.best_iterate_on_failure && (!best_iterate.valid || max_violation < best_iterate.violation)) {

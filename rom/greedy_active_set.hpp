@@ -33,12 +33,13 @@
 /// operation costs O(n_s r + n_c (r |I| + m) + r²|I|): nothing scales with the mesh
 /// beyond the contact surface. The returned (û, λ̂_I) solve the saddle-point system
 /// of the last iteration (with the I used there). The contact search runs only for
-/// the rows where some dictionary column is non-zero (ReducedModel::dictionary_support):
+/// the rows where some dictionary column is non-zero (SupportRows of D_d):
 /// the other rows of C never enter Ĉ or the violation.
 #include <iosfwd>
 
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
+#include "rom/support_rows.hpp"
 
 namespace contactrom::rom {
 
@@ -93,8 +94,7 @@ class GreedyActiveSet final : public OnlineSolver {
   const ReducedModel& m_model;
   Options m_options;
   double m_threshold = 0.0;
-  std::vector<int> m_rows;    // contact rows R where the dictionary is not zero
-  Eigen::MatrixXd m_dict_r;   // D_d restricted to R (|R| x m)
+  SupportRows m_support;  // contact rows R where D_d is not zero, D_d restricted to R
 };
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,

@@ -16,15 +16,7 @@ std::vector<Eigen::VectorXd> harmonic_offsets(const fom::Problem& problem) {
   const int n = problem.num_dofs(), nf = static_cast<int>(free.size());
   std::vector<int> index(n, -1);
   for (int i = 0; i < nf; ++i) index[free[i]] = i;
-  std::vector<Eigen::Triplet<double>> trip;
-  for (int col = 0; col < k.outerSize(); ++col) {
-    if (index[col] < 0) continue;
-    for (fom::SparseMatrix::InnerIterator it(k, col); it; ++it)
-      if (index[it.row()] >= 0) trip.emplace_back(index[it.row()], index[col], it.value());
-  }
-  fom::SparseMatrix kff(nf, nf);
-  kff.setFromTriplets(trip.begin(), trip.end());
-  Eigen::SimplicialLDLT<fom::SparseMatrix> ldlt(kff);
+  Eigen::SimplicialLDLT<fom::SparseMatrix> ldlt(fom::free_block(k, index, nf));
   if (ldlt.info() != Eigen::Success)
     throw InputError("stiffness of '" + problem.name() + "' is singular on the free dofs; cannot build the lifting");
   std::vector<Eigen::VectorXd> out;
@@ -70,8 +62,6 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
     m_dict.col(c) = db.dual.col(j);
     m_dict_params.push_back(db.parameter(j));
   }
-  for (int s = 0; s < nc; ++s)
-    if ((m_dict.row(s).array() != 0.0).any()) m_support.push_back(s);
   // The database stores u − u_lift; the reduced displacement is measured from the
   // offset: u − u_off = (u − u_lift) − Σ_k φ_k (L̃_k − L_k).
   if (options.lifting != LiftingKind::Dirichlet) {

@@ -77,9 +77,6 @@ class ReducedModel {
   const Eigen::MatrixXd& surface_basis() const { return m_phi_s; }
   /// Dual dictionary D_d (n_c × m).
   const Eigen::MatrixXd& dictionary() const { return m_dict; }
-  /// Contact rows where some dictionary column is non-zero (ascending). Rows
-  /// outside it never carry a reduced pressure, so their contact search can be skipped.
-  const std::vector<int>& dictionary_support() const { return m_support; }
   /// Database snapshot index of each dictionary column.
   const std::vector<int>& dictionary_snapshots() const { return m_dict_snapshots; }
   /// Parameter of each dictionary column.
@@ -121,7 +118,7 @@ class ReducedModel {
   ReducedModelOptions m_options;
   Eigen::MatrixXd m_primal, m_phi, m_phi_s, m_dict, m_lift_s;
   Eigen::VectorXd m_sigma;
-  std::vector<int> m_dict_snapshots, m_support;
+  std::vector<int> m_dict_snapshots;
   std::vector<fom::Param> m_dict_params;
   std::vector<Eigen::VectorXd> m_offset;  // L̃_k
   std::vector<Eigen::MatrixXd> m_k_hat;   // Φᵀ K_q Φ
