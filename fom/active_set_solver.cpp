@@ -163,16 +163,18 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
     // within the margin of contact. The QP is solved on W; rows outside W are
     // then checked at the solution and the violated ones join W (repeat), so
     // λ solves the QP of all rows while the Delassus matrix is only |W| x |W|.
+    auto paired = [&](int s) { return !contact.has_pairing() || pairing.segment[s] >= 0; };
     std::vector<char> in_w(nc, 0);
     std::vector<int> w_rows;
     {
       const Eigen::VectorXd gap = c * x - g;
-      for (int s = 0; s < nc; ++s) {
-        const bool paired = !contact.has_pairing() || pairing.segment[s] >= 0;
-        if (paired && (all_rows || lambda(s) > 0.0 || gap(s) > -margin * contact.weights()(s)))
+      for (int s = 0; s < nc; ++s)
+        if (paired(s) && (all_rows || lambda(s) > 0.0 || gap(s) > -margin * contact.weights()(s)))
           in_w[s] = 1, w_rows.push_back(s);
-      }
     }
+    // Rows outside W must not penetrate at the QP's solution, to the QP's tolerance
+    // (relative to |h|∞; W's part of h is no larger).
+    const double tol = m_options.qp.relative_tolerance * (nc > 0 ? h.cwiseAbs().maxCoeff() : 0.0);
     Eigen::VectorXd lambda_w, f;
     bool qp_ok = true;
     for (;;) {
@@ -192,15 +194,10 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
         break;
       }
       f = u0_s - sct * lambda_w;
-      // Rows outside W must not penetrate at f (same tolerance as the QP's).
-      const double tol = m_options.qp.relative_tolerance * std::max(h_w.size() ? h_w.cwiseAbs().maxCoeff() : 0.0,
-                                                                    h.cwiseAbs().maxCoeff());
       const Eigen::VectorXd v = c * f - g;
       bool grown = false;
-      for (int s = 0; s < nc; ++s) {
-        const bool paired = !contact.has_pairing() || pairing.segment[s] >= 0;
-        if (!in_w[s] && paired && v(s) > tol) in_w[s] = 1, grown = true;
-      }
+      for (int s = 0; s < nc; ++s)
+        if (!in_w[s] && paired(s) && v(s) > tol) in_w[s] = 1, grown = true;
       if (!grown) break;
       for (int a = 0; a < nw; ++a) lambda(w_rows[a]) = lambda_w(a);
       w_rows.clear();
