@@ -54,7 +54,7 @@ ReducedActiveSet::ReducedActiveSet(std::string name, const rom::ReducedModel& mo
   rom::GreedyOptions g;
   g.tau = options.tau;
   g.tau_scaling = options.tau_scaling;
-  m_threshold = rom::GreedyActiveSet(model, g).threshold();
+  m_threshold = rom::greedy_threshold(model, g);
 }
 
 rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {

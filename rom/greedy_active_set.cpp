@@ -27,20 +27,21 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
   return g;
 }
 
-GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& options)
-    : m_model(model), m_options(options), m_support(model.dictionary()) {
+double greedy_threshold(const ReducedModel& model, const GreedyOptions& options) {
   const double tau = options.tau < 0.0 ? model.delta() : options.tau;
-  m_threshold = tau;
-  if (options.tau_scaling == TauScaling::Relative) {
-    // Scale of D_dᵀ(Cu − g): the work of the largest dictionary force
-    // Σ_s w_s |D[s,p]| through a gap of one displacement scale U.
-    const Eigen::VectorXd& w = model.problem().contact().weights();
-    double force = 0.0;
-    for (int p = 0; p < model.dictionary_size(); ++p)
-      force = std::max(force, w.dot(model.dictionary().col(p).cwiseAbs()));
-    m_threshold = tau * model.problem().displacement_scale() * force;
-  }
+  if (options.tau_scaling != TauScaling::Relative) return tau;
+  // Scale of D_dᵀ(Cu − g): the work of the largest dictionary force
+  // Σ_s w_s |D[s,p]| through a gap of one displacement scale U.
+  const Eigen::VectorXd& w = model.problem().contact().weights();
+  double force = 0.0;
+  for (int p = 0; p < model.dictionary_size(); ++p)
+    force = std::max(force, w.dot(model.dictionary().col(p).cwiseAbs()));
+  return tau * model.problem().displacement_scale() * force;
 }
+
+GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& options)
+    : m_model(model), m_options(options), m_threshold(greedy_threshold(model, options)),
+      m_support(model.dictionary()) {}
 
 OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   using clock = std::chrono::steady_clock;

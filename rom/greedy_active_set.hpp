@@ -97,6 +97,10 @@ class GreedyActiveSet final : public OnlineSolver {
   SupportRows m_support;  // contact rows R where D_d is not zero, D_d restricted to R
 };
 
+/// \brief The threshold τ that GreedyActiveSet applies with `options` (defaulted to δ
+/// and scaled per TauScaling), in the units of \f$ D_d^T (Cu - g) \f$.
+double greedy_threshold(const ReducedModel& model, const GreedyOptions& options);
+
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
 /// step_tolerance) into GreedyOptions. \throws InputError for an unknown tau_scaling.
 GreedyOptions greedy_options(const OnlineSolverOptions& options);
