@@ -7,7 +7,27 @@
 #include <cmath>
 #include <ostream>
 
+#include "fom/anderson.hpp"
+
 namespace contactrom::rom {
+
+namespace {
+
+int parse_int_option(const std::string& key, const std::string& value, int minimum) {
+  size_t used = 0;
+  int v = 0;
+  try {
+    v = std::stoi(value, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != value.size() || v < minimum)
+    throw InputError("greedy option " + key + "='" + value + "' invalid; expected an integer >= " +
+                     std::to_string(minimum));
+  return v;
+}
+
+}  // namespace
 
 GreedyOptions greedy_options(const OnlineSolverOptions& options) {
   GreedyOptions g;
@@ -24,6 +44,20 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
     throw InputError("step tolerance " + std::to_string(options.step_tolerance) + " invalid; expected >= 0");
   g.max_iterations = options.max_iterations;
   g.step_tolerance = options.step_tolerance;
+  for (const auto& [key, value] : options.extra) {
+    if (key == "schedule") {
+      if (value == "interleaved")
+        g.schedule = GreedySchedule::Interleaved;
+      else if (value == "nested")
+        g.schedule = GreedySchedule::Nested;
+      else
+        throw InputError("greedy schedule '" + value + "' unknown; expected interleaved or nested");
+    } else if (key == "anderson_depth") {
+      g.anderson_depth = parse_int_option(key, value, 0);
+    } else if (key == "max_solves") {
+      g.max_solves = parse_int_option(key, value, 1);
+    }
+  }
   return g;
 }
 
@@ -41,32 +75,69 @@ double greedy_threshold(const ReducedModel& model, const GreedyOptions& options)
 
 GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& options)
     : m_model(model), m_options(options), m_threshold(greedy_threshold(model, options)),
-      m_support(model.dictionary()) {}
+      m_support(model.dictionary()), m_phi_s_rows(model.surface_basis()) {}
+
+/// Per-query quantities shared by both schedules.
+struct GreedyActiveSet::Query {
+  const Eigen::LLT<Eigen::MatrixXd>* llt = nullptr;  // factor of K̂ (or of K̂₀, scaled by inv_theta)
+  double inv_theta = 1.0;
+  Eigen::VectorXd lift_s;  // surface lifting u_off,s(μ)
+  Eigen::VectorXd u_free;  // unconstrained reduced solution K̂⁻¹ f̂
+  // Outcome, filled by the schedule: final û, the selection and its multipliers.
+  Eigen::VectorXd u_hat, lambda_i;
+  std::vector<int> selected;
+  bool best_iterate_returned = false;  // not converged: the best iterate replaced the last one
+
+  /// Best iterate with λ̂ ≥ 0 so far (smallest largest violation), for the iteration cap.
+  struct {
+    bool valid = false;
+    double violation = 0.0;
+    Eigen::VectorXd u_hat, lambda_i;
+    std::vector<int> selected;
+  } best;
+  void offer(double max_violation, const Eigen::VectorXd& u, const Eigen::VectorXd& l, const std::vector<int>& s) {
+    if (best.valid && max_violation >= best.violation) return;
+    best.valid = true;
+    best.violation = max_violation;
+    best.u_hat = u;
+    best.lambda_i = l;
+    best.selected = s;
+  }
+  /// Stores the outcome: the last iterate, or the best one when `use_best` and one exists.
+  void finish(bool use_best, Eigen::VectorXd& u, Eigen::VectorXd& l, std::vector<int>& s) {
+    if (use_best && best.valid) {
+      u.swap(best.u_hat);
+      l.swap(best.lambda_i);
+      s.swap(best.selected);
+      best_iterate_returned = true;
+    }
+    u_hat = std::move(u);
+    lambda_i = std::move(l);
+    selected = std::move(s);
+  }
+};
 
 OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   const fom::Problem& problem = m_model.problem();
-  const fom::ContactModel& contact = problem.contact();
-  const Eigen::MatrixXd& phi_s = m_model.surface_basis();
-  const Eigen::MatrixXd& dict = m_model.dictionary();
-  const int r = m_model.primal_rank(), m = m_model.dictionary_size(), nc = static_cast<int>(dict.rows());
+  const int r = m_model.primal_rank(), nc = static_cast<int>(m_model.dictionary().rows());
 
   OnlineResult res;
   res.mu = mu;
 
   // K̂(μ)⁻¹ through the offline Cholesky factor when K̂(μ) = θ₀(μ) K̂₀, else a
   // per-query factorisation of the r × r matrix.
+  Query q;
   Eigen::LLT<Eigen::MatrixXd> local;
-  const Eigen::LLT<Eigen::MatrixXd>* llt = m_model.single_term_factor();
-  double inv_theta = 1.0;
-  if (llt) {
-    inv_theta = 1.0 / problem.stiffness_coefficients(mu)(0);
+  q.llt = m_model.single_term_factor();
+  if (q.llt) {
+    q.inv_theta = 1.0 / problem.stiffness_coefficients(mu)(0);
   } else {
     local.compute(m_model.reduced_stiffness(mu));
-    llt = &local;
+    q.llt = &local;
   }
-  if (llt->info() != Eigen::Success || !std::isfinite(inv_theta)) {
+  if (q.llt->info() != Eigen::Success || !std::isfinite(q.inv_theta)) {
     res.status = Status::NumericalIssue;
     res.message = "Cholesky factorisation of the reduced stiffness failed";
     res.u_hat = Eigen::VectorXd::Zero(r);
@@ -75,10 +146,46 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
     res.time_s = std::chrono::duration<double>(clock::now() - t0).count();
     return res;
   }
+  q.lift_s = m_model.surface_lifting(mu);
+  q.u_free = q.inv_theta * q.llt->solve(m_model.reduced_rhs(mu));
 
-  const Eigen::VectorXd f_hat = m_model.reduced_rhs(mu);
-  const Eigen::VectorXd lift_s = m_model.surface_lifting(mu);
-  const Eigen::VectorXd u_free = inv_theta * llt->solve(f_hat);  // unconstrained reduced solution
+  if (m_options.schedule == GreedySchedule::Nested)
+    solve_nested(q, res);
+  else
+    solve_interleaved(q, res);
+
+  res.u_hat = std::move(q.u_hat);
+  res.selected = std::move(q.selected);
+  res.coefficients = std::move(q.lambda_i);
+  res.lambda = m_model.reconstruct_dual(res.selected, res.coefficients);
+  if (res.status == Status::Success && !res.converged) {
+    res.status = Status::NoConvergence;
+    const bool nested = m_options.schedule == GreedySchedule::Nested;
+    res.message = "greedy active set did not converge in " + std::to_string(m_options.max_iterations) +
+                  (nested ? " operator rebuilds (or " + std::to_string(m_options.max_solves) + " solves)" : " iterations") +
+                  (q.best_iterate_returned ? "; best iterate with non-negative multipliers returned" : "");
+  }
+  const auto t1 = clock::now();
+  res.time_s = std::chrono::duration<double>(t1 - t0).count();
+  res.u = m_model.reconstruct_primal(res.u_hat, mu);
+  res.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
+  return res;
+}
+
+bool GreedyActiveSet::confirmed(const Eigen::VectorXd& violation) const {
+  const double worst = violation.size() > 0 ? violation.maxCoeff() : 0.0;
+  if (m_options.trace) *m_options.trace << "greedy check at fresh pairing: max(violation)=" << worst << "\n";
+  return worst <= m_threshold;
+}
+
+void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
+  const fom::ContactModel& contact = m_model.problem().contact();
+  const Eigen::MatrixXd& phi_s = m_model.surface_basis();
+  const Eigen::MatrixXd& dict = m_model.dictionary();
+  const int r = m_model.primal_rank(), m = m_model.dictionary_size();
+  const Eigen::LLT<Eigen::MatrixXd>* llt = q.llt;
+  const double inv_theta = q.inv_theta;
+  const Eigen::VectorXd &u_free = q.u_free, &lift_s = q.lift_s;
 
   Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, g, y, v, violation, rhs;
   Eigen::MatrixXd c_hat_i, w, schur;
@@ -90,13 +197,6 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   // Surface displacement of the current iterate, u_s = Φ_s û + u_off,s: the only
   // place the primal enters the contact operators.
   Eigen::VectorXd u_s = phi_s * u_hat + lift_s;
-  // Best iterate with λ̂ ≥ 0 (smallest largest violation), for the iteration cap.
-  struct {
-    bool valid = false;
-    double violation = 0.0;
-    Eigen::VectorXd u_hat, lambda_i;
-    std::vector<int> selected;
-  } best_iterate;
 
   bool pending = false;  // converged in the sense of Alg. 1, to be confirmed
   for (int k = 0; k <= m_options.max_iterations; ++k) {
@@ -109,9 +209,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
       // is violated by more than τ (selected columns included), so the returned
       // solution meets the reduced constraint at its own pairing; else go on.
       m_support.violation(c, g, u_s, v, violation);
-      const double worst = m > 0 ? violation.maxCoeff() : 0.0;
-      if (m_options.trace) *m_options.trace << "greedy check at fresh pairing: max(violation)=" << worst << "\n";
-      if (worst <= m_threshold) {
+      if (confirmed(violation)) {
         res.converged = true;
         break;
       }
@@ -174,13 +272,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
       m_support.violation(c, g, u_s, v, violation);
       int add = -1;
       if (m > 0) max_violation = violation.maxCoeff();
-      if (m_options.best_iterate_on_failure && (!best_iterate.valid || max_violation < best_iterate.violation)) {
-        best_iterate.valid = true;
-        best_iterate.violation = max_violation;
-        best_iterate.u_hat = u_hat;
-        best_iterate.lambda_i = lambda_i;
-        best_iterate.selected = solved;
-      }
+      if (m_options.best_iterate_on_failure) q.offer(max_violation, u_hat, lambda_i, solved);
       double best = m_threshold;  // (·)^{+,τ}: entries ≤ τ count as zero
       for (int p = 0; p < m; ++p)
         if (!in_active[p] && violation(p) > best) best = violation(p), add = p;
@@ -207,25 +299,176 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
     if (!changed && step <= m_options.step_tolerance * size) pending = true;
   }
 
-  if (!res.converged && res.status == Status::Success && best_iterate.valid) {
-    u_hat = best_iterate.u_hat;
-    lambda_i = best_iterate.lambda_i;
-    solved = best_iterate.selected;
+  q.finish(!res.converged && res.status == Status::Success, u_hat, lambda_i, solved);
+}
+
+void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
+  const fom::ContactModel& contact = m_model.problem().contact();
+  const Eigen::MatrixXd& phi_s = m_model.surface_basis();
+  const Eigen::MatrixXd& dr = m_support.basis;  // D_d on the support rows R, |R| × m
+  const int r = m_model.primal_rank(), m = m_model.dictionary_size();
+  const int nr = static_cast<int>(m_support.rows.size());
+  const Eigen::VectorXd &u_free = q.u_free, &lift_s = q.lift_s;
+
+  // A selected column p with the operators frozen: its row Ĉ_p = d_pᵀ A of Ĉ_I,
+  // w_p = K̂⁻¹ Ĉ_pᵀ and z_p = D_dᵀ C_s Φ_s w_p, the change of every column's
+  // violation per unit λ̂_p (û = u_free − Σ λ̂_p w_p).
+  struct Column {
+    int p;
+    Eigen::RowVectorXd c_hat;
+    Eigen::VectorXd w, z;
+  };
+  std::vector<Column> cols;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> a;  // A = C_R Φ_s (|R| × r)
+  Eigen::VectorXd b;       // C_R u_off,s − g_R: A û + b is the gap on R
+  Eigen::VectorXd v_free;  // every column's violation at u_free, D_Rᵀ (A u_free + b)
+  Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x = u_free, u_hat = u_free, g;
+  Eigen::MatrixXd schur;
+  Eigen::LDLT<Eigen::MatrixXd> ldlt;
+  fom::ConstraintMatrix c;
+  fom::Pairing pairing;
+  Eigen::VectorXd u_s;
+  std::vector<char> in_active(m, 0);
+  std::vector<int> solved, key;
+  std::vector<std::vector<int>> seen;  // selections met on the current operators
+  fom::AndersonMixer mixer(m_options.anderson_depth);
+
+  auto make_column = [&](int p) {
+    Column col{p, dr.col(p).transpose() * a, {}, {}};
+    col.w = q.inv_theta * q.llt->solve(col.c_hat.transpose());
+    aw.noalias() = a * col.w;
+    col.z.noalias() = dr.transpose() * aw;
+    return col;
+  };
+
+  bool pending = false;  // settled: to be confirmed at the fresh pairing of û
+  int solves = 0;
+  for (int rebuild = 0;; ++rebuild) {
+    // 1. Operators at x (surface rows only), A = C_R Φ_s and b.
+    u_s.noalias() = phi_s * x;
+    u_s += lift_s;
+    pairing = contact.search_rows(u_s, &m_support.rows, rebuild > 0 ? &pairing : nullptr);
+    contact.assemble(pairing, c, g);
+    a.setZero(nr, r);
+    b.resize(nr);
+    for (int i = 0; i < nr; ++i) {
+      const int row = m_support.rows[static_cast<size_t>(i)];
+      double acc = -g(row);
+      for (fom::ConstraintMatrix::InnerIterator it(c, row); it; ++it) {
+        a.row(i).noalias() += it.value() * m_phi_s_rows.row(it.col());
+        acc += it.value() * lift_s(it.col());
+      }
+      b(i) = acc;
+    }
+    if (pending) {  // x = û: is every column (selected ones included) within τ here?
+      gap.noalias() = a * x;
+      gap += b;
+      violation.noalias() = dr.transpose() * gap;
+      if (confirmed(violation)) {
+        res.converged = true;
+        break;
+      }
+      pending = false;
+    }
+    if (rebuild == m_options.max_iterations || solves >= m_options.max_solves) break;
+    gap.noalias() = a * u_free;
+    gap += b;
+    v_free.noalias() = dr.transpose() * gap;
+    for (auto& col : cols) col = make_column(col.p);
+
+    // 2–3. One-change steps on the frozen operators until nothing changes, a
+    //      selection comes back (cycle) or the solve cap is reached.
+    bool changed = false;
+    seen.clear();
+    while (solves < m_options.max_solves) {
+      const int na = static_cast<int>(cols.size());
+      u_hat = u_free;
+      violation = v_free;
+      lambda_i.resize(na);
+      if (na > 0) {
+        schur.resize(na, na);
+        rhs.resize(na);
+        for (int i = 0; i < na; ++i) {
+          rhs(i) = v_free(cols[i].p);  // Ĉ_i u_free − ĝ_i
+          for (int j = 0; j <= i; ++j) schur(i, j) = schur(j, i) = cols[i].c_hat.dot(cols[j].w);
+        }
+        ldlt.compute(schur);
+        if (ldlt.info() == Eigen::Success && ldlt.rcond() > m_options.singular_tolerance)
+          lambda_i = ldlt.solve(rhs);
+        else  // dependent rows: least-squares, minimum-norm multipliers
+          lambda_i = schur.completeOrthogonalDecomposition().solve(rhs);
+        for (int i = 0; i < na; ++i) {
+          u_hat.noalias() -= lambda_i(i) * cols[i].w;
+          violation.noalias() -= lambda_i(i) * cols[i].z;
+        }
+      }
+      ++solves;
+      solved.resize(static_cast<size_t>(na));
+      for (int i = 0; i < na; ++i) solved[static_cast<size_t>(i)] = cols[i].p;
+      if (!u_hat.allFinite() || !lambda_i.allFinite()) {
+        res.status = Status::NumericalIssue;
+        res.message = "reduced saddle-point solve produced a non-finite value";
+        break;
+      }
+
+      int remove = -1, add = -1;
+      double most_negative = 0.0, max_violation = m > 0 ? violation.maxCoeff() : 0.0;
+      for (int i = 0; i < na; ++i)
+        if (lambda_i(i) < most_negative) most_negative = lambda_i(i), remove = i;
+      if (remove < 0) {
+        if (m_options.best_iterate_on_failure) q.offer(max_violation, u_hat, lambda_i, solved);
+        double best = m_threshold;  // (·)^{+,τ}
+        for (int p = 0; p < m; ++p)
+          if (!in_active[p] && violation(p) > best) best = violation(p), add = p;
+      }
+      if (m_options.trace) {
+        *m_options.trace << "greedy rebuild=" << rebuild << " solve=" << solves << " |I|=" << na
+                         << " min(lambda)=" << (na ? lambda_i.minCoeff() : 0.0) << " max(violation)=" << max_violation
+                         << " -> ";
+        if (remove >= 0)
+          *m_options.trace << "remove " << cols[remove].p;
+        else if (add >= 0)
+          *m_options.trace << "add " << add;
+        else
+          *m_options.trace << "no change";
+        *m_options.trace << "\n";
+      }
+      if (remove >= 0) {
+        in_active[cols[remove].p] = 0;
+        cols.erase(cols.begin() + remove);
+      } else if (add >= 0) {
+        in_active[add] = 1;
+        cols.push_back(make_column(add));
+      } else {
+        break;
+      }
+      changed = true;
+      key.clear();
+      for (const auto& col : cols) key.push_back(col.p);
+      std::sort(key.begin(), key.end());
+      if (std::find(seen.begin(), seen.end(), key) != seen.end()) break;  // cycle: rebuild the operators
+      seen.push_back(key);
+    }
+    if (res.status != Status::Success) break;
+
+    // 4. Settled on these operators and û close to where they were built: confirm
+    //    at the pairing of û itself; else rebuild at the (accelerated) new point.
+    const double step = (u_hat - x).norm(), size = u_hat.norm();
+    if (m_options.trace)
+      *m_options.trace << "greedy rebuild=" << rebuild << " step=" << step / std::max(size, 1e-300) << "\n";
+    if (!changed && step <= m_options.step_tolerance * size) {
+      pending = true;
+      x = u_hat;
+    } else if (!changed) {
+      x = mixer.next(x, u_hat);  // same selection: a smooth fixed point in x
+    } else {
+      mixer = fom::AndersonMixer(m_options.anderson_depth);
+      x = u_hat;
+    }
   }
-  res.u_hat = u_hat;
-  res.selected = solved;
-  res.coefficients = lambda_i;
-  res.lambda = m_model.reconstruct_dual(solved, lambda_i);
-  if (res.status == Status::Success && !res.converged) {
-    res.status = Status::NoConvergence;
-    res.message = "greedy active set did not converge in " + std::to_string(m_options.max_iterations) + " iterations" +
-                  (best_iterate.valid && m_options.best_iterate_on_failure ? "; best iterate with non-negative multipliers returned" : "");
-  }
-  const auto t1 = clock::now();
-  res.time_s = std::chrono::duration<double>(t1 - t0).count();
-  res.u = m_model.reconstruct_primal(u_hat, mu);
-  res.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
-  return res;
+  res.iterations = solves;
+
+  q.finish(!res.converged && res.status == Status::Success, u_hat, lambda_i, solved);
 }
 
 }  // namespace contactrom::rom

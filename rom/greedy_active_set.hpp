@@ -35,6 +35,16 @@
 /// of the last iteration (with the I used there). The contact search runs only for
 /// the rows where some dictionary column is non-zero (SupportRows of D_d):
 /// the other rows of C never enter Ĉ or the violation.
+///
+/// Nested schedule (GreedySchedule::Nested, method "greedy-nested"): the same
+/// one-change steps 2–3 are repeated on FROZEN operators until they change nothing
+/// (or revisit a selection: a cycle), and only then are the operators rebuilt at the
+/// new iterate (step 1), Anderson-accelerated while the selection is unchanged. With
+/// the operators frozen, $ A = C_R \Phi_s $ is formed once per rebuild, and each
+/// selected column p keeps $ \hat C_p $, $ K̂^{-1} \hat C_p^T $ and its effect on
+/// every column's violation, so a one-change step costs O(|I|(r + m) + |I|³) and
+/// needs no contact search. Stopping test and confirmation are those of step 4;
+/// k_max counts the rebuilds, GreedyOptions::max_solves the one-change steps.
 #include <iosfwd>
 
 #include "rom/online_evaluation.hpp"
@@ -47,6 +57,18 @@ namespace contactrom::rom {
 enum class TauScaling {
   Absolute,  ///< paper: entries of \f$ D_d^T (Cu - g) \f$ compared with τ directly
   Relative   ///< compared with τ·U·max_p Σ_s w_s|D_d[s,p]| (U: displacement scale)
+};
+
+/// \brief When the reduced contact operators are rebuilt (see docs/rom.md).
+enum class GreedySchedule {
+  /// Paper Alg. 1: operators rebuilt at the previous iterate before every
+  /// one-change iteration.
+  Interleaved,
+  /// Operators rebuilt only once the one-change iterations have settled on the
+  /// current (frozen) operators, or cycle on them; the rebuild point is
+  /// Anderson-accelerated while the selection stays the same. Same selection
+  /// rules, threshold and convergence test; k_max counts the rebuilds.
+  Nested
 };
 
 /// \brief Settings of GreedyActiveSet (documented defaults).
@@ -68,6 +90,13 @@ struct GreedyOptions {
   /// instead of the last one (which may carry negative multipliers). The result is
   /// still flagged converged = false. Default true.
   bool best_iterate_on_failure = true;
+  /// Operator-rebuild schedule. Default Interleaved (paper Alg. 1).
+  GreedySchedule schedule = GreedySchedule::Interleaved;
+  /// Nested schedule: Anderson depth of the rebuild point (0: plain). Default 5.
+  int anderson_depth = 5;
+  /// Nested schedule: cap on the one-change solves of a query, over all rebuilds.
+  /// Default 1000.
+  int max_solves = 1000;
   /// If set, one line per iteration (|I|, action, largest violation, step) is
   /// written here; for diagnosis only (not thread-safe). Default nullptr.
   std::ostream* trace = nullptr;
@@ -81,7 +110,7 @@ class GreedyActiveSet final : public OnlineSolver {
   /// \param model reduced model (must outlive the solver)
   explicit GreedyActiveSet(const ReducedModel& model, const Options& options = {});
 
-  std::string name() const override { return "greedy"; }
+  std::string name() const override { return m_options.schedule == GreedySchedule::Nested ? "greedy-nested" : "greedy"; }
   const ReducedModel& model() const override { return m_model; }
   OnlineResult solve(const fom::Param& mu) const override;
 
@@ -95,6 +124,13 @@ class GreedyActiveSet final : public OnlineSolver {
   Options m_options;
   double m_threshold = 0.0;
   SupportRows m_support;  // contact rows R where D_d is not zero, D_d restricted to R
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m_phi_s_rows;  // Φ_s, row-major
+
+  struct Query;  // the per-query quantities both schedules share
+  void solve_interleaved(Query& q, OnlineResult& res) const;
+  void solve_nested(Query& q, OnlineResult& res) const;
+  /// Every column's violation at the fresh pairing of the returned û is within τ.
+  bool confirmed(const Eigen::VectorXd& violation) const;
 };
 
 /// \brief The threshold τ that GreedyActiveSet applies with `options` (defaulted to δ
@@ -102,7 +138,9 @@ class GreedyActiveSet final : public OnlineSolver {
 double greedy_threshold(const ReducedModel& model, const GreedyOptions& options);
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
-/// step_tolerance) into GreedyOptions. \throws InputError for an unknown tau_scaling.
+/// step_tolerance, and the extra keys schedule = interleaved|nested, anderson_depth,
+/// max_solves) into GreedyOptions. \throws InputError for an unknown tau_scaling or
+/// schedule, or a malformed number.
 GreedyOptions greedy_options(const OnlineSolverOptions& options);
 
 }  // namespace contactrom::rom
