@@ -5,8 +5,8 @@ For each case (default: hertz with 30 snapshots, ironing level 7 = 129 snapshots
 the script runs the contactrom CLI:
 
   contactrom offline --problem P (--train N | --level n) --out DB.h5      (if DB.h5 is missing)
-  contactrom online  --db DB.h5 --method M --validation --delta D --json  (M = greedy, cpg, full-dictionary)
-  contactrom verify  --db DB.h5 --method greedy,cpg,full-dictionary --reference fom --bench --delta D --json
+  contactrom online  --db DB.h5 --method M --validation --delta D --json  (M = greedy, greedy-nested, cpg, full-dictionary)
+  contactrom verify  --db DB.h5 --method greedy,greedy-nested,cpg,full-dictionary --reference fom --bench --delta D --json
   contactrom verify  --db DB.h5 --method cpg --cpg-tolerance T --reference fom --bench --delta D --json
                                                                           (each extra --cpg-tolerance T)
 
@@ -29,7 +29,7 @@ import os
 import subprocess
 import sys
 
-METHODS = ["greedy", "cpg", "full-dictionary"]
+METHODS = ["greedy", "greedy-nested", "cpg", "full-dictionary"]
 
 
 def run_json(cmd):

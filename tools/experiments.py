@@ -473,7 +473,7 @@ def stage_comparison(runner, cfg, dbs, timings, md):
         cases.append(("hertz", "train 30", dbs["hertz"][30]))
     if "ironing" in dbs and 7 in dbs["ironing"]:
         cases.append(("ironing", "level 7", dbs["ironing"][7]))
-    methods = ["greedy", "cpg", "full-dictionary"]
+    methods = ["greedy", "greedy-nested", "cpg", "full-dictionary"]
     missing = set()
     for problem, label, db in cases:
         for m in methods:
