@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <sstream>
 
 namespace contactrom::baselines {
@@ -52,15 +51,6 @@ Eigen::VectorXd projection_errors_scaled(const Eigen::MatrixXd& a, const Eigen::
     errors(j) = (a.col(j) - ab * x).norm() / norms(j);
   }
   return errors;
-}
-
-double parse_number(const std::string& key, const std::string& text) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  const double v = std::strtod(begin, &end);
-  if (text.empty() || end != begin + text.size() || !std::isfinite(v))
-    throw InputError("option " + key + " = '" + text + "' is not a number");
-  return v;
 }
 
 }  // namespace
@@ -138,12 +128,12 @@ CpgActiveSet::CpgActiveSet(CpgBasis&& basis, const rom::ReducedModel& model, con
 CpgOptions cpg_options(const rom::OnlineSolverOptions& options) {
   CpgOptions o;
   if (const auto it = options.extra.find("cpg_tolerance"); it != options.extra.end()) {
-    o.tolerance = parse_number(it->first, it->second);
+    o.tolerance = rom::parse_option_number("cpg", it->first, it->second);
     if (!(o.tolerance >= 0.0 && o.tolerance <= 1.0))
       throw InputError("option cpg_tolerance = '" + it->second + "' invalid; expected a value in [0, 1]");
   }
   if (const auto it = options.extra.find("cpg_max_size"); it != options.extra.end()) {
-    const double v = parse_number(it->first, it->second);
+    const double v = rom::parse_option_number("cpg", it->first, it->second);
     if (!(v >= 0.0) || v != std::floor(v) || v > 1e9)
       throw InputError("option cpg_max_size = '" + it->second + "' invalid; expected an integer >= 0");
     o.max_size = static_cast<int>(v);

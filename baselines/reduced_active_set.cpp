@@ -1,7 +1,6 @@
 #include "baselines/reduced_active_set.hpp"
 
 #include <Eigen/Cholesky>
-#include <Eigen/QR>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -164,11 +163,7 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
         lambda_i = nnls.solve(rhs);
         if (nnls.info() == Status::InvalidInput) lambda_i = Eigen::VectorXd::Constant(na, std::numeric_limits<double>::quiet_NaN());
       } else {
-        ldlt.compute(schur);
-        if (ldlt.info() == Eigen::Success && ldlt.rcond() > m_options.singular_tolerance)
-          lambda_i = ldlt.solve(rhs);
-        else  // dependent rows: least-squares, minimum-norm multipliers
-          lambda_i = schur.completeOrthogonalDecomposition().solve(rhs);
+        lambda_i = rom::schur_multipliers(schur, rhs, m_options.singular_tolerance, ldlt);
       }
       u_hat.noalias() = u_free - z * lambda_i;
     }

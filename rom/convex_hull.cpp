@@ -45,23 +45,11 @@ std::vector<Index> nonzeros(const VectorXd& v) {
 }
 
 double parse_double(const std::string& key, const std::string& text) {
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(text, &used);
-    if (used == text.size() && std::isfinite(v)) return v;
-  } catch (const std::exception&) {
-  }
-  throw InputError("convex-hull option " + key + " = '" + text + "' is not a number");
+  return parse_option_number("convex-hull", key, text);
 }
 
 long long parse_integer(const std::string& key, const std::string& text) {
-  try {
-    std::size_t used = 0;
-    const long long v = std::stoll(text, &used);
-    if (used == text.size()) return v;
-  } catch (const std::exception&) {
-  }
-  throw InputError("convex-hull option " + key + " = '" + text + "' is not an integer");
+  return parse_option_integer("convex-hull", key, text);
 }
 
 /// One solve of the projected problem for a fixed contact operator.

@@ -13,18 +13,32 @@ namespace contactrom::rom {
 
 namespace {
 
-int parse_int_option(const std::string& key, const std::string& value, int minimum) {
-  size_t used = 0;
-  int v = 0;
-  try {
-    v = std::stoi(value, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != value.size() || v < minimum)
-    throw InputError("greedy option " + key + "='" + value + "' invalid; expected an integer >= " +
+/// Integer greedy setting `key` = `value`, at least `minimum`.
+int greedy_int_option(const std::string& key, const std::string& value, int minimum) {
+  const long long v = parse_option_integer("greedy", key, value);
+  if (v < minimum || v > 1000000000)
+    throw InputError("greedy option " + key + " = '" + value + "' invalid; expected an integer >= " +
                      std::to_string(minimum));
-  return v;
+  return static_cast<int>(v);
+}
+
+/// Alg. 1's elimination: position of the most negative multiplier, −1 if none is.
+int most_negative(const Eigen::VectorXd& lambda) {
+  int at = -1;
+  double lowest = 0.0;
+  for (int i = 0; i < lambda.size(); ++i)
+    if (lambda(i) < lowest) lowest = lambda(i), at = i;
+  return at;
+}
+
+/// Alg. 1's enrichment: the unselected column with the largest violation, where
+/// entries ≤ τ count as zero ((·)^{+,τ}); −1 if there is none.
+int most_violated(const Eigen::VectorXd& violation, const std::vector<char>& in_active, double tau) {
+  int at = -1;
+  double best = tau;
+  for (int p = 0; p < violation.size(); ++p)
+    if (!in_active[static_cast<size_t>(p)] && violation(p) > best) best = violation(p), at = p;
+  return at;
 }
 
 }  // namespace
@@ -53,9 +67,9 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
       else
         throw InputError("greedy schedule '" + value + "' unknown; expected interleaved or nested");
     } else if (key == "anderson_depth") {
-      g.anderson_depth = parse_int_option(key, value, 0);
+      g.anderson_depth = greedy_int_option(key, value, 0);
     } else if (key == "max_solves") {
-      g.max_solves = parse_int_option(key, value, 1);
+      g.max_solves = greedy_int_option(key, value, 1);
     }
   }
   return g;
@@ -172,6 +186,13 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   return res;
 }
 
+Eigen::VectorXd schur_multipliers(const Eigen::MatrixXd& schur, const Eigen::VectorXd& rhs,
+                                  double singular_tolerance, Eigen::LDLT<Eigen::MatrixXd>& ldlt) {
+  ldlt.compute(schur);
+  if (ldlt.info() == Eigen::Success && ldlt.rcond() > singular_tolerance) return ldlt.solve(rhs);
+  return schur.completeOrthogonalDecomposition().solve(rhs);
+}
+
 bool GreedyActiveSet::confirmed(const Eigen::VectorXd& violation) const {
   const double worst = violation.size() > 0 ? violation.maxCoeff() : 0.0;
   if (m_options.trace) *m_options.trace << "greedy check at fresh pairing: max(violation)=" << worst << "\n";
@@ -237,11 +258,7 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
       w = inv_theta * llt->solve(c_hat_i.transpose());  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
       schur.noalias() = c_hat_i * w;
       rhs = c_hat_i * u_free - rhs;  // Ĉ_I K̂⁻¹ f̂ − ĝ_I
-      ldlt.compute(schur);
-      if (ldlt.info() == Eigen::Success && ldlt.rcond() > m_options.singular_tolerance)
-        lambda_i = ldlt.solve(rhs);
-      else  // dependent rows (e.g. |I| > r): least-squares, minimum-norm multipliers
-        lambda_i = schur.completeOrthogonalDecomposition().solve(rhs);
+      lambda_i = schur_multipliers(schur, rhs, m_options.singular_tolerance, ldlt);  // |I| > r: min-norm
       u_hat.noalias() = u_free - w * lambda_i;
     }
     solved = active;
@@ -258,10 +275,7 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
     //    correlated with the thresholded violation.
     bool changed = false;
     double max_violation = 0.0;
-    int remove = -1;
-    double most_negative = 0.0;
-    for (int i = 0; i < na; ++i)
-      if (lambda_i(i) < most_negative) most_negative = lambda_i(i), remove = i;
+    const int remove = most_negative(lambda_i);
     if (remove >= 0) {
       in_active[active[remove]] = 0;
       active.erase(active.begin() + remove);
@@ -270,12 +284,9 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
       // Ĉ û − ĝ for every column = D_dᵀ (C_s u_s − g), from the support rows, with
       // the operators of step 1.
       m_support.violation(c, g, u_s, v, violation);
-      int add = -1;
       if (m > 0) max_violation = violation.maxCoeff();
       if (m_options.best_iterate_on_failure) q.offer(max_violation, u_hat, lambda_i, solved);
-      double best = m_threshold;  // (·)^{+,τ}: entries ≤ τ count as zero
-      for (int p = 0; p < m; ++p)
-        if (!in_active[p] && violation(p) > best) best = violation(p), add = p;
+      const int add = most_violated(violation, in_active, m_threshold);
       if (add >= 0) {
         in_active[add] = 1;
         active.push_back(add);
@@ -392,11 +403,7 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
           rhs(i) = v_free(cols[i].p);  // Ĉ_i u_free − ĝ_i
           for (int j = 0; j <= i; ++j) schur(i, j) = schur(j, i) = cols[i].c_hat.dot(cols[j].w);
         }
-        ldlt.compute(schur);
-        if (ldlt.info() == Eigen::Success && ldlt.rcond() > m_options.singular_tolerance)
-          lambda_i = ldlt.solve(rhs);
-        else  // dependent rows: least-squares, minimum-norm multipliers
-          lambda_i = schur.completeOrthogonalDecomposition().solve(rhs);
+        lambda_i = schur_multipliers(schur, rhs, m_options.singular_tolerance, ldlt);
         for (int i = 0; i < na; ++i) {
           u_hat.noalias() -= lambda_i(i) * cols[i].w;
           violation.noalias() -= lambda_i(i) * cols[i].z;
@@ -411,15 +418,12 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
         break;
       }
 
-      int remove = -1, add = -1;
-      double most_negative = 0.0, max_violation = m > 0 ? violation.maxCoeff() : 0.0;
-      for (int i = 0; i < na; ++i)
-        if (lambda_i(i) < most_negative) most_negative = lambda_i(i), remove = i;
+      const int remove = most_negative(lambda_i);
+      const double max_violation = m > 0 ? violation.maxCoeff() : 0.0;
+      int add = -1;
       if (remove < 0) {
         if (m_options.best_iterate_on_failure) q.offer(max_violation, u_hat, lambda_i, solved);
-        double best = m_threshold;  // (·)^{+,τ}
-        for (int p = 0; p < m; ++p)
-          if (!in_active[p] && violation(p) > best) best = violation(p), add = p;
+        add = most_violated(violation, in_active, m_threshold);
       }
       if (m_options.trace) {
         *m_options.trace << "greedy rebuild=" << rebuild << " solve=" << solves << " |I|=" << na

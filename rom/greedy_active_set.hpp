@@ -137,6 +137,13 @@ class GreedyActiveSet final : public OnlineSolver {
 /// and scaled per TauScaling), in the units of \f$ D_d^T (Cu - g) \f$.
 double greedy_threshold(const ReducedModel& model, const GreedyOptions& options);
 
+/// \brief Multipliers of the reduced saddle-point system from its Schur complement
+/// S (|I| × |I|): S⁻¹ rhs by `ldlt` (which keeps the factorisation), or — when S is
+/// numerically singular (LDLᵀ failure or reciprocal condition ≤ `singular_tolerance`,
+/// e.g. dependent rows) — the least-squares, minimum-norm solution.
+Eigen::VectorXd schur_multipliers(const Eigen::MatrixXd& schur, const Eigen::VectorXd& rhs,
+                                  double singular_tolerance, Eigen::LDLT<Eigen::MatrixXd>& ldlt);
+
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
 /// step_tolerance, and the extra keys schedule = interleaved|nested, anderson_depth,
 /// max_solves) into GreedyOptions. \throws InputError for an unknown tau_scaling or

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <mutex>
 #include <ostream>
@@ -61,6 +62,26 @@ void check_extra_options(const OnlineSolverOptions& options, const std::string& 
     throw InputError("online method '" + method + "' has no option '" + entry.first + "'; it knows: " +
                      (list.empty() ? "none" : list));
   }
+}
+
+double parse_option_number(const std::string& method, const std::string& key, const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    if (used == text.size() && std::isfinite(v)) return v;
+  } catch (const std::exception&) {
+  }
+  throw InputError(method + " option " + key + " = '" + text + "' is not a number");
+}
+
+long long parse_option_integer(const std::string& method, const std::string& key, const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const long long v = std::stoll(text, &used);
+    if (used == text.size()) return v;
+  } catch (const std::exception&) {
+  }
+  throw InputError(method + " option " + key + " = '" + text + "' is not an integer");
 }
 
 std::vector<std::string> online_solver_names() {
