@@ -221,6 +221,13 @@ def run_study(runner, outdir, problem, kind, ns, deltas, timings):
 # ----------------------------------------------------------------------------- figures
 
 
+def save_figure(fig, path):
+    """Lays out `fig`, writes it to `path` (PNG, DPI) and releases it."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+
+
 def evolution_figure(records, deltas, xlabel, path, n_contact, title, fom_time=None):
     """(a) mean errors (bars) + primal rank (lines, right axis), (b) iterations,
     (c) total time, (d) time per iteration, all vs training set."""
@@ -279,9 +286,7 @@ def evolution_figure(records, deltas, xlabel, path, n_contact, title, fom_time=N
         a.grid(alpha=0.3)
         a.set_ylim(bottom=0)
         a.legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def error_curves_figure(rows, ns, deltas, path):
@@ -306,9 +311,7 @@ def error_curves_figure(rows, ns, deltas, path):
                 a.set_xlabel("d")
             if i == 0 and j == 0:
                 a.legend(fontsize=7, title="× = not converged", title_fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def sparsity_figure(rw, db, path, title):
@@ -326,9 +329,7 @@ def sparsity_figure(rw, db, path, title):
     a.set_ylabel(f"validation parameter index ({len(rw)} queries, increasing)")
     a.set_title(title, fontsize=9)
     a.grid(alpha=0.2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def spy_figure(db, path, title):
@@ -341,9 +342,7 @@ def spy_figure(db, path, title):
     a.xaxis.set_ticks_position("bottom")
     a.xaxis.set_label_position("bottom")
     a.set_title(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def read_surface(path):
@@ -384,9 +383,7 @@ def reconstruction_figure(examples, db, path):
                     f"{js['iterations']} it.", fontsize=9)
         a.legend(fontsize=7)
         a.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 # ----------------------------------------------------------------------------- stages
