@@ -70,9 +70,11 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   // K̂(μ)⁻¹ as in the greedy: the offline Cholesky factor when K̂(μ) = θ₀(μ) K̂₀.
   Eigen::LLT<Eigen::MatrixXd> local;
   const Eigen::LLT<Eigen::MatrixXd>* llt = m_model.single_term_factor();
+  const Eigen::MatrixXd* k_inv = nullptr;  // K̂₀⁻¹, offline
   double inv_theta = 1.0;
   if (llt) {
     inv_theta = 1.0 / problem.stiffness_coefficients(mu)(0);
+    k_inv = m_model.single_term_inverse();
   } else {
     local.compute(m_model.reduced_stiffness(mu));
     llt = &local;
@@ -91,8 +93,10 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   const Eigen::VectorXd lift_s = m_model.surface_lifting(mu);
   const Eigen::VectorXd u_free = inv_theta * llt->solve(f_hat);
 
-  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, u_s, g, y, v, violation, rhs;
-  Eigen::MatrixXd c_hat_i, z, schur;
+  const rom::RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
+  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, u_s, g, v, violation, rhs;
+  rom::RowMajorMatrix c_hat_i;
+  Eigen::MatrixXd z, schur;
   fom::ConstraintMatrix c;
   fom::Pairing pairing;
   std::vector<int> active, next, solved;  // positions in W
@@ -108,7 +112,7 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
     u_s.noalias() = phi_s * u_hat;
     u_s += lift_s;
     pairing = contact.search_rows(u_s, &m_support.rows, k > 0 ? &pairing : nullptr);
-    contact.assemble(pairing, c, g);
+    contact.assemble_rows(pairing, m_support.rows, c, g);  // C_R, g_R
     m_support.violation(c, g, u_s, v, violation);
 
     // 2. Primal–dual update: drop the columns whose multiplier left the cone, add every
@@ -145,15 +149,13 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
     } else {
       c_hat_i.resize(na, r);
       rhs.resize(na);
-      for (int i = 0; i < na; ++i) {
-        // Row of Ĉ_I = W_Iᵀ C_s Φ_s and entry of ĝ_I = W_Iᵀ (g − C_s u_lift,s) through
-        // y = C_sᵀ w_p: O(nnz(C) + n_s r) per active column, never C_s Φ_s itself.
-        const auto w = m_w.col(active[i]);
-        y.noalias() = c.transpose() * w;
-        c_hat_i.row(i).noalias() = y.transpose() * phi_s;
-        rhs(i) = w.dot(g) - y.dot(lift_s);
-      }
-      z = inv_theta * llt->solve(c_hat_i.transpose());  // K̂⁻¹ Ĉ_Iᵀ
+      // Rows of Ĉ_I = W_Iᵀ C_R Φ_s and entries of ĝ_I = W_Iᵀ (g_R − C_R u_lift,s),
+      // as in the greedy: from the rows where each active column is non-zero.
+      for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], c, g, phi_s_rows, lift_s, c_hat_i.row(i));
+      if (k_inv)
+        z.noalias() = inv_theta * (*k_inv) * c_hat_i.transpose();  // K̂⁻¹ Ĉ_Iᵀ
+      else
+        z = inv_theta * llt->solve(c_hat_i.transpose());
       schur.noalias() = c_hat_i * z;
       rhs = c_hat_i * u_free - rhs;
       if (nonnegative) {

@@ -26,6 +26,21 @@ Eigen::VectorXd ContactModel::restrict_to_surface(const Eigen::VectorXd& u_full)
   return out;
 }
 
+void ContactModel::assemble_rows(const Pairing& pairing, const std::vector<int>& rows, ConstraintMatrix& c,
+                                 Eigen::VectorXd& g) const {
+  ConstraintMatrix full;
+  Eigen::VectorXd g_full;
+  assemble(pairing, full, g_full);
+  c.resize(static_cast<Eigen::Index>(rows.size()), full.cols());
+  g.resize(static_cast<Eigen::Index>(rows.size()));
+  for (size_t i = 0; i < rows.size(); ++i) {
+    c.startVec(static_cast<Eigen::Index>(i));
+    for (ConstraintMatrix::InnerIterator it(full, rows[i]); it; ++it) c.insertBack(static_cast<Eigen::Index>(i), it.col()) = it.value();
+    g(static_cast<Eigen::Index>(i)) = g_full(rows[i]);
+  }
+  c.finalize();
+}
+
 // Surface dof layout: slave node k -> columns 2k, 2k+1; master node j -> 2(n_s+j), 2(n_s+j)+1.
 NodeToSegmentContact::NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const std::vector<int>& slave_chain,
                                            const std::vector<int>& master_chain,
@@ -195,6 +210,35 @@ void NodeToSegmentContact::assemble(const Pairing& p, ConstraintMatrix& c, Eigen
     c.insertBack(k, 2 * (ns + j + 1) + 1) = w * xi * n(1);
   }
   c.finalize();
+}
+
+void NodeToSegmentContact::assemble_rows(const Pairing& p, const std::vector<int>& rows, ConstraintMatrix& c,
+                                         Eigen::VectorXd& g) const {
+  // Same entries as assemble(), written straight into the compressed arrays.
+  const int ns = static_cast<int>(m_slave.size()), nr = static_cast<int>(rows.size());
+  g.resize(nr);
+  c.resize(nr, static_cast<int>(m_surface_dofs.size()));
+  c.resizeNonZeros(6 * nr);
+  int* outer = c.outerIndexPtr();
+  int* inner = c.innerIndexPtr();
+  double* value = c.valuePtr();
+  int nnz = 0;
+  for (int i = 0; i < nr; ++i) {
+    outer[i] = nnz;
+    const int k = rows[static_cast<size_t>(i)], j = p.segment[static_cast<size_t>(k)];
+    g(i) = 0.0;
+    if (j < 0) continue;
+    const double w = m_weights(k), xi = p.xi[static_cast<size_t>(k)];
+    const Eigen::Vector2d n = p.normal.col(k);
+    const Eigen::Vector2d xm = (1.0 - xi) * m_master_x.col(j) + xi * m_master_x.col(j + 1);
+    g(i) = w * n.dot(m_slave_x.col(k) - xm);
+    const int cols[6] = {2 * k, 2 * k + 1, 2 * (ns + j), 2 * (ns + j) + 1, 2 * (ns + j + 1), 2 * (ns + j + 1) + 1};
+    const double vals[6] = {-w * n(0), -w * n(1), w * (1.0 - xi) * n(0), w * (1.0 - xi) * n(1), w * xi * n(0), w * xi * n(1)};
+    for (int e = 0; e < 6; ++e) inner[nnz + e] = cols[e], value[nnz + e] = vals[e];
+    nnz += 6;
+  }
+  outer[nr] = nnz;
+  c.resizeNonZeros(nnz);
 }
 
 ObstacleContact::ObstacleContact(const Eigen::VectorXd& x, const Eigen::VectorXd& psi,

@@ -65,6 +65,11 @@ class ContactModel {
 
   /// \brief Constraint operator for a pairing: C (n_c x surface dofs) and g (n_c).
   virtual void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const = 0;
+  /// \brief The listed rows of C and g only, compact: row i of `c` (|rows| x surface
+  /// dofs) and g(i) are row rows[i] of assemble()'s. The storage of `c` and `g` is
+  /// reused, so repeated online calls do not allocate.
+  virtual void assemble_rows(const Pairing& pairing, const std::vector<int>& rows, ConstraintMatrix& c,
+                             Eigen::VectorXd& g) const;
 
   /// Gather a full dof vector onto the surface dofs.
   Eigen::VectorXd restrict_to_surface(const Eigen::VectorXd& u_full) const;
@@ -89,6 +94,8 @@ class NodeToSegmentContact final : public ContactModel {
   Pairing search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
                       const Pairing* hint) const override;
   void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const override;
+  void assemble_rows(const Pairing& pairing, const std::vector<int>& rows, ConstraintMatrix& c,
+                     Eigen::VectorXd& g) const override;
 
   const std::vector<int>& slave_nodes() const { return m_slave; }
   const std::vector<int>& master_nodes() const { return m_master; }

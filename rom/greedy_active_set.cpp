@@ -89,12 +89,21 @@ double greedy_threshold(const ReducedModel& model, const GreedyOptions& options)
 
 GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& options)
     : m_model(model), m_options(options), m_threshold(greedy_threshold(model, options)),
-      m_support(model.dictionary()), m_phi_s_rows(model.surface_basis()) {}
+      m_support(model.dictionary()) {}
 
 /// Per-query quantities shared by both schedules.
 struct GreedyActiveSet::Query {
   const Eigen::LLT<Eigen::MatrixXd>* llt = nullptr;  // factor of K̂ (or of K̂₀, scaled by inv_theta)
+  const Eigen::MatrixXd* k_inv = nullptr;            // K̂₀⁻¹ when offline (scaled by inv_theta)
   double inv_theta = 1.0;
+  /// out = K̂⁻¹ rhs (r × n).
+  template <class Rhs>
+  void solve_stiffness(const Rhs& rhs, Eigen::MatrixXd& out) const {
+    if (k_inv)
+      out.noalias() = inv_theta * (*k_inv) * rhs;
+    else
+      out = inv_theta * llt->solve(rhs);
+  }
   Eigen::VectorXd lift_s;  // surface lifting u_off,s(μ)
   Eigen::VectorXd u_free;  // unconstrained reduced solution K̂⁻¹ f̂
   // Outcome, filled by the schedule: final û, the selection and its multipliers.
@@ -147,6 +156,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   q.llt = m_model.single_term_factor();
   if (q.llt) {
     q.inv_theta = 1.0 / problem.stiffness_coefficients(mu)(0);
+    q.k_inv = m_model.single_term_inverse();
   } else {
     local.compute(m_model.reduced_stiffness(mu));
     q.llt = &local;
@@ -202,14 +212,13 @@ bool GreedyActiveSet::confirmed(const Eigen::VectorXd& violation) const {
 void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
   const fom::ContactModel& contact = m_model.problem().contact();
   const Eigen::MatrixXd& phi_s = m_model.surface_basis();
-  const Eigen::MatrixXd& dict = m_model.dictionary();
+  const RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
   const int r = m_model.primal_rank(), m = m_model.dictionary_size();
-  const Eigen::LLT<Eigen::MatrixXd>* llt = q.llt;
-  const double inv_theta = q.inv_theta;
   const Eigen::VectorXd &u_free = q.u_free, &lift_s = q.lift_s;
 
-  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, g, y, v, violation, rhs;
-  Eigen::MatrixXd c_hat_i, w, schur;
+  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, g, v, violation, rhs;
+  RowMajorMatrix c_hat_i;
+  Eigen::MatrixXd w, schur;
   fom::ConstraintMatrix c;
   fom::Pairing pairing;
   std::vector<int> active, solved;
@@ -223,7 +232,7 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
   for (int k = 0; k <= m_options.max_iterations; ++k) {
     // 1. Contact operators at the previous iterate, from the surface rows only.
     pairing = contact.search_rows(u_s, &m_support.rows, k > 0 ? &pairing : nullptr);
-    contact.assemble(pairing, c, g);
+    contact.assemble_rows(pairing, m_support.rows, c, g);  // C_R, g_R
     if (pending) {
       // Alg. 1 found no change and a settled û^k, but judged û^k with the operators
       // of û^{k−1}. Confirm at the pairing of û^k itself that no dictionary column
@@ -240,14 +249,9 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
     const int na = static_cast<int>(active.size());
     c_hat_i.resize(na, r);
     rhs.resize(na);
-    for (int i = 0; i < na; ++i) {
-      // Row of Ĉ_I = D_Iᵀ C_s Φ_s and entry of ĝ_I = D_Iᵀ (g − C_s u_off,s),
-      // through y = C_sᵀ d_p (n_s): O(nnz(C) + n_s r) per selected column.
-      const auto d = dict.col(active[i]);
-      y.noalias() = c.transpose() * d;
-      c_hat_i.row(i).noalias() = y.transpose() * phi_s;
-      rhs(i) = d.dot(g) - y.dot(lift_s);
-    }
+    // Rows of Ĉ_I = D_Iᵀ C_R Φ_s and entries of ĝ_I = D_Iᵀ (g_R − C_R u_off,s), from
+    // the rows where each selected column is non-zero.
+    for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], c, g, phi_s_rows, lift_s, c_hat_i.row(i));
 
     // 2. Saddle-point system by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ.
     u_prev = u_hat;
@@ -255,7 +259,7 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
       u_hat = u_free;
       lambda_i.resize(0);
     } else {
-      w = inv_theta * llt->solve(c_hat_i.transpose());  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
+      q.solve_stiffness(c_hat_i.transpose(), w);  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
       schur.noalias() = c_hat_i * w;
       rhs = c_hat_i * u_free - rhs;  // Ĉ_I K̂⁻¹ f̂ − ĝ_I
       lambda_i = schur_multipliers(schur, rhs, m_options.singular_tolerance, ldlt);  // |I| > r: min-norm
@@ -316,6 +320,7 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
 void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
   const fom::ContactModel& contact = m_model.problem().contact();
   const Eigen::MatrixXd& phi_s = m_model.surface_basis();
+  const RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
   const Eigen::MatrixXd& dr = m_support.basis;  // D_d on the support rows R, |R| × m
   const int r = m_model.primal_rank(), m = m_model.dictionary_size();
   const int nr = static_cast<int>(m_support.rows.size());
@@ -327,10 +332,11 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
   struct Column {
     int p;
     Eigen::RowVectorXd c_hat;
-    Eigen::VectorXd w, z;
+    Eigen::MatrixXd w;  // r × 1
+    Eigen::VectorXd z;
   };
   std::vector<Column> cols;
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> a;  // A = C_R Φ_s (|R| × r)
+  RowMajorMatrix a;  // A = C_R Φ_s (|R| × r)
   Eigen::VectorXd b;       // C_R u_off,s − g_R: A û + b is the gap on R
   Eigen::VectorXd v_free;  // every column's violation at u_free, D_Rᵀ (A u_free + b)
   Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x = u_free, u_hat = u_free, g;
@@ -345,9 +351,10 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
   fom::AndersonMixer mixer(m_options.anderson_depth);
 
   auto make_column = [&](int p) {
-    Column col{p, dr.col(p).transpose() * a, {}, {}};
-    col.w = q.inv_theta * q.llt->solve(col.c_hat.transpose());
-    aw.noalias() = a * col.w;
+    Column col{p, Eigen::RowVectorXd::Zero(r), {}, {}};
+    for (int i : m_support.column_support[static_cast<size_t>(p)]) col.c_hat.noalias() += dr(i, p) * a.row(i);
+    q.solve_stiffness(col.c_hat.transpose(), col.w);
+    aw.noalias() = a * col.w.col(0);
     col.z.noalias() = dr.transpose() * aw;
     return col;
   };
@@ -359,14 +366,13 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
     u_s.noalias() = phi_s * x;
     u_s += lift_s;
     pairing = contact.search_rows(u_s, &m_support.rows, rebuild > 0 ? &pairing : nullptr);
-    contact.assemble(pairing, c, g);
+    contact.assemble_rows(pairing, m_support.rows, c, g);  // C_R, g_R
     a.setZero(nr, r);
     b.resize(nr);
     for (int i = 0; i < nr; ++i) {
-      const int row = m_support.rows[static_cast<size_t>(i)];
-      double acc = -g(row);
-      for (fom::ConstraintMatrix::InnerIterator it(c, row); it; ++it) {
-        a.row(i).noalias() += it.value() * m_phi_s_rows.row(it.col());
+      double acc = -g(i);
+      for (fom::ConstraintMatrix::InnerIterator it(c, i); it; ++it) {
+        a.row(i).noalias() += it.value() * phi_s_rows.row(it.col());
         acc += it.value() * lift_s(it.col());
       }
       b(i) = acc;
@@ -401,11 +407,11 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
         rhs.resize(na);
         for (int i = 0; i < na; ++i) {
           rhs(i) = v_free(cols[i].p);  // Ĉ_i u_free − ĝ_i
-          for (int j = 0; j <= i; ++j) schur(i, j) = schur(j, i) = cols[i].c_hat.dot(cols[j].w);
+          for (int j = 0; j <= i; ++j) schur(i, j) = schur(j, i) = cols[i].c_hat.dot(cols[j].w.col(0));
         }
         lambda_i = schur_multipliers(schur, rhs, m_options.singular_tolerance, ldlt);
         for (int i = 0; i < na; ++i) {
-          u_hat.noalias() -= lambda_i(i) * cols[i].w;
+          u_hat.noalias() -= lambda_i(i) * cols[i].w.col(0);
           violation.noalias() -= lambda_i(i) * cols[i].z;
         }
       }

@@ -124,7 +124,6 @@ class GreedyActiveSet final : public OnlineSolver {
   Options m_options;
   double m_threshold = 0.0;
   SupportRows m_support;  // contact rows R where D_d is not zero, D_d restricted to R
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m_phi_s_rows;  // Φ_s, row-major
 
   struct Query;  // the per-query quantities both schedules share
   void solve_interleaved(Query& q, OnlineResult& res) const;

@@ -89,6 +89,7 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
   const int ns = static_cast<int>(surf.size()), r = primal_rank();
   m_phi_s.resize(ns, r);
   for (int a = 0; a < ns; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
+  m_phi_s_rows = m_phi_s;
   m_lift_s.resize(ns, nt);
   for (int k = 0; k < nt; ++k)
     for (int a = 0; a < ns; ++a) m_lift_s(a, k) = m_offset[k](surf[a]);
@@ -108,6 +109,10 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
   if (problem.num_stiffness_terms() == 1) {
     m_k_llt.compute(m_k_hat[0]);
     m_single_ok = m_k_llt.info() == Eigen::Success;
+    if (m_single_ok) {
+      m_k_inv = m_k_llt.solve(Eigen::MatrixXd::Identity(r, r));
+      m_k_inv = (0.5 * (m_k_inv + m_k_inv.transpose())).eval();
+    }
   }
   m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

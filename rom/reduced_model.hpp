@@ -75,6 +75,11 @@ class ReducedModel {
   const Eigen::VectorXd& singular_values() const { return m_sigma; }
   /// Contact-surface rows of the basis, Φ_s (n_s × r), in surface_dofs() order.
   const Eigen::MatrixXd& surface_basis() const { return m_phi_s; }
+  /// The same Φ_s stored row by row: the online methods combine a few of its rows
+  /// per constraint row (C_s Φ_s touches 6 surface dofs per row).
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& surface_basis_rows() const {
+    return m_phi_s_rows;
+  }
   /// Dual dictionary D_d (n_c × m).
   const Eigen::MatrixXd& dictionary() const { return m_dict; }
   /// Database snapshot index of each dictionary column.
@@ -104,6 +109,10 @@ class ReducedModel {
   /// stiffness term (then \f$ \hat K(\mu) = \theta_0(\mu)\,\Phi^T K_0\Phi \f$: factorised
   /// once here, offline); nullptr otherwise (factorise per query).
   const Eigen::LLT<Eigen::MatrixXd>* single_term_factor() const { return m_single_ok ? &m_k_llt : nullptr; }
+  /// \brief \f$ (\Phi^T K_0 \Phi)^{-1} \f$ from that factor (same condition), nullptr
+  /// otherwise: the online solves need K̂⁻¹ times a few vectors of size r, where one
+  /// small dense product costs less than two triangular solves.
+  const Eigen::MatrixXd* single_term_inverse() const { return m_single_ok ? &m_k_inv : nullptr; }
 
   /// \brief Full displacement \f$ u = \Phi\hat u + u_{off}(\mu) \f$ (n_dofs).
   Eigen::VectorXd reconstruct_primal(const Eigen::VectorXd& u_hat, const fom::Param& mu) const;
@@ -124,7 +133,9 @@ class ReducedModel {
   std::vector<Eigen::MatrixXd> m_k_hat;   // Φᵀ K_q Φ
   Eigen::MatrixXd m_f_hat;                // column k: Φᵀ f_ext,k
   std::vector<Eigen::MatrixXd> m_kl_hat;  // per q, column k: Φᵀ K_q L_k
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m_phi_s_rows;
   Eigen::LLT<Eigen::MatrixXd> m_k_llt;
+  Eigen::MatrixXd m_k_inv;
   bool m_single_ok = false;
   double m_setup_time = 0.0;
 };

@@ -3,7 +3,7 @@
 /// \brief A dual basis (dictionary, CPG basis, ...) restricted to the contact rows
 /// where it is non-zero. Only those rows enter the reduced operators
 /// \f$ W^T C \Phi \f$ and the reduced violation \f$ W^T (C u - g) \f$, so the online
-/// contact search and the violation need nothing else.
+/// contact search, the assembly and the violation need nothing else.
 #include <Eigen/Dense>
 #include <vector>
 
@@ -11,18 +11,32 @@
 
 namespace contactrom::rom {
 
-/// \brief Support rows of a dual basis W (n_c × m) and W restricted to them.
+/// Row-major dense matrix (Φ_s by rows, A = C_R Φ_s).
+using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// \brief Support rows R of a dual basis W (n_c × m) and W restricted to them.
+///
+/// The online kernels work on the compact operators of R: C_R (|R| × surface dofs)
+/// and g_R, as ContactModel::assemble_rows(pairing, rows, ...) gives them.
 struct SupportRows {
   SupportRows() = default;  ///< no rows
   explicit SupportRows(const Eigen::MatrixXd& w);
 
   std::vector<int> rows;  ///< contact rows where some column of W is non-zero, ascending
-  Eigen::MatrixXd basis;  ///< W[rows, :] (|rows| × m)
+  Eigen::MatrixXd basis;  ///< W[rows, :] (|R| × m)
+  /// Per column p, the positions i in `rows` where W[rows[i], p] is not zero.
+  std::vector<std::vector<int>> column_support;
 
-  /// \brief \f$ W^T (C u_s - g) \f$ for every column of W, from the support rows only.
-  /// \param gap work vector, left holding \f$ (C u_s - g) \f$ on the support rows
-  void violation(const fom::ConstraintMatrix& c, const Eigen::VectorXd& g, const Eigen::VectorXd& u_surface,
+  /// \brief \f$ W^T (C u_s - g) \f$ for every column of W, from C_R and g_R.
+  /// \param gap work vector, left holding \f$ (C_R u_s - g_R) \f$
+  void violation(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r, const Eigen::VectorXd& u_surface,
                  Eigen::VectorXd& gap, Eigen::VectorXd& out) const;
+
+  /// \brief Row p of the reduced operators from C_R and g_R:
+  /// \f$ \hat C_p = w_p^T C_R \Phi_s \f$ into `c_hat` (size r) and the return value
+  /// \f$ \hat g_p = w_p^T (g_R - C_R u_{off,s}) \f$. O(nnz(w_p) · 6 · r).
+  double reduced_row(int p, const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r, const RowMajorMatrix& phi_s,
+                     const Eigen::VectorXd& lift_s, Eigen::Ref<Eigen::RowVectorXd> c_hat) const;
 };
 
 }  // namespace contactrom::rom

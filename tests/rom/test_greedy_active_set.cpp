@@ -18,6 +18,7 @@
 #include "rom/offline.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
+#include "rom/support_rows.hpp"
 
 using namespace contactrom;
 
@@ -325,6 +326,58 @@ BOOST_AUTO_TEST_CASE(zero_pressure_dictionary_gives_the_unconstrained_solution) 
   BOOST_TEST(res.lambda.norm() == 0.0);
   const Eigen::VectorXd u_free = model.reduced_stiffness(mu).llt().solve(model.reduced_rhs(mu));
   BOOST_TEST((res.u_hat - u_free).norm() <= 1e-12 * std::max(1.0, u_free.norm()));
+}
+
+BOOST_AUTO_TEST_CASE(support_row_kernels_match_the_dense_operators) {
+  // The online kernels work on the compact support rows C_R, g_R: check them against
+  // the dense formulas D_dᵀ C_s Φ_s, D_dᵀ (g − C_s u_off,s) and D_dᵀ (C_s u_s − g)
+  // built from assemble() — on hertz (node-to-segment, fast assemble_rows) and rope
+  // (obstacle, the generic assemble_rows) — and K̂₀⁻¹ against the Cholesky solve.
+  Setup rope("rope");
+  for (Setup* setup : {&hertz(), &rope}) {
+    const fom::Problem& problem = *setup->problem;
+    const fom::ContactModel& contact = problem.contact();
+    const rom::ReducedModel model(problem, setup->db(setup == &rope ? 9 : 12));
+    const rom::SupportRows support(model.dictionary());
+    BOOST_REQUIRE(!support.rows.empty());
+    const fom::Param mu = problem.validation_set(12)[5];
+    const rom::GreedyActiveSet greedy(model);
+    const rom::OnlineResult res = greedy.solve(mu);
+    const Eigen::VectorXd lift_s = model.surface_lifting(mu);
+    const Eigen::VectorXd u_s = model.surface_basis() * res.u_hat + lift_s;
+    const fom::Pairing pairing = contact.search(u_s);
+    fom::ConstraintMatrix c, c_r;
+    Eigen::VectorXd g, g_r, gap, violation;
+    contact.assemble(pairing, c, g);
+    contact.assemble_rows(pairing, support.rows, c_r, g_r);
+    BOOST_TEST(c_r.rows() == static_cast<Eigen::Index>(support.rows.size()));
+    for (size_t i = 0; i < support.rows.size(); ++i) {
+      const Eigen::Index ii = static_cast<Eigen::Index>(i);
+      BOOST_TEST(g_r(ii) == g(support.rows[i]));
+      BOOST_TEST((Eigen::RowVectorXd(c_r.row(ii)) - Eigen::RowVectorXd(c.row(support.rows[i]))).norm() == 0.0);
+    }
+    const Eigen::MatrixXd& dict = model.dictionary();
+    const Eigen::MatrixXd c_hat = dict.transpose() * (c * model.surface_basis());
+    const Eigen::VectorXd g_hat = dict.transpose() * (g - c * lift_s);
+    const double scale = c_hat.cwiseAbs().maxCoeff(), g_scale = std::max(g_hat.cwiseAbs().maxCoeff(), 1e-300);
+    Eigen::RowVectorXd row(model.primal_rank());
+    for (int p = 0; p < model.dictionary_size(); ++p) {
+      const double gp = support.reduced_row(p, c_r, g_r, model.surface_basis_rows(), lift_s, row);
+      BOOST_TEST((row - c_hat.row(p)).cwiseAbs().maxCoeff() <= 1e-13 * scale);
+      BOOST_TEST(std::abs(gp - g_hat(p)) <= 1e-13 * g_scale);
+    }
+    support.violation(c_r, g_r, u_s, gap, violation);
+    const Eigen::VectorXd expected = dict.transpose() * (c * u_s - g);
+    BOOST_TEST((violation - expected).cwiseAbs().maxCoeff() <= 1e-12 * std::max(expected.cwiseAbs().maxCoeff(), 1e-300));
+    if (const Eigen::MatrixXd* k_inv = model.single_term_inverse()) {
+      const Eigen::MatrixXd b = c_hat.transpose();
+      const Eigen::MatrixXd x = model.single_term_factor()->solve(b);
+      BOOST_TEST(((*k_inv) * b - x).norm() <= 1e-8 * x.norm());
+    } else {
+      BOOST_TEST(&problem == setup->problem.get());  // rope: K̂ depends on γ, no offline inverse
+      BOOST_TEST(setup == &rope);
+    }
+  }
 }
 
 BOOST_AUTO_TEST_CASE(failed_snapshots_are_left_out_of_the_model) {
