@@ -98,10 +98,9 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   rom::RowMajorMatrix c_hat_i;
   Eigen::MatrixXd z, schur;
   fom::ConstraintMatrix c;
-  fom::Pairing pairing;
+  fom::Pairing pairing, searched;  // the current pairing; the next one, written in place
   std::vector<int> active, next, solved;  // positions in W
   std::vector<char> in_active(mw, 0);
-  Eigen::LDLT<Eigen::MatrixXd> ldlt;
   rom::NnlsQp nnls(m_options.nnls);
   const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
   bool small_step = true;  // û = u_free is exact for I = ∅
@@ -111,7 +110,8 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
     //    column, Ĉû − ĝ = Wᵀ(C_s u_s − g).
     u_s.noalias() = phi_s * u_hat;
     u_s += lift_s;
-    pairing = contact.search_rows(u_s, &m_support.rows, k > 0 ? &pairing : nullptr);
+    contact.search_rows(u_s, &m_support.rows, k > 0 ? &pairing : nullptr, searched);
+    std::swap(pairing, searched);
     contact.assemble_rows(pairing, m_support.rows, c, g);  // C_R, g_R
     m_support.violation(c, g, u_s, v, violation);
 
@@ -165,7 +165,7 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
         lambda_i = nnls.solve(rhs);
         if (nnls.info() == Status::InvalidInput) lambda_i = Eigen::VectorXd::Constant(na, std::numeric_limits<double>::quiet_NaN());
       } else {
-        lambda_i = rom::schur_multipliers(schur, rhs, m_options.singular_tolerance, ldlt);
+        lambda_i = rom::schur_multipliers(schur, rhs, m_options.singular_tolerance);
       }
       u_hat.noalias() = u_free - z * lambda_i;
     }

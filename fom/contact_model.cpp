@@ -78,8 +78,13 @@ NodeToSegmentContact::NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const 
   }
 }
 
-Pairing NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
-                                          const Pairing* hint) const {
+void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
+                                       const Pairing* hint, Pairing& p) const {
+  if (hint == &p) {  // the hint is read while p is written
+    const Pairing copy = *hint;
+    search_rows(u_surface, rows, &copy, p);
+    return;
+  }
   const int ns = static_cast<int>(m_slave.size()), nm = static_cast<int>(m_master.size());
   // Per-thread scratch arrays: a search takes a few microseconds inside the online
   // loops, where allocating them on every call would be a visible share.
@@ -133,10 +138,9 @@ Pairing NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, cons
     block_r(b) = std::sqrt(r2);
   }
 
-  Pairing p;
   p.segment.assign(ns, -1);
   p.xi.assign(ns, 0.0);
-  p.normal = Eigen::Matrix2Xd::Zero(2, ns);
+  p.normal.setZero(2, ns);
   // Exact closest segment per slave node. Squared distances only; the segment of
   // the previous slave node is tried first (neighbouring slave nodes have
   // neighbouring pairs), then every block whose circle may hold a closer point,
@@ -184,7 +188,6 @@ Pairing NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, cons
     p.xi[k] = best_xi;
     p.normal.col(k) = ((1.0 - best_xi) * node_normal.col(best_seg) + best_xi * node_normal.col(best_seg + 1)).normalized();
   }
-  return p;
 }
 
 void NodeToSegmentContact::assemble(const Pairing& p, ConstraintMatrix& c, Eigen::VectorXd& g) const {

@@ -60,8 +60,15 @@ class ContactModel {
   /// model whose dual dictionary vanishes outside a set of rows needs only those.
   /// `hint` (may be nullptr): a nearby pairing (e.g. of the previous iterate) whose
   /// segments are tried first; it speeds the search up and never changes its result.
-  virtual Pairing search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
-                              const Pairing* hint) const = 0;
+  Pairing search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows, const Pairing* hint) const {
+    Pairing p;
+    search_rows(u_surface, rows, hint, p);
+    return p;
+  }
+  /// \brief Same, into `out`, whose storage is reused (repeated online searches do
+  /// not allocate). `hint` must not be `&out`.
+  virtual void search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows, const Pairing* hint,
+                           Pairing& out) const = 0;
 
   /// \brief Constraint operator for a pairing: C (n_c x surface dofs) and g (n_c).
   virtual void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const = 0;
@@ -91,8 +98,9 @@ class NodeToSegmentContact final : public ContactModel {
                        const std::vector<int>& master_chain, const std::vector<Eigen::Vector2d>& master_inside);
 
   bool has_pairing() const override { return true; }
-  Pairing search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
-                      const Pairing* hint) const override;
+  using ContactModel::search_rows;
+  void search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows, const Pairing* hint,
+                   Pairing& out) const override;
   void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const override;
   void assemble_rows(const Pairing& pairing, const std::vector<int>& rows, ConstraintMatrix& c,
                      Eigen::VectorXd& g) const override;
@@ -114,7 +122,10 @@ class ObstacleContact final : public ContactModel {
   /// \param weights tributary lengths (the dof of node i is i).
   ObstacleContact(const Eigen::VectorXd& x, const Eigen::VectorXd& psi, const Eigen::VectorXd& weights);
   bool has_pairing() const override { return false; }
-  Pairing search_rows(const Eigen::VectorXd&, const std::vector<int>*, const Pairing*) const override { return {}; }
+  using ContactModel::search_rows;
+  void search_rows(const Eigen::VectorXd&, const std::vector<int>*, const Pairing*, Pairing& out) const override {
+    out = Pairing{};
+  }
   void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const override;
 
  private:

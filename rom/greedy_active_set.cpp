@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <ostream>
+#include <utility>
 
 #include "fom/anderson.hpp"
 
@@ -97,8 +98,8 @@ struct GreedyActiveSet::Query {
   const Eigen::MatrixXd* k_inv = nullptr;            // K̂₀⁻¹ when offline (scaled by inv_theta)
   double inv_theta = 1.0;
   /// out = K̂⁻¹ rhs (r × n).
-  template <class Rhs>
-  void solve_stiffness(const Rhs& rhs, Eigen::MatrixXd& out) const {
+  template <class Rhs, class Out>
+  void solve_stiffness(const Rhs& rhs, Out&& out) const {
     if (k_inv)
       out.noalias() = inv_theta * (*k_inv) * rhs;
     else
@@ -196,10 +197,18 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   return res;
 }
 
-Eigen::VectorXd schur_multipliers(const Eigen::MatrixXd& schur, const Eigen::VectorXd& rhs,
-                                  double singular_tolerance, Eigen::LDLT<Eigen::MatrixXd>& ldlt) {
-  ldlt.compute(schur);
-  if (ldlt.info() == Eigen::Success && ldlt.rcond() > singular_tolerance) return ldlt.solve(rhs);
+Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur,
+                                  const Eigen::Ref<const Eigen::VectorXd>& rhs, double singular_tolerance) {
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 16, 16>;
+  thread_local Eigen::LDLT<Small> small;
+  thread_local Eigen::LDLT<Eigen::MatrixXd> large;
+  if (schur.rows() <= 16) {
+    small.compute(schur);
+    if (small.info() == Eigen::Success && small.rcond() > singular_tolerance) return small.solve(rhs);
+  } else {
+    large.compute(schur);
+    if (large.info() == Eigen::Success && large.rcond() > singular_tolerance) return large.solve(rhs);
+  }
   return schur.completeOrthogonalDecomposition().solve(rhs);
 }
 
@@ -217,13 +226,13 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
   const Eigen::VectorXd &u_free = q.u_free, &lift_s = q.lift_s;
 
   Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, g, v, violation, rhs;
+  // Ĉ_I, K̂⁻¹Ĉ_Iᵀ and S in storage that only grows: the leading |I| rows/columns are used.
   RowMajorMatrix c_hat_i;
   Eigen::MatrixXd w, schur;
   fom::ConstraintMatrix c;
-  fom::Pairing pairing;
+  fom::Pairing pairing, searched;  // the current pairing; the next one, written in place
   std::vector<int> active, solved;
   std::vector<char> in_active(m, 0);
-  Eigen::LDLT<Eigen::MatrixXd> ldlt;
   // Surface displacement of the current iterate, u_s = Φ_s û + u_off,s: the only
   // place the primal enters the contact operators.
   Eigen::VectorXd u_s = phi_s * u_hat + lift_s;
@@ -231,7 +240,8 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
   bool pending = false;  // converged in the sense of Alg. 1, to be confirmed
   for (int k = 0; k <= m_options.max_iterations; ++k) {
     // 1. Contact operators at the previous iterate, from the surface rows only.
-    pairing = contact.search_rows(u_s, &m_support.rows, k > 0 ? &pairing : nullptr);
+    contact.search_rows(u_s, &m_support.rows, k > 0 ? &pairing : nullptr, searched);
+    std::swap(pairing, searched);
     contact.assemble_rows(pairing, m_support.rows, c, g);  // C_R, g_R
     if (pending) {
       // Alg. 1 found no change and a settled û^k, but judged û^k with the operators
@@ -247,8 +257,10 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
     }
     if (k == m_options.max_iterations) break;
     const int na = static_cast<int>(active.size());
-    c_hat_i.resize(na, r);
-    rhs.resize(na);
+    if (c_hat_i.rows() < na) {
+      const int cap = std::max(2 * static_cast<int>(c_hat_i.rows()), std::max(na, 4));
+      c_hat_i.resize(cap, r), w.resize(r, cap), schur.resize(cap, cap), rhs.resize(cap);
+    }
     // Rows of Ĉ_I = D_Iᵀ C_R Φ_s and entries of ĝ_I = D_Iᵀ (g_R − C_R u_off,s), from
     // the rows where each selected column is non-zero.
     for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], c, g, phi_s_rows, lift_s, c_hat_i.row(i));
@@ -259,11 +271,14 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
       u_hat = u_free;
       lambda_i.resize(0);
     } else {
-      q.solve_stiffness(c_hat_i.transpose(), w);  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
-      schur.noalias() = c_hat_i * w;
-      rhs = c_hat_i * u_free - rhs;  // Ĉ_I K̂⁻¹ f̂ − ĝ_I
-      lambda_i = schur_multipliers(schur, rhs, m_options.singular_tolerance, ldlt);  // |I| > r: min-norm
-      u_hat.noalias() = u_free - w * lambda_i;
+      const auto c_hat = c_hat_i.topRows(na);
+      auto w_i = w.leftCols(na);
+      q.solve_stiffness(c_hat.transpose(), w_i);  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
+      schur.topLeftCorner(na, na).noalias() = c_hat * w_i;
+      for (int i = 0; i < na; ++i) rhs(i) = c_hat.row(i).dot(u_free) - rhs(i);  // Ĉ_I K̂⁻¹ f̂ − ĝ_I
+      // |I| > r: min-norm
+      lambda_i = schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), m_options.singular_tolerance);
+      u_hat.noalias() = u_free - w_i * lambda_i;
     }
     solved = active;
     res.iterations = k + 1;
@@ -323,7 +338,6 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
   const RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
   const Eigen::MatrixXd& dr = m_support.basis;  // D_d on the support rows R, |R| × m
   const int r = m_model.primal_rank(), m = m_model.dictionary_size();
-  const int nr = static_cast<int>(m_support.rows.size());
   const Eigen::VectorXd &u_free = q.u_free, &lift_s = q.lift_s;
 
   // A selected column p with the operators frozen: its row Ĉ_p = d_pᵀ A of Ĉ_I,
@@ -335,28 +349,29 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
     Eigen::MatrixXd w;  // r × 1
     Eigen::VectorXd z;
   };
-  std::vector<Column> cols;
+  std::vector<Column> cols, spare;  // selected columns; removed ones, kept for their storage
   RowMajorMatrix a;  // A = C_R Φ_s (|R| × r)
   Eigen::VectorXd b;       // C_R u_off,s − g_R: A û + b is the gap on R
   Eigen::VectorXd v_free;  // every column's violation at u_free, D_Rᵀ (A u_free + b)
   Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x = u_free, u_hat = u_free, g;
   Eigen::MatrixXd schur;
-  Eigen::LDLT<Eigen::MatrixXd> ldlt;
   fom::ConstraintMatrix c;
-  fom::Pairing pairing;
+  fom::Pairing pairing, searched;  // the current pairing; the next one, written in place
   Eigen::VectorXd u_s;
   std::vector<char> in_active(m, 0);
   std::vector<int> solved, key;
-  std::vector<std::vector<int>> seen;  // selections met on the current operators
+  std::vector<int> seen, seen_start;  // selections met on the current operators, one after the other
   fom::AndersonMixer mixer(m_options.anderson_depth);
 
-  auto make_column = [&](int p) {
-    Column col{p, Eigen::RowVectorXd::Zero(r), {}, {}};
+  // Fills `col` for dictionary column p on the current operators (its vectors keep
+  // their storage from one rebuild to the next).
+  auto make_column = [&](Column& col, int p) {
+    col.p = p;
+    col.c_hat.setZero(r);
     for (int i : m_support.column_support[static_cast<size_t>(p)]) col.c_hat.noalias() += dr(i, p) * a.row(i);
     q.solve_stiffness(col.c_hat.transpose(), col.w);
     aw.noalias() = a * col.w.col(0);
     col.z.noalias() = dr.transpose() * aw;
-    return col;
   };
 
   bool pending = false;  // settled: to be confirmed at the fresh pairing of û
@@ -365,51 +380,44 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
     // 1. Operators at x (surface rows only), A = C_R Φ_s and b.
     u_s.noalias() = phi_s * x;
     u_s += lift_s;
-    pairing = contact.search_rows(u_s, &m_support.rows, rebuild > 0 ? &pairing : nullptr);
+    contact.search_rows(u_s, &m_support.rows, rebuild > 0 ? &pairing : nullptr, searched);
+    std::swap(pairing, searched);
     contact.assemble_rows(pairing, m_support.rows, c, g);  // C_R, g_R
-    a.setZero(nr, r);
-    b.resize(nr);
-    for (int i = 0; i < nr; ++i) {
-      double acc = -g(i);
-      for (fom::ConstraintMatrix::InnerIterator it(c, i); it; ++it) {
-        a.row(i).noalias() += it.value() * phi_s_rows.row(it.col());
-        acc += it.value() * lift_s(it.col());
-      }
-      b(i) = acc;
-    }
     if (pending) {  // x = û: is every column (selected ones included) within τ here?
-      gap.noalias() = a * x;
-      gap += b;
-      violation.noalias() = dr.transpose() * gap;
+      m_support.violation(c, g, u_s, gap, violation);
       if (confirmed(violation)) {
         res.converged = true;
         break;
       }
       pending = false;
     }
+    m_support.gap_operator(c, g, phi_s_rows, lift_s, a, b);  // A = C_R Φ_s, b = C_R u_off,s − g_R
     if (rebuild == m_options.max_iterations || solves >= m_options.max_solves) break;
     gap.noalias() = a * u_free;
     gap += b;
     v_free.noalias() = dr.transpose() * gap;
-    for (auto& col : cols) col = make_column(col.p);
+    for (auto& col : cols) make_column(col, col.p);
 
     // 2–3. One-change steps on the frozen operators until nothing changes, a
     //      selection comes back (cycle) or the solve cap is reached.
     bool changed = false;
     seen.clear();
+    seen_start.assign(1, 0);
     while (solves < m_options.max_solves) {
       const int na = static_cast<int>(cols.size());
       u_hat = u_free;
       violation = v_free;
       lambda_i.resize(na);
       if (na > 0) {
-        schur.resize(na, na);
-        rhs.resize(na);
+        if (schur.rows() < na) {  // storage that only grows; the leading |I| entries are used
+          const int cap = std::max(2 * static_cast<int>(schur.rows()), std::max(na, 4));
+          schur.resize(cap, cap), rhs.resize(cap);
+        }
         for (int i = 0; i < na; ++i) {
           rhs(i) = v_free(cols[i].p);  // Ĉ_i u_free − ĝ_i
           for (int j = 0; j <= i; ++j) schur(i, j) = schur(j, i) = cols[i].c_hat.dot(cols[j].w.col(0));
         }
-        lambda_i = schur_multipliers(schur, rhs, m_options.singular_tolerance, ldlt);
+        lambda_i = schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), m_options.singular_tolerance);
         for (int i = 0; i < na; ++i) {
           u_hat.noalias() -= lambda_i(i) * cols[i].w.col(0);
           violation.noalias() -= lambda_i(i) * cols[i].z;
@@ -445,10 +453,14 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
       }
       if (remove >= 0) {
         in_active[cols[remove].p] = 0;
+        spare.push_back(std::move(cols[remove]));
         cols.erase(cols.begin() + remove);
       } else if (add >= 0) {
         in_active[add] = 1;
-        cols.push_back(make_column(add));
+        if (spare.empty()) spare.emplace_back();
+        cols.push_back(std::move(spare.back()));
+        spare.pop_back();
+        make_column(cols.back(), add);
       } else {
         break;
       }
@@ -456,8 +468,12 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
       key.clear();
       for (const auto& col : cols) key.push_back(col.p);
       std::sort(key.begin(), key.end());
-      if (std::find(seen.begin(), seen.end(), key) != seen.end()) break;  // cycle: rebuild the operators
-      seen.push_back(key);
+      bool cycle = false;  // this selection was met before on these operators
+      for (size_t e = 0; e + 1 < seen_start.size() && !cycle; ++e)
+        cycle = std::equal(key.begin(), key.end(), seen.begin() + seen_start[e], seen.begin() + seen_start[e + 1]);
+      if (cycle) break;  // rebuild the operators
+      seen.insert(seen.end(), key.begin(), key.end());
+      seen_start.push_back(static_cast<int>(seen.size()));
     }
     if (res.status != Status::Success) break;
 

@@ -137,11 +137,12 @@ class GreedyActiveSet final : public OnlineSolver {
 double greedy_threshold(const ReducedModel& model, const GreedyOptions& options);
 
 /// \brief Multipliers of the reduced saddle-point system from its Schur complement
-/// S (|I| × |I|): S⁻¹ rhs by `ldlt` (which keeps the factorisation), or — when S is
-/// numerically singular (LDLᵀ failure or reciprocal condition ≤ `singular_tolerance`,
-/// e.g. dependent rows) — the least-squares, minimum-norm solution.
-Eigen::VectorXd schur_multipliers(const Eigen::MatrixXd& schur, const Eigen::VectorXd& rhs,
-                                  double singular_tolerance, Eigen::LDLT<Eigen::MatrixXd>& ldlt);
+/// S (|I| × |I|): S⁻¹ rhs by LDLᵀ, or — when S is numerically singular (LDLᵀ failure
+/// or reciprocal condition ≤ `singular_tolerance`, e.g. dependent rows) — the
+/// least-squares, minimum-norm solution. The factorisation lives in per-thread
+/// storage of fixed size while |I| ≤ 16, so the online steps do not allocate it.
+Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur,
+                                  const Eigen::Ref<const Eigen::VectorXd>& rhs, double singular_tolerance);
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
 /// step_tolerance, and the extra keys schedule = interleaved|nested, anderson_depth,

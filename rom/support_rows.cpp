@@ -26,6 +26,28 @@ void SupportRows::violation(const fom::ConstraintMatrix& c_r, const Eigen::Vecto
   out.noalias() = basis.transpose() * gap;
 }
 
+void SupportRows::gap_operator(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
+                               const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s, RowMajorMatrix& a,
+                               Eigen::VectorXd& b) const {
+  // Plain loops, as in reduced_row().
+  const Eigen::Index r = phi_s.cols(), nr = c_r.rows();
+  a.setZero(nr, r);
+  b.resize(nr);
+  const int* outer = c_r.outerIndexPtr();
+  const int* inner = c_r.innerIndexPtr();
+  const double* value = c_r.valuePtr();
+  for (Eigen::Index i = 0; i < nr; ++i) {
+    double* out = a.data() + i * r;
+    double acc = -g_r(i);
+    for (int e = outer[i]; e < outer[i + 1]; ++e) {
+      const double* row = phi_s.data() + static_cast<Eigen::Index>(inner[e]) * r;
+      for (Eigen::Index t = 0; t < r; ++t) out[t] += value[e] * row[t];
+      acc += value[e] * lift_s(inner[e]);
+    }
+    b(i) = acc;
+  }
+}
+
 double SupportRows::reduced_row(int p, const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
                                 const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s,
                                 Eigen::Ref<Eigen::RowVectorXd> c_hat) const {

@@ -32,6 +32,11 @@ struct SupportRows {
   void violation(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r, const Eigen::VectorXd& u_surface,
                  Eigen::VectorXd& gap, Eigen::VectorXd& out) const;
 
+  /// \brief \f$ A = C_R \Phi_s \f$ (|R| × r) and \f$ b = C_R u_{off,s} - g_R \f$, so that
+  /// \f$ A\hat u + b \f$ is the gap on R at \f$ \hat u \f$. O(nnz(C_R) · r).
+  void gap_operator(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r, const RowMajorMatrix& phi_s,
+                    const Eigen::VectorXd& lift_s, RowMajorMatrix& a, Eigen::VectorXd& b) const;
+
   /// \brief Row p of the reduced operators from C_R and g_R:
   /// \f$ \hat C_p = w_p^T C_R \Phi_s \f$ into `c_hat` (size r) and the return value
   /// \f$ \hat g_p = w_p^T (g_R - C_R u_{off,s}) \f$. O(nnz(w_p) · 6 · r).
