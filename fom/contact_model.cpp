@@ -96,33 +96,24 @@ void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const s
   xm = m_master_x;
   for (int j = 0; j < nm; ++j) xm.col(j) += u_surface.segment<2>(2 * (ns + j));
 
-  // Nodal normals of the deformed master surface (average of the adjacent
-  // segments' outward normals): interpolating them along a segment gives a
-  // normal field that is continuous across master nodes, so the constraint row
-  // does not jump when a slave node passes from one segment to the next.
+  // Segment data for the distances: tangent t, midpoint, 1/|t|² and the radius of a
+  // circle about the midpoint holding the segment (½(|t_x|+|t_y|) ≥ ½|t|, no root).
   const int nseg = std::max(nm - 1, 0);
-  Eigen::Matrix2Xd& node_normal = scratch.node_normal;
   Eigen::Matrix2Xd& seg_t = scratch.seg_t;
   Eigen::Matrix2Xd& mid = scratch.mid;
   Eigen::VectorXd& inv_len2 = scratch.inv_len2;
   Eigen::VectorXd& half = scratch.half;
-  node_normal.setZero(2, nm);
   seg_t.resize(2, nseg);
   mid.resize(2, nseg);
   inv_len2.resize(nseg);
   half.resize(nseg);
   for (int j = 0; j < nseg; ++j) {
     const Eigen::Vector2d t = xm.col(j + 1) - xm.col(j);
-    const double len = t.norm();
-    const Eigen::Vector2d n = (m_orientation[j] / len) * Eigen::Vector2d(t.y(), -t.x());
-    node_normal.col(j) += n;
-    node_normal.col(j + 1) += n;
     seg_t.col(j) = t;
     mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
-    inv_len2(j) = 1.0 / (len * len);
-    half(j) = 0.5 * len;
+    inv_len2(j) = 1.0 / t.squaredNorm();
+    half(j) = 0.5 * (std::abs(t.x()) + std::abs(t.y()));
   }
-  for (int j = 0; j < nm; ++j) node_normal.col(j).normalize();
   // Bounding circles of blocks of m_block consecutive segments (centre, radius):
   // a block is skipped when its circle is farther than the best distance found.
   const int nblock = (nseg + m_block - 1) / m_block;
@@ -146,7 +137,7 @@ void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const s
   // neighbouring pairs), then every block whose circle may hold a closer point,
   // then within it every segment whose circle (centre mid, radius half) may.
   // Ties (a slave node exactly at a master node) go to the lower segment index.
-  int guess = 0;
+  int guess = 0, lowest = nseg, highest = -1;
   const int nrows = rows ? static_cast<int>(rows->size()) : ns;
   for (int r = 0; r < nrows; ++r) {
     const int k = rows ? (*rows)[r] : r;
@@ -186,7 +177,31 @@ void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const s
     if (best_seg < 0 || (best_seg == 0 && best_raw < 0.0) || (best_seg == nm - 2 && best_raw > 1.0)) continue;
     p.segment[k] = best_seg;
     p.xi[k] = best_xi;
-    p.normal.col(k) = ((1.0 - best_xi) * node_normal.col(best_seg) + best_xi * node_normal.col(best_seg + 1)).normalized();
+    lowest = std::min(lowest, best_seg);
+    highest = std::max(highest, best_seg);
+  }
+  if (highest < 0) return;
+
+  // Nodal normals of the deformed master surface (average of the adjacent
+  // segments' outward normals) where rows are paired, nodes lowest … highest+1:
+  // interpolating them along a segment gives a normal field that is continuous
+  // across master nodes, so the constraint row does not jump when a slave node
+  // passes from one segment to the next.
+  Eigen::Matrix2Xd& node_normal = scratch.node_normal;
+  node_normal.resize(2, nm);
+  node_normal.middleCols(lowest, highest + 2 - lowest).setZero();
+  for (int j = std::max(lowest - 1, 0); j <= std::min(highest + 1, nseg - 1); ++j) {
+    const Eigen::Vector2d t = seg_t.col(j);
+    const Eigen::Vector2d n = (m_orientation[j] / t.norm()) * Eigen::Vector2d(t.y(), -t.x());
+    if (j >= lowest) node_normal.col(j) += n;
+    if (j + 1 <= highest + 1) node_normal.col(j + 1) += n;
+  }
+  for (int j = lowest; j <= highest + 1; ++j) node_normal.col(j).normalize();
+  for (int r = 0; r < nrows; ++r) {
+    const int k = rows ? (*rows)[r] : r, j = p.segment[k];
+    if (j < 0) continue;
+    const double xi = p.xi[k];
+    p.normal.col(k) = ((1.0 - xi) * node_normal.col(j) + xi * node_normal.col(j + 1)).normalized();
   }
 }
 
