@@ -4,6 +4,36 @@
 
 namespace contactrom::rom {
 
+namespace {
+
+/// out (r) = (Assign) or += scale · Σ_e value[e] Φ_s.row(inner[e]) over one
+/// compressed row of C_R, by plain loops (the vectors are short: expression set-up
+/// per entry would cost as much as the arithmetic); a node-to-segment row (six
+/// entries) in one pass.
+template <bool Assign>
+void row_times_basis(double scale, const double* value, const int* inner, int nnz, const RowMajorMatrix& phi_s,
+                     double* out) {
+  const Eigen::Index r = phi_s.cols();
+  if (nnz == 6) {
+    const double* q[6];
+    double v[6];
+    for (int f = 0; f < 6; ++f) q[f] = phi_s.data() + static_cast<Eigen::Index>(inner[f]) * r, v[f] = scale * value[f];
+    for (Eigen::Index t = 0; t < r; ++t) {
+      const double sum = v[0] * q[0][t] + v[1] * q[1][t] + v[2] * q[2][t] + v[3] * q[3][t] + v[4] * q[4][t] + v[5] * q[5][t];
+      out[t] = Assign ? sum : out[t] + sum;
+    }
+    return;
+  }
+  if (Assign) std::fill(out, out + r, 0.0);
+  for (int f = 0; f < nnz; ++f) {
+    const double a = scale * value[f];
+    const double* row = phi_s.data() + static_cast<Eigen::Index>(inner[f]) * r;
+    for (Eigen::Index t = 0; t < r; ++t) out[t] += a * row[t];
+  }
+}
+
+}  // namespace
+
 SupportRows::SupportRows(const Eigen::MatrixXd& w) {
   for (Eigen::Index s = 0; s < w.rows(); ++s)
     if ((w.row(s).array() != 0.0).any()) rows.push_back(static_cast<int>(s));
@@ -29,21 +59,16 @@ void SupportRows::violation(const fom::ConstraintMatrix& c_r, const Eigen::Vecto
 void SupportRows::gap_operator(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
                                const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s, RowMajorMatrix& a,
                                Eigen::VectorXd& b) const {
-  // Plain loops, as in reduced_row().
   const Eigen::Index r = phi_s.cols(), nr = c_r.rows();
-  a.setZero(nr, r);
+  a.resize(nr, r);
   b.resize(nr);
   const int* outer = c_r.outerIndexPtr();
   const int* inner = c_r.innerIndexPtr();
   const double* value = c_r.valuePtr();
   for (Eigen::Index i = 0; i < nr; ++i) {
-    double* out = a.data() + i * r;
+    row_times_basis<true>(1.0, value + outer[i], inner + outer[i], outer[i + 1] - outer[i], phi_s, a.data() + i * r);
     double acc = -g_r(i);
-    for (int e = outer[i]; e < outer[i + 1]; ++e) {
-      const double* row = phi_s.data() + static_cast<Eigen::Index>(inner[e]) * r;
-      for (Eigen::Index t = 0; t < r; ++t) out[t] += value[e] * row[t];
-      acc += value[e] * lift_s(inner[e]);
-    }
+    for (int e = outer[i]; e < outer[i + 1]; ++e) acc += value[e] * lift_s(inner[e]);
     b(i) = acc;
   }
 }
@@ -51,24 +76,16 @@ void SupportRows::gap_operator(const fom::ConstraintMatrix& c_r, const Eigen::Ve
 double SupportRows::reduced_row(int p, const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
                                 const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s,
                                 Eigen::Ref<Eigen::RowVectorXd> c_hat) const {
-  // Plain loops over the compressed rows: the vectors are short (r), where the
-  // set-up of an expression per entry would cost as much as the arithmetic.
-  const Eigen::Index r = phi_s.cols();
-  double* out = c_hat.data();
-  std::fill(out, out + r, 0.0);
+  c_hat.setZero();
   const int* outer = c_r.outerIndexPtr();
   const int* inner = c_r.innerIndexPtr();
   const double* value = c_r.valuePtr();
   double g_hat = 0.0;
   for (int i : column_support[static_cast<size_t>(p)]) {
     const double wi = basis(i, p);
+    row_times_basis<false>(wi, value + outer[i], inner + outer[i], outer[i + 1] - outer[i], phi_s, c_hat.data());
     double acc = g_r(i);
-    for (int e = outer[i]; e < outer[i + 1]; ++e) {
-      const double a = wi * value[e];
-      const double* row = phi_s.data() + static_cast<Eigen::Index>(inner[e]) * r;
-      for (Eigen::Index t = 0; t < r; ++t) out[t] += a * row[t];
-      acc -= value[e] * lift_s(inner[e]);
-    }
+    for (int e = outer[i]; e < outer[i + 1]; ++e) acc -= value[e] * lift_s(inner[e]);
     g_hat += wi * acc;
   }
   return g_hat;
