@@ -391,8 +391,8 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
       }
       pending = false;
     }
-    m_support.gap_operator(c, g, phi_s_rows, lift_s, a, b);  // A = C_R Φ_s, b = C_R u_off,s − g_R
     if (rebuild == m_options.max_iterations || solves >= m_options.max_solves) break;
+    m_support.gap_operator(c, g, phi_s_rows, lift_s, a, b);  // A = C_R Φ_s, b = C_R u_off,s − g_R
     gap.noalias() = a * u_free;
     gap += b;
     v_free.noalias() = dr.transpose() * gap;
