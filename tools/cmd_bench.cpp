@@ -113,6 +113,9 @@ void run_bench(const BenchArgs& a) {
     if (!j.contains(k)) continue;
     ratios["fom_active_set/" + k] = t_fom / j[k].get<double>();
     if (k != "rom_greedy" && j.contains("rom_greedy")) ratios[k + "/rom_greedy"] = j[k].get<double>() / j["rom_greedy"].get<double>();
+    // The baselines against the nested greedy schedule as well.
+    if (k.rfind("rom_greedy", 0) != 0 && j.contains("rom_greedy_nested"))
+      ratios[k + "/rom_greedy_nested"] = j[k].get<double>() / j["rom_greedy_nested"].get<double>();
   }
   j["ratios"] = ratios;
   if (a.json) {

@@ -9,6 +9,7 @@
 #include <boost/test/unit_test.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -134,6 +135,30 @@ BOOST_AUTO_TEST_CASE(bench_with_the_fom_reference) {
     BOOST_TEST(j["methods"][m]["nonconverged"] == 0);
   }
   BOOST_TEST(j["methods"]["cpg"]["basis_time_s"].get<double>() >= 0.0);
+}
+
+BOOST_AUTO_TEST_CASE(bench_reports_every_method_and_consistent_ratios) {
+  // `contactrom bench` on rope (tiny): every registered ROM and both FOM solvers are
+  // timed in the one run, and every ratio is the quotient of the two medians it names
+  // (no assertion on the times themselves: they are benchmarks, not tests).
+  const json j = run_json("bench --problem rope --repeats 1 --queries 3 --ipopt-queries 1");
+  for (const char* k : {"fom_active_set", "fom_ipopt", "rom_greedy", "rom_greedy_nested", "rom_cpg",
+                        "rom_full_dictionary", "rom_convex_hull"})
+    BOOST_TEST((j.contains(k) && j[k].get<double>() > 0.0), k);
+  const json& ratios = j["ratios"];
+  for (const char* k : {"fom_active_set/rom_greedy", "fom_active_set/rom_greedy_nested", "rom_cpg/rom_greedy",
+                        "rom_cpg/rom_greedy_nested", "rom_greedy_nested/rom_greedy", "fom_ipopt/fom_active_set"})
+    BOOST_TEST(ratios.contains(k), k);
+  int checked = 0;
+  for (auto it = ratios.begin(); it != ratios.end(); ++it) {
+    const std::string key = it.key();
+    const size_t slash = key.find('/');
+    BOOST_REQUIRE(slash != std::string::npos);
+    const double expected = j[key.substr(0, slash)].get<double>() / j[key.substr(slash + 1)].get<double>();
+    BOOST_TEST(std::abs(it.value().get<double>() - expected) <= 1e-12 * expected, key);
+    ++checked;
+  }
+  BOOST_TEST(checked >= 6);
 }
 
 BOOST_AUTO_TEST_CASE(online_runs_cpg_and_full_dictionary) {
