@@ -67,19 +67,9 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   rom::OnlineResult res;
   res.mu = mu;
 
-  // K̂(μ)⁻¹ as in the greedy: the offline Cholesky factor when K̂(μ) = θ₀(μ) K̂₀.
-  Eigen::LLT<Eigen::MatrixXd> local;
-  const Eigen::LLT<Eigen::MatrixXd>* llt = m_model.single_term_factor();
-  const Eigen::MatrixXd* k_inv = nullptr;  // K̂₀⁻¹, offline
-  double inv_theta = 1.0;
-  if (llt) {
-    inv_theta = 1.0 / problem.stiffness_coefficients(mu)(0);
-    k_inv = m_model.single_term_inverse();
-  } else {
-    local.compute(m_model.reduced_stiffness(mu));
-    llt = &local;
-  }
-  if (llt->info() != Eigen::Success || !std::isfinite(inv_theta)) {
+  // K̂(μ)⁻¹ as in the greedy: the offline factor when K̂(μ) = θ₀(μ) K̂₀.
+  const rom::ReducedStiffnessInverse k_inv(m_model, mu);
+  if (!k_inv.ok()) {
     res.status = Status::NumericalIssue;
     res.message = "Cholesky factorisation of the reduced stiffness failed";
     res.u_hat = Eigen::VectorXd::Zero(r);
@@ -91,14 +81,13 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
 
   const Eigen::VectorXd f_hat = m_model.reduced_rhs(mu);
   const Eigen::VectorXd lift_s = m_model.surface_lifting(mu);
-  const Eigen::VectorXd u_free = inv_theta * llt->solve(f_hat);
+  const Eigen::VectorXd u_free = k_inv.solve(f_hat);
 
   const rom::RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
-  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, u_s, g, v, violation, rhs;
+  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, u_s, v, violation, rhs;
   rom::RowMajorMatrix c_hat_i;
   Eigen::MatrixXd z, schur;
-  fom::ConstraintMatrix c;
-  fom::Pairing pairing, searched;  // the current pairing; the next one, written in place
+  rom::SupportOperators ops;  // pairing, C_R and g_R at the current û
   std::vector<int> active, next, solved;  // positions in W
   std::vector<char> in_active(mw, 0);
   rom::NnlsQp nnls(m_options.nnls);
@@ -110,10 +99,8 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
     //    column, Ĉû − ĝ = Wᵀ(C_s u_s − g).
     u_s.noalias() = phi_s * u_hat;
     u_s += lift_s;
-    contact.search_rows(u_s, &m_support.rows, k > 0 ? &pairing : nullptr, searched);
-    std::swap(pairing, searched);
-    contact.assemble_rows(pairing, m_support.rows, c, g);  // C_R, g_R
-    m_support.violation(c, g, u_s, v, violation);
+    ops.rebuild(contact, m_support, u_s);
+    m_support.violation(ops.c, ops.g, u_s, v, violation);
 
     // 2. Primal–dual update: drop the columns whose multiplier left the cone, add every
     //    violated column. With the non-negative inner solve a zero multiplier on a
@@ -151,11 +138,8 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
       rhs.resize(na);
       // Rows of Ĉ_I = W_Iᵀ C_R Φ_s and entries of ĝ_I = W_Iᵀ (g_R − C_R u_lift,s),
       // as in the greedy: from the rows where each active column is non-zero.
-      for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], c, g, phi_s_rows, lift_s, c_hat_i.row(i));
-      if (k_inv)
-        z.noalias() = inv_theta * (*k_inv) * c_hat_i.transpose();  // K̂⁻¹ Ĉ_Iᵀ
-      else
-        z = inv_theta * llt->solve(c_hat_i.transpose());
+      for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], ops.c, ops.g, phi_s_rows, lift_s, c_hat_i.row(i));
+      k_inv.apply(c_hat_i.transpose(), z);  // K̂⁻¹ Ĉ_Iᵀ
       schur.noalias() = c_hat_i * z;
       rhs = c_hat_i * u_free - rhs;
       if (nonnegative) {

@@ -94,17 +94,8 @@ GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& optio
 
 /// Per-query quantities shared by both schedules.
 struct GreedyActiveSet::Query {
-  const Eigen::LLT<Eigen::MatrixXd>* llt = nullptr;  // factor of K̂ (or of K̂₀, scaled by inv_theta)
-  const Eigen::MatrixXd* k_inv = nullptr;            // K̂₀⁻¹ when offline (scaled by inv_theta)
-  double inv_theta = 1.0;
-  /// out = K̂⁻¹ rhs (r × n).
-  template <class Rhs, class Out>
-  void solve_stiffness(const Rhs& rhs, Out&& out) const {
-    if (k_inv)
-      out.noalias() = inv_theta * (*k_inv) * rhs;
-    else
-      out = inv_theta * llt->solve(rhs);
-  }
+  Query(const ReducedModel& model, const fom::Param& mu) : k_inv(model, mu) {}
+  ReducedStiffnessInverse k_inv;  // K̂(μ)⁻¹
   Eigen::VectorXd lift_s;  // surface lifting u_off,s(μ)
   Eigen::VectorXd u_free;  // unconstrained reduced solution K̂⁻¹ f̂
   // Outcome, filled by the schedule: final û, the selection and its multipliers.
@@ -144,25 +135,15 @@ struct GreedyActiveSet::Query {
 OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
-  const fom::Problem& problem = m_model.problem();
   const int r = m_model.primal_rank(), nc = static_cast<int>(m_model.dictionary().rows());
 
   OnlineResult res;
   res.mu = mu;
 
-  // K̂(μ)⁻¹ through the offline Cholesky factor when K̂(μ) = θ₀(μ) K̂₀, else a
-  // per-query factorisation of the r × r matrix.
-  Query q;
-  Eigen::LLT<Eigen::MatrixXd> local;
-  q.llt = m_model.single_term_factor();
-  if (q.llt) {
-    q.inv_theta = 1.0 / problem.stiffness_coefficients(mu)(0);
-    q.k_inv = m_model.single_term_inverse();
-  } else {
-    local.compute(m_model.reduced_stiffness(mu));
-    q.llt = &local;
-  }
-  if (q.llt->info() != Eigen::Success || !std::isfinite(q.inv_theta)) {
+  // K̂(μ)⁻¹ through the offline factor when K̂(μ) = θ₀(μ) K̂₀, else a per-query
+  // factorisation of the r × r matrix.
+  Query q(m_model, mu);
+  if (!q.k_inv.ok()) {
     res.status = Status::NumericalIssue;
     res.message = "Cholesky factorisation of the reduced stiffness failed";
     res.u_hat = Eigen::VectorXd::Zero(r);
@@ -172,7 +153,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
     return res;
   }
   q.lift_s = m_model.surface_lifting(mu);
-  q.u_free = q.inv_theta * q.llt->solve(m_model.reduced_rhs(mu));
+  q.u_free = q.k_inv.solve(m_model.reduced_rhs(mu));
 
   if (m_options.schedule == GreedySchedule::Nested)
     solve_nested(q, res);
@@ -225,12 +206,11 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
   const int r = m_model.primal_rank(), m = m_model.dictionary_size();
   const Eigen::VectorXd &u_free = q.u_free, &lift_s = q.lift_s;
 
-  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, g, v, violation, rhs;
+  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, v, violation, rhs;
   // Ĉ_I, K̂⁻¹Ĉ_Iᵀ and S in storage that only grows: the leading |I| rows/columns are used.
   RowMajorMatrix c_hat_i;
   Eigen::MatrixXd w, schur;
-  fom::ConstraintMatrix c;
-  fom::Pairing pairing, searched;  // the current pairing; the next one, written in place
+  SupportOperators ops;  // pairing, C_R and g_R at the previous iterate
   std::vector<int> active, solved;
   std::vector<char> in_active(m, 0);
   // Surface displacement of the current iterate, u_s = Φ_s û + u_off,s: the only
@@ -240,15 +220,13 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
   bool pending = false;  // converged in the sense of Alg. 1, to be confirmed
   for (int k = 0; k <= m_options.max_iterations; ++k) {
     // 1. Contact operators at the previous iterate, from the surface rows only.
-    contact.search_rows(u_s, &m_support.rows, k > 0 ? &pairing : nullptr, searched);
-    std::swap(pairing, searched);
-    contact.assemble_rows(pairing, m_support.rows, c, g);  // C_R, g_R
+    ops.rebuild(contact, m_support, u_s);
     if (pending) {
       // Alg. 1 found no change and a settled û^k, but judged û^k with the operators
       // of û^{k−1}. Confirm at the pairing of û^k itself that no dictionary column
       // is violated by more than τ (selected columns included), so the returned
       // solution meets the reduced constraint at its own pairing; else go on.
-      m_support.violation(c, g, u_s, v, violation);
+      m_support.violation(ops.c, ops.g, u_s, v, violation);
       if (confirmed(violation)) {
         res.converged = true;
         break;
@@ -263,7 +241,7 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
     }
     // Rows of Ĉ_I = D_Iᵀ C_R Φ_s and entries of ĝ_I = D_Iᵀ (g_R − C_R u_off,s), from
     // the rows where each selected column is non-zero.
-    for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], c, g, phi_s_rows, lift_s, c_hat_i.row(i));
+    for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], ops.c, ops.g, phi_s_rows, lift_s, c_hat_i.row(i));
 
     // 2. Saddle-point system by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ.
     u_prev = u_hat;
@@ -273,7 +251,7 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
     } else {
       const auto c_hat = c_hat_i.topRows(na);
       auto w_i = w.leftCols(na);
-      q.solve_stiffness(c_hat.transpose(), w_i);  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
+      q.k_inv.apply(c_hat.transpose(), w_i);  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
       schur.topLeftCorner(na, na).noalias() = c_hat * w_i;
       for (int i = 0; i < na; ++i) rhs(i) = c_hat.row(i).dot(u_free) - rhs(i);  // Ĉ_I K̂⁻¹ f̂ − ĝ_I
       // |I| > r: min-norm
@@ -302,7 +280,7 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
     } else {
       // Ĉ û − ĝ for every column = D_dᵀ (C_s u_s − g), from the support rows, with
       // the operators of step 1.
-      m_support.violation(c, g, u_s, v, violation);
+      m_support.violation(ops.c, ops.g, u_s, v, violation);
       if (m > 0) max_violation = violation.maxCoeff();
       if (m_options.best_iterate_on_failure) q.offer(max_violation, u_hat, lambda_i, solved);
       const int add = most_violated(violation, in_active, m_threshold);
@@ -353,10 +331,9 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
   RowMajorMatrix a;  // A = C_R Φ_s (|R| × r)
   Eigen::VectorXd b;       // C_R u_off,s − g_R: A û + b is the gap on R
   Eigen::VectorXd v_free;  // every column's violation at u_free, D_Rᵀ (A u_free + b)
-  Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x = u_free, u_hat = u_free, g;
+  Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x = u_free, u_hat = u_free;
   Eigen::MatrixXd schur;
-  fom::ConstraintMatrix c;
-  fom::Pairing pairing, searched;  // the current pairing; the next one, written in place
+  SupportOperators ops;  // pairing, C_R and g_R at the rebuild point x
   Eigen::VectorXd u_s;
   std::vector<char> in_active(m, 0);
   std::vector<int> solved, key;
@@ -369,7 +346,7 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
     col.p = p;
     col.c_hat.setZero(r);
     for (int i : m_support.column_support[static_cast<size_t>(p)]) col.c_hat.noalias() += dr(i, p) * a.row(i);
-    q.solve_stiffness(col.c_hat.transpose(), col.w);
+    q.k_inv.apply(col.c_hat.transpose(), col.w);
     aw.noalias() = a * col.w.col(0);
     col.z.noalias() = dr.transpose() * aw;
   };
@@ -380,11 +357,9 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
     // 1. Operators at x (surface rows only), A = C_R Φ_s and b.
     u_s.noalias() = phi_s * x;
     u_s += lift_s;
-    contact.search_rows(u_s, &m_support.rows, rebuild > 0 ? &pairing : nullptr, searched);
-    std::swap(pairing, searched);
-    contact.assemble_rows(pairing, m_support.rows, c, g);  // C_R, g_R
+    ops.rebuild(contact, m_support, u_s);
     if (pending) {  // x = û: is every column (selected ones included) within τ here?
-      m_support.violation(c, g, u_s, gap, violation);
+      m_support.violation(ops.c, ops.g, u_s, gap, violation);
       if (confirmed(violation)) {
         res.converged = true;
         break;
@@ -392,7 +367,7 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
       pending = false;
     }
     if (rebuild == m_options.max_iterations || solves >= m_options.max_solves) break;
-    m_support.gap_operator(c, g, phi_s_rows, lift_s, a, b);  // A = C_R Φ_s, b = C_R u_off,s − g_R
+    m_support.gap_operator(ops.c, ops.g, phi_s_rows, lift_s, a, b);  // A = C_R Φ_s, b = C_R u_off,s − g_R
     gap.noalias() = a * u_free;
     gap += b;
     v_free.noalias() = dr.transpose() * gap;

@@ -2,6 +2,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <chrono>
+#include <cmath>
 
 #include "rom/pod.hpp"
 
@@ -130,6 +131,18 @@ Eigen::VectorXd ReducedModel::reduced_rhs(const fom::Param& mu) const {
   Eigen::VectorXd f = m_f_hat * phi;
   for (size_t q = 0; q < m_kl_hat.size(); ++q) f.noalias() -= theta(q) * (m_kl_hat[q] * phi);
   return f;
+}
+
+ReducedStiffnessInverse::ReducedStiffnessInverse(const ReducedModel& model, const fom::Param& mu)
+    : m_factor(model.single_term_factor()) {
+  if (m_factor) {
+    m_inv_theta = 1.0 / model.problem().stiffness_coefficients(mu)(0);
+    m_inverse = model.single_term_inverse();
+  } else {
+    m_local.compute(model.reduced_stiffness(mu));
+    m_factor = &m_local;
+  }
+  m_ok = m_factor->info() == Eigen::Success && std::isfinite(m_inv_theta);
 }
 
 Eigen::VectorXd ReducedModel::surface_lifting(const fom::Param& mu) const {

@@ -140,4 +140,35 @@ class ReducedModel {
   double m_setup_time = 0.0;
 };
 
+/// \brief K̂(μ)⁻¹ for one online query: with a single stiffness term the offline
+/// factor and inverse of K̂₀, scaled by 1/θ₀(μ); otherwise a Cholesky factorisation
+/// of K̂(μ) made here. Shared by the greedy and the reduced active sets.
+class ReducedStiffnessInverse {
+ public:
+  ReducedStiffnessInverse(const ReducedModel& model, const fom::Param& mu);
+  ReducedStiffnessInverse(const ReducedStiffnessInverse&) = delete;
+  ReducedStiffnessInverse& operator=(const ReducedStiffnessInverse&) = delete;
+
+  /// False when K̂(μ) is not positive definite (factorisation failed) or θ₀(μ) is 0.
+  bool ok() const { return m_ok; }
+  /// K̂(μ)⁻¹ f through the Cholesky factor (once per query, e.g. the unconstrained û).
+  Eigen::VectorXd solve(const Eigen::VectorXd& f) const { return m_inv_theta * m_factor->solve(f); }
+  /// out = K̂(μ)⁻¹ rhs inside the online loops: one small dense product with the
+  /// offline inverse when there is one, else the factor.
+  template <class Rhs, class Out>
+  void apply(const Rhs& rhs, Out&& out) const {
+    if (m_inverse)
+      out.noalias() = m_inv_theta * (*m_inverse) * rhs;
+    else
+      out = m_inv_theta * m_factor->solve(rhs);
+  }
+
+ private:
+  Eigen::LLT<Eigen::MatrixXd> m_local;             // factor of K̂(μ) when there is no offline one
+  const Eigen::LLT<Eigen::MatrixXd>* m_factor;     // the offline factor of K̂₀, or m_local
+  const Eigen::MatrixXd* m_inverse = nullptr;      // K̂₀⁻¹ (offline), or none
+  double m_inv_theta = 1.0;                        // 1/θ₀(μ) with the offline factor, else 1
+  bool m_ok = true;
+};
+
 }  // namespace contactrom::rom

@@ -1,6 +1,7 @@
 #include "rom/support_rows.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace contactrom::rom {
 
@@ -89,6 +90,13 @@ double SupportRows::reduced_row(int p, const fom::ConstraintMatrix& c_r, const E
     g_hat += wi * acc;
   }
   return g_hat;
+}
+
+void SupportOperators::rebuild(const fom::ContactModel& contact, const SupportRows& support,
+                               const Eigen::VectorXd& u_surface) {
+  contact.search_rows(u_surface, &support.rows, &pairing, m_next);  // an empty hint is ignored
+  std::swap(pairing, m_next);
+  contact.assemble_rows(pairing, support.rows, c, g);
 }
 
 }  // namespace contactrom::rom

@@ -44,4 +44,19 @@ struct SupportRows {
                      const Eigen::VectorXd& lift_s, Eigen::Ref<Eigen::RowVectorXd> c_hat) const;
 };
 
+/// \brief Contact operators of the support rows at the current iterate, rebuilt in
+/// place by the online loops: the pairing (the previous one seeds the next search)
+/// and C_R, g_R, in storage reused from one rebuild to the next.
+struct SupportOperators {
+  fom::Pairing pairing;     ///< of the last rebuild (empty before the first)
+  fom::ConstraintMatrix c;  ///< C_R
+  Eigen::VectorXd g;        ///< g_R
+  /// Searches the support rows at u_s, seeded by the current pairing, and assembles
+  /// C_R and g_R there.
+  void rebuild(const fom::ContactModel& contact, const SupportRows& support, const Eigen::VectorXd& u_surface);
+
+ private:
+  fom::Pairing m_next;  // the search writes here, then it becomes `pairing`
+};
+
 }  // namespace contactrom::rom
