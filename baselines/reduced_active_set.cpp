@@ -19,6 +19,7 @@ ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOption
   o.tau_scaling = g.tau_scaling;
   o.max_iterations = g.max_iterations;
   o.step_tolerance = g.step_tolerance;
+  o.time_operators = g.time_operators;
   if (const auto it = options.extra.find("inner_solve"); it != options.extra.end()) {
     if (it->second == "nonnegative")
       o.inner_solve = InnerSolve::NonNegative;
@@ -93,13 +94,16 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   rom::NnlsQp nnls(m_options.nnls);
   const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
   bool small_step = true;  // û = u_free is exact for I = ∅
+  rom::OperatorClock operators(m_options.time_operators);
 
   for (int k = 0;; ++k) {
     // 1. Operators at the current û (surface rows only) and the violation of every
     //    column, Ĉû − ĝ = Wᵀ(C_s u_s − g).
+    operators.start();
     u_s.noalias() = phi_s * u_hat;
     u_s += lift_s;
     ops.rebuild(contact, m_support, u_s);
+    operators.stop();
     m_support.violation(ops.c, ops.g, u_s, v, violation);
 
     // 2. Primal–dual update: drop the columns whose multiplier left the cone, add every
@@ -138,7 +142,9 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
       rhs.resize(na);
       // Rows of Ĉ_I = W_Iᵀ C_R Φ_s and entries of ĝ_I = W_Iᵀ (g_R − C_R u_lift,s),
       // as in the greedy: from the rows where each active column is non-zero.
+      operators.start();
       for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], ops.c, ops.g, phi_s_rows, lift_s, c_hat_i.row(i));
+      operators.stop();
       k_inv.apply(c_hat_i.transpose(), z);  // K̂⁻¹ Ĉ_Iᵀ
       schur.noalias() = c_hat_i * z;
       rhs = c_hat_i * u_free - rhs;
@@ -181,6 +187,7 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   }
   const auto t1 = clock::now();
   res.time_s = std::chrono::duration<double>(t1 - t0).count();
+  res.operator_time_s = operators.total();
   res.u = m_model.reconstruct_primal(u_hat, mu);
   res.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
   return res;

@@ -87,10 +87,13 @@ struct ReducedActiveSetOptions {
   InnerSolve inner_solve = InnerSolve::NonNegative;
   /// Settings of the NNLS inner solve (default: those of rom::NnlsOptions).
   rom::NnlsOptions nnls;
+  /// Measure OnlineResult::operator_time_s (see rom::OnlineSolverOptions::time_operators).
+  /// Default false.
+  bool time_operators = false;
 };
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
-/// step_tolerance; validated as for the greedy) and `extra["inner_solve"]`
+/// step_tolerance, time_operators; validated as for the greedy) and `extra["inner_solve"]`
 /// ("nonnegative" or "equality"). \throws InputError on bad values.
 ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options);
 

@@ -59,6 +59,7 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
     throw InputError("step tolerance " + std::to_string(options.step_tolerance) + " invalid; expected >= 0");
   g.max_iterations = options.max_iterations;
   g.step_tolerance = options.step_tolerance;
+  g.time_operators = options.time_operators;
   for (const auto& [key, value] : options.extra) {
     if (key == "schedule") {
       if (value == "interleaved")
@@ -94,8 +95,10 @@ GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& optio
 
 /// Per-query quantities shared by both schedules.
 struct GreedyActiveSet::Query {
-  Query(const ReducedModel& model, const fom::Param& mu) : k_inv(model, mu) {}
+  Query(const ReducedModel& model, const fom::Param& mu, bool time_operators)
+      : k_inv(model, mu), operators(time_operators) {}
   ReducedStiffnessInverse k_inv;  // K̂(μ)⁻¹
+  OperatorClock operators;  // time spent building the contact operators (optional)
   Eigen::VectorXd lift_s;  // surface lifting u_off,s(μ)
   Eigen::VectorXd u_free;  // unconstrained reduced solution K̂⁻¹ f̂
   // Outcome, filled by the schedule: final û, the selection and its multipliers.
@@ -142,7 +145,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
 
   // K̂(μ)⁻¹ through the offline factor when K̂(μ) = θ₀(μ) K̂₀, else a per-query
   // factorisation of the r × r matrix.
-  Query q(m_model, mu);
+  Query q(m_model, mu, m_options.time_operators);
   if (!q.k_inv.ok()) {
     res.status = Status::NumericalIssue;
     res.message = "Cholesky factorisation of the reduced stiffness failed";
@@ -173,6 +176,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   }
   const auto t1 = clock::now();
   res.time_s = std::chrono::duration<double>(t1 - t0).count();
+  res.operator_time_s = q.operators.total();
   res.u = m_model.reconstruct_primal(res.u_hat, mu);
   res.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
   return res;
@@ -220,7 +224,9 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
   bool pending = false;  // converged in the sense of Alg. 1, to be confirmed
   for (int k = 0; k <= m_options.max_iterations; ++k) {
     // 1. Contact operators at the previous iterate, from the surface rows only.
+    q.operators.start();
     ops.rebuild(contact, m_support, u_s);
+    q.operators.stop();
     if (pending) {
       // Alg. 1 found no change and a settled û^k, but judged û^k with the operators
       // of û^{k−1}. Confirm at the pairing of û^k itself that no dictionary column
@@ -241,7 +247,9 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
     }
     // Rows of Ĉ_I = D_Iᵀ C_R Φ_s and entries of ĝ_I = D_Iᵀ (g_R − C_R u_off,s), from
     // the rows where each selected column is non-zero.
+    q.operators.start();
     for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], ops.c, ops.g, phi_s_rows, lift_s, c_hat_i.row(i));
+    q.operators.stop();
 
     // 2. Saddle-point system by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ.
     u_prev = u_hat;
@@ -265,8 +273,10 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
       res.message = "reduced saddle-point solve produced a non-finite value";
       break;
     }
+    q.operators.start();
     u_s.noalias() = phi_s * u_hat;
     u_s += lift_s;
+    q.operators.stop();
 
     // 3. One change: remove the most negative multiplier, else add the column most
     //    correlated with the thresholded violation.
@@ -344,8 +354,10 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
   // their storage from one rebuild to the next).
   auto make_column = [&](Column& col, int p) {
     col.p = p;
+    q.operators.start();  // Ĉ_p is the operator; w_p and z_p belong to the solve
     col.c_hat.setZero(r);
     for (int i : m_support.column_support[static_cast<size_t>(p)]) col.c_hat.noalias() += dr(i, p) * a.row(i);
+    q.operators.stop();
     q.k_inv.apply(col.c_hat.transpose(), col.w);
     aw.noalias() = a * col.w.col(0);
     col.z.noalias() = dr.transpose() * aw;
@@ -355,9 +367,11 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
   int solves = 0;
   for (int rebuild = 0;; ++rebuild) {
     // 1. Operators at x (surface rows only), A = C_R Φ_s and b.
+    q.operators.start();
     u_s.noalias() = phi_s * x;
     u_s += lift_s;
     ops.rebuild(contact, m_support, u_s);
+    q.operators.stop();
     if (pending) {  // x = û: is every column (selected ones included) within τ here?
       m_support.violation(ops.c, ops.g, u_s, gap, violation);
       if (confirmed(violation)) {
@@ -367,7 +381,9 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
       pending = false;
     }
     if (rebuild == m_options.max_iterations || solves >= m_options.max_solves) break;
+    q.operators.start();
     m_support.gap_operator(ops.c, ops.g, phi_s_rows, lift_s, a, b);  // A = C_R Φ_s, b = C_R u_off,s − g_R
+    q.operators.stop();
     gap.noalias() = a * u_free;
     gap += b;
     v_free.noalias() = dr.transpose() * gap;

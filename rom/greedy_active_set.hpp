@@ -97,6 +97,9 @@ struct GreedyOptions {
   /// Nested schedule: cap on the one-change solves of a query, over all rebuilds.
   /// Default 1000.
   int max_solves = 1000;
+  /// Measure OnlineResult::operator_time_s (see OnlineSolverOptions::time_operators).
+  /// Default false.
+  bool time_operators = false;
   /// If set, one line per iteration (|I|, action, largest violation, step) is
   /// written here; for diagnosis only (not thread-safe). Default nullptr.
   std::ostream* trace = nullptr;

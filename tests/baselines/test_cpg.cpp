@@ -279,4 +279,20 @@ BOOST_AUTO_TEST_CASE(hertz_basis_and_online_solver) {
   BOOST_REQUIRE(typed);
   BOOST_TEST(typed->basis().tolerance == 0.05);
   BOOST_TEST(typed->basis().columns.size() <= basis.columns.size());
+
+  // time_operators only reads the clock: the same result, with the share of the
+  // contact-operator construction in [0, time_s] (−1 when not measured).
+  rom::OnlineSolverOptions timed_options;
+  timed_options.time_operators = true;
+  const auto timed = rom::make_online_solver("cpg", model, timed_options);
+  const auto plain = rom::make_online_solver("cpg", model);
+  for (size_t i = 5; i < validation.size(); i += 40) {
+    const rom::OnlineResult a = plain->solve(validation[i]), b = timed->solve(validation[i]);
+    BOOST_TEST(a.operator_time_s == -1.0);
+    BOOST_TEST(b.operator_time_s >= 0.0);
+    BOOST_TEST(b.operator_time_s <= b.time_s);
+    BOOST_TEST(a.iterations == b.iterations);
+    BOOST_TEST((a.selected == b.selected));
+    BOOST_TEST((a.u_hat - b.u_hat).norm() == 0.0);
+  }
 }

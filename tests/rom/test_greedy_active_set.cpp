@@ -442,6 +442,38 @@ BOOST_AUTO_TEST_CASE(registry_and_timing) {
   BOOST_TEST(rom::median({4.0, 1.0, 2.0, 3.0}) == 2.5);
 }
 
+BOOST_AUTO_TEST_CASE(operator_clock_measures_a_share_and_changes_nothing) {
+  // time_operators only reads the clock: same iterates, same result, and the
+  // operator share lies in [0, time_s]; without it operator_time_s is −1 and
+  // time_online reports no split. Both schedules, and the reduced active sets
+  // through the registry (tests/baselines) follow the same contract.
+  Setup& h = hertz();
+  const rom::ReducedModel model(*h.problem, h.db(30));
+  const std::vector<fom::Param> params = {Eigen::VectorXd::Constant(1, 0.0525), Eigen::VectorXd::Constant(1, 0.2475)};
+  for (const auto& [label, plain_options] : schedules()) {
+    rom::GreedyOptions timed_options = plain_options;
+    timed_options.time_operators = true;
+    const rom::GreedyActiveSet plain(model, plain_options), timed(model, timed_options);
+    for (const fom::Param& mu : params) {
+      const rom::OnlineResult a = plain.solve(mu), b = timed.solve(mu);
+      BOOST_TEST(a.operator_time_s == -1.0, label);
+      BOOST_TEST(b.operator_time_s >= 0.0, label);
+      BOOST_TEST(b.operator_time_s <= b.time_s, label);
+      BOOST_TEST(a.iterations == b.iterations, label);
+      BOOST_TEST((a.selected == b.selected), label);
+      BOOST_TEST((a.u_hat - b.u_hat).norm() == 0.0, label);
+      BOOST_TEST((a.lambda - b.lambda).norm() == 0.0, label);
+    }
+    BOOST_TEST(rom::time_online(plain, params, 1).median_without_operators_s == -1.0, label);
+    const rom::OnlineTiming t = rom::time_online(timed, params, 1);
+    BOOST_TEST(t.median_without_operators_s >= 0.0, label);
+    BOOST_TEST(t.median_without_operators_s <= t.median_core_s, label);
+  }
+  rom::OnlineSolverOptions o;
+  o.time_operators = true;
+  BOOST_TEST(rom::greedy_options(o).time_operators);
+}
+
 BOOST_AUTO_TEST_CASE(concurrent_queries_match_sequential_ones) {
   Setup& h = hertz();
   const rom::ReducedModel model(*h.problem, h.db(30));
