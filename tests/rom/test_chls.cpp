@@ -14,23 +14,18 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "rom/chls.hpp"
+#include "common/random_problems.hpp"
 #include "common/run_command.hpp"
+#include "rom/chls.hpp"
 
 using contactrom::Status;
 using contactrom::rom::chls_leave_one_out;
 using contactrom::rom::SimplexLeastSquares;
+using contactrom::test::gaussian;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 namespace {
-
-MatrixXd gaussian(Eigen::Index rows, Eigen::Index cols, std::mt19937_64& gen) {
-  std::normal_distribution<double> normal;
-  MatrixXd a(rows, cols);
-  for (Eigen::Index i = 0; i < a.size(); ++i) a(i) = normal(gen);
-  return a;
-}
 
 /// Random matrix with orthonormal columns (rows ≥ cols).
 MatrixXd orthonormal(Eigen::Index rows, Eigen::Index cols, std::mt19937_64& gen) {

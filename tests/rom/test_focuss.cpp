@@ -11,50 +11,22 @@
 #include <set>
 #include <vector>
 
+#include "common/random_problems.hpp"
 #include "rom/focuss.hpp"
 
 using contactrom::Status;
 using contactrom::rom::Focuss;
 using contactrom::rom::FocussOptions;
 using contactrom::rom::NnFocuss;
+using contactrom::test::as_set;
+using contactrom::test::gaussian;
+using contactrom::test::planted;
+using contactrom::test::scaled_dictionary;
 using Eigen::Index;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 namespace {
-
-MatrixXd gaussian(Index rows, Index cols, std::mt19937_64& gen) {
-  std::normal_distribution<double> normal;
-  MatrixXd a(rows, cols);
-  for (Index i = 0; i < a.size(); ++i) a(i) = normal(gen);
-  return a;
-}
-
-MatrixXd scaled_dictionary(Index m, Index n, std::mt19937_64& gen) {
-  std::uniform_real_distribution<double> scale(0.5, 2.0);
-  MatrixXd d = gaussian(m, n, gen);
-  for (Index j = 0; j < n; ++j) d.col(j) *= scale(gen);
-  return d;
-}
-
-/// k-sparse vector with magnitudes in [1, 2]; signed unless non_negative.
-VectorXd planted(Index n, Index k, bool non_negative, std::mt19937_64& gen, std::set<Index>& support) {
-  std::vector<Index> columns(static_cast<std::size_t>(n));
-  for (Index j = 0; j < n; ++j) columns[static_cast<std::size_t>(j)] = j;
-  std::shuffle(columns.begin(), columns.end(), gen);
-  std::uniform_real_distribution<double> magnitude(1.0, 2.0);
-  std::bernoulli_distribution sign;
-  VectorXd a = VectorXd::Zero(n);
-  support.clear();
-  for (Index i = 0; i < k; ++i) {
-    const Index j = columns[static_cast<std::size_t>(i)];
-    a(j) = (non_negative || sign(gen)) ? magnitude(gen) : -magnitude(gen);
-    support.insert(j);
-  }
-  return a;
-}
-
-std::set<Index> as_set(const std::vector<Index>& v) { return std::set<Index>(v.begin(), v.end()); }
 
 constexpr Index kRows = 60;
 constexpr Index kCols = 200;

@@ -10,24 +10,19 @@
 #include <random>
 #include <string>
 
+#include "common/random_problems.hpp"
 #include "rom/nnls.hpp"
 
 using contactrom::Status;
 using contactrom::rom::Nnls;
 using contactrom::rom::NnlsOptions;
 using contactrom::rom::NnlsQp;
+using contactrom::test::gaussian;
 using Eigen::Index;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 namespace {
-
-MatrixXd gaussian(Index rows, Index cols, std::mt19937_64& gen) {
-  std::normal_distribution<double> normal;
-  MatrixXd a(rows, cols);
-  for (Index i = 0; i < a.size(); ++i) a(i) = normal(gen);
-  return a;
-}
 
 double spectral_norm(const MatrixXd& a) {
   if (a.size() == 0) return 0.0;

@@ -10,52 +10,22 @@
 #include <set>
 #include <vector>
 
+#include "common/random_problems.hpp"
 #include "rom/omp.hpp"
 
 using contactrom::Status;
 using contactrom::rom::Omp;
 using contactrom::rom::OmpOptions;
 using contactrom::rom::OmpStop;
+using contactrom::test::as_set;
+using contactrom::test::gaussian;
+using contactrom::test::planted;
+using contactrom::test::scaled_dictionary;
 using Eigen::Index;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 namespace {
-
-MatrixXd gaussian(Index rows, Index cols, std::mt19937_64& gen) {
-  std::normal_distribution<double> normal;
-  MatrixXd a(rows, cols);
-  for (Index i = 0; i < a.size(); ++i) a(i) = normal(gen);
-  return a;
-}
-
-/// Gaussian dictionary with column norms spread over [0.5, 2] x sqrt(m), so that the
-/// returned coefficients must be those of the original columns.
-MatrixXd scaled_dictionary(Index m, Index n, std::mt19937_64& gen) {
-  std::uniform_real_distribution<double> scale(0.5, 2.0);
-  MatrixXd d = gaussian(m, n, gen);
-  for (Index j = 0; j < n; ++j) d.col(j) *= scale(gen);
-  return d;
-}
-
-/// k-sparse vector with entries of magnitude in [1, 2] and random signs.
-VectorXd planted(Index n, Index k, std::mt19937_64& gen, std::set<Index>& support) {
-  std::vector<Index> columns(static_cast<std::size_t>(n));
-  for (Index j = 0; j < n; ++j) columns[static_cast<std::size_t>(j)] = j;
-  std::shuffle(columns.begin(), columns.end(), gen);
-  std::uniform_real_distribution<double> magnitude(1.0, 2.0);
-  std::bernoulli_distribution sign;
-  VectorXd a = VectorXd::Zero(n);
-  support.clear();
-  for (Index i = 0; i < k; ++i) {
-    const Index j = columns[static_cast<std::size_t>(i)];
-    a(j) = sign(gen) ? magnitude(gen) : -magnitude(gen);
-    support.insert(j);
-  }
-  return a;
-}
-
-std::set<Index> as_set(const std::vector<Index>& v) { return std::set<Index>(v.begin(), v.end()); }
 
 }  // namespace
 
@@ -66,7 +36,7 @@ BOOST_AUTO_TEST_CASE(recovers_planted_5_sparse_supports_in_at_least_95_of_100_tr
   for (int trial = 0; trial < 100; ++trial) {
     const MatrixXd d = scaled_dictionary(100, 400, gen);
     std::set<Index> support;
-    const VectorXd a = planted(400, 5, gen, support);
+    const VectorXd a = planted(400, 5, false, gen, support);
     Omp omp;
     const VectorXd alpha = omp.compute(d).solve(d * a);
     BOOST_TEST_CONTEXT("trial " << trial) {
@@ -91,7 +61,7 @@ BOOST_AUTO_TEST_CASE(residual_tolerance_stops_at_the_first_sufficient_atom_count
   std::mt19937_64 gen(31);
   const MatrixXd d = scaled_dictionary(60, 150, gen);
   std::set<Index> support;
-  VectorXd a = planted(150, 12, gen, support);
+  VectorXd a = planted(150, 12, false, gen, support);
   // Geometrically decaying magnitudes: each further atom removes about half of the
   // remaining residual, so the tolerance 0.05 is met after a handful of atoms.
   double magnitude = 1.0;
@@ -126,7 +96,7 @@ BOOST_AUTO_TEST_CASE(atom_cap_stops_the_selection) {
   std::mt19937_64 gen(37);
   const MatrixXd d = scaled_dictionary(100, 400, gen);
   std::set<Index> support;
-  const VectorXd a = planted(400, 5, gen, support);
+  const VectorXd a = planted(400, 5, false, gen, support);
   OmpOptions options;
   options.max_atoms = 3;
   Omp omp(options);

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "common/random_problems.hpp"
 #include "fom/errors.hpp"
 #include "rom/dense_csv.hpp"
 #include "rom/nnls.hpp"
@@ -30,6 +31,7 @@
 
 namespace fs = std::filesystem;
 using contactrom::InputError;
+using contactrom::test::gaussian;
 using Eigen::Index;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -104,13 +106,6 @@ std::vector<CommandResult> run_cli(const std::vector<std::string>& arguments, co
 }
 
 CommandResult run_one(const std::string& arguments, const TempDir& dir) { return run_cli({arguments}, dir).at(0); }
-
-MatrixXd gaussian(Index rows, Index cols, std::mt19937_64& gen) {
-  std::normal_distribution<double> normal;
-  MatrixXd a(rows, cols);
-  for (Index i = 0; i < a.size(); ++i) a(i) = normal(gen);
-  return a;
-}
 
 VectorXd coefficients(const nlohmann::json& out) {
   const auto values = out.at("coefficients").get<std::vector<double>>();
