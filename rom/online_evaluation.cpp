@@ -197,36 +197,46 @@ void write_evaluation_csv(const std::string& path, const fom::Problem& problem, 
   });
 }
 
-OnlineTiming time_online(const OnlineSolver& solver, const std::vector<fom::Param>& params, int repeats) {
+OnlineTiming OnlineSamples::timing() const {
   OnlineTiming t;
-  if (params.empty()) return t;
-  for (const fom::Param& mu : params) (void)solver.solve(mu);  // warm-up (caches, allocator)
-  std::vector<double> core, total, without;
-  for (int rep = 0; rep < std::max(repeats, 1); ++rep)
-    for (const fom::Param& mu : params) {
-      const auto t0 = std::chrono::steady_clock::now();
-      const OnlineResult res = solver.solve(mu);
-      total.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      core.push_back(res.time_s);
-      if (res.operator_time_s >= 0.0) without.push_back(res.time_s - res.operator_time_s);
-    }
   t.median_core_s = median(core);
   t.median_total_s = median(total);
-  if (without.size() == core.size()) t.median_without_operators_s = median(without);
+  if (!core.empty() && without.size() == core.size()) t.median_without_operators_s = median(without);
   t.queries = static_cast<int>(core.size());
   return t;
+}
+
+void time_online_pass(const OnlineSolver& solver, const std::vector<fom::Param>& params, OnlineSamples& out) {
+  for (const fom::Param& mu : params) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const OnlineResult res = solver.solve(mu);
+    out.total.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    out.core.push_back(res.time_s);
+    if (res.operator_time_s >= 0.0) out.without.push_back(res.time_s - res.operator_time_s);
+  }
+}
+
+void time_fom_pass(const fom::ActiveSetSolver& solver, const std::vector<fom::Param>& params, std::vector<double>& out) {
+  for (const fom::Param& mu : params) {
+    const auto t0 = std::chrono::steady_clock::now();
+    (void)solver.solve(mu);
+    out.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+}
+
+OnlineTiming time_online(const OnlineSolver& solver, const std::vector<fom::Param>& params, int repeats) {
+  if (params.empty()) return OnlineTiming{};
+  for (const fom::Param& mu : params) (void)solver.solve(mu);  // warm-up (caches, allocator)
+  OnlineSamples samples;
+  for (int rep = 0; rep < std::max(repeats, 1); ++rep) time_online_pass(solver, params, samples);
+  return samples.timing();
 }
 
 double time_fom(const fom::ActiveSetSolver& solver, const std::vector<fom::Param>& params, int repeats) {
   if (params.empty()) return 0.0;
   (void)solver.solve(params.front());  // warm-up
   std::vector<double> times;
-  for (int rep = 0; rep < std::max(repeats, 1); ++rep)
-    for (const fom::Param& mu : params) {
-      const auto t0 = std::chrono::steady_clock::now();
-      (void)solver.solve(mu);
-      times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    }
+  for (int rep = 0; rep < std::max(repeats, 1); ++rep) time_fom_pass(solver, params, times);
   return median(times);
 }
 

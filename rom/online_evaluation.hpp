@@ -220,6 +220,21 @@ struct OnlineTiming {
   int queries = 0;              ///< number of timed queries
 };
 
+/// \brief Per-query time samples of online passes, in seconds; `without` stays empty
+/// unless the solver measures OnlineResult::operator_time_s.
+struct OnlineSamples {
+  std::vector<double> core, total, without;
+  /// Medians of the samples so far.
+  OnlineTiming timing() const;
+};
+
+/// \brief One timed pass of `solver` over `params` (no warm-up), appended to `out`.
+void time_online_pass(const OnlineSolver& solver, const std::vector<fom::Param>& params, OnlineSamples& out);
+
+/// \brief One timed pass of the FOM over `params` (no warm-up): per-query wall
+/// times appended to `out`.
+void time_fom_pass(const fom::ActiveSetSolver& solver, const std::vector<fom::Param>& params, std::vector<double>& out);
+
 /// \brief Times `solver` over `params`, `repeats` times each (after one warm-up
 /// pass), on the calling thread. For `contactrom bench` and docs/rom.md.
 OnlineTiming time_online(const OnlineSolver& solver, const std::vector<fom::Param>& params, int repeats = 3);

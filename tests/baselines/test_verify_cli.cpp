@@ -161,6 +161,10 @@ BOOST_AUTO_TEST_CASE(bench_reports_every_method_and_consistent_ratios) {
                         "rom_cpg_without_operators", "rom_full_dictionary_without_operators"})
     BOOST_TEST((j.contains(k) && j[k].get<double>() > 0.0), k);
   BOOST_TEST(!j.contains("rom_convex_hull_without_operators"));
+  // One FOM median per interleaved round (--repeats 1 here).
+  BOOST_REQUIRE(j.contains("fom_active_set_rounds"));
+  BOOST_TEST(j["fom_active_set_rounds"].size() == 1u);
+  BOOST_TEST(j["fom_active_set_rounds"][0].get<double>() > 0.0);
   int checked = 0;
   for (auto it = ratios.begin(); it != ratios.end(); ++it) {
     const std::string key = it.key();
