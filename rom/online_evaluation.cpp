@@ -232,6 +232,28 @@ OnlineTiming time_online(const OnlineSolver& solver, const std::vector<fom::Para
   return samples.timing();
 }
 
+InterleavedTiming time_interleaved(const fom::ActiveSetSolver& fom, const std::vector<const OnlineSolver*>& solvers,
+                                   const std::vector<fom::Param>& params, int rounds) {
+  InterleavedTiming t;
+  t.online.resize(solvers.size());
+  if (params.empty()) return t;
+  (void)fom.solve(params.front());  // warm-up (caches, allocator)
+  for (const OnlineSolver* s : solvers)
+    for (const fom::Param& mu : params) (void)s->solve(mu);
+  std::vector<double> fom_samples;
+  std::vector<OnlineSamples> samples(solvers.size());
+  for (int round = 0; round < std::max(rounds, 1); ++round) {
+    std::vector<double> this_round;
+    time_fom_pass(fom, params, this_round);
+    t.fom_round_median_s.push_back(median(this_round));
+    fom_samples.insert(fom_samples.end(), this_round.begin(), this_round.end());
+    for (size_t i = 0; i < solvers.size(); ++i) time_online_pass(*solvers[i], params, samples[i]);
+  }
+  t.fom_median_s = median(fom_samples);
+  for (size_t i = 0; i < solvers.size(); ++i) t.online[i] = samples[i].timing();
+  return t;
+}
+
 double time_fom(const fom::ActiveSetSolver& solver, const std::vector<fom::Param>& params, int repeats) {
   if (params.empty()) return 0.0;
   (void)solver.solve(params.front());  // warm-up

@@ -243,6 +243,22 @@ OnlineTiming time_online(const OnlineSolver& solver, const std::vector<fom::Para
 /// built before timing), `repeats` passes over `params` after one warm-up query.
 double time_fom(const fom::ActiveSetSolver& solver, const std::vector<fom::Param>& params, int repeats = 1);
 
+/// \brief Medians of the FOM and of several online solvers timed in interleaved
+/// rounds (see time_interleaved).
+struct InterleavedTiming {
+  double fom_median_s = 0.0;             ///< median FOM time per query over all rounds
+  std::vector<double> fom_round_median_s;  ///< the FOM median of each round
+  std::vector<OnlineTiming> online;      ///< per solver, in the order given
+};
+
+/// \brief Times the FOM (factorisation reused) and every solver in `solvers` over
+/// `params`: one warm-up pass of each, then `rounds` rounds of one FOM pass followed
+/// by one pass of every solver; medians over all rounds. A slow spell of the machine
+/// then lands on all of them alike instead of on whichever was being timed, so
+/// their ratios are reproducible. On the calling thread; `solvers` must not be null.
+InterleavedTiming time_interleaved(const fom::ActiveSetSolver& fom, const std::vector<const OnlineSolver*>& solvers,
+                                   const std::vector<fom::Param>& params, int rounds);
+
 /// \brief Median of a list of numbers (0 for an empty list).
 double median(std::vector<double> values);
 

@@ -98,53 +98,32 @@ void run_bench(const BenchArgs& a) {
   nlohmann::json skipped = nlohmann::json::object();
   // Every ROM twice: as is, and clocking the construction of the contact operators
   // (the paper's convention, times without it; a separate solver so that the clock
-  // reads do not touch the main times).
-  struct Timed {
-    std::string key;
-    std::unique_ptr<rom::OnlineSolver> plain, clocked;
-    rom::OnlineSamples plain_samples, clocked_samples;
-  };
-  std::vector<Timed> roms;
+  // reads do not touch the main times). All timed with the FOM in interleaved rounds.
+  std::vector<std::string> keys;
+  std::vector<std::unique_ptr<rom::OnlineSolver>> owned;
+  std::vector<const rom::OnlineSolver*> solvers;
   for (const std::string& method : rom::online_solver_names()) {
-    Timed t;
-    t.key = key_of(method);
     try {
-      t.plain = rom::make_online_solver(method, model);
+      owned.push_back(rom::make_online_solver(method, model));
     } catch (const InputError& e) {
       skipped[method] = e.what();  // e.g. convex-hull on a non-convex feasible set
       continue;
     }
     rom::OnlineSolverOptions clock_options;
     clock_options.time_operators = true;
-    t.clocked = rom::make_online_solver(method, model, clock_options);
-    roms.push_back(std::move(t));
+    owned.push_back(rom::make_online_solver(method, model, clock_options));
+    keys.push_back(key_of(method));
   }
-  // Rounds: one pass of the FOM, then one pass of every ROM, `repeats` times, after a
-  // warm-up pass of each. A slow spell of the machine (another VM, a frequency
-  // change) then lands on all methods alike instead of on whichever was being timed,
-  // which kept the FOM median of separate phases from being reproducible.
-  (void)fom_solver.solve(queries.front());
-  for (Timed& t : roms)
-    for (const fom::Param& mu : queries) (void)t.plain->solve(mu), (void)t.clocked->solve(mu);
-  std::vector<double> fom_samples;
-  nlohmann::json fom_rounds = nlohmann::json::array();
-  for (int round = 0; round < a.repeats; ++round) {
-    const size_t first = fom_samples.size();
-    rom::time_fom_pass(fom_solver, queries, fom_samples);
-    fom_rounds.push_back(rom::median(std::vector<double>(fom_samples.begin() + static_cast<long>(first), fom_samples.end())));
-    for (Timed& t : roms) {
-      rom::time_online_pass(*t.plain, queries, t.plain_samples);
-      rom::time_online_pass(*t.clocked, queries, t.clocked_samples);
-    }
-  }
-  const double t_fom = rom::median(fom_samples);
+  for (const auto& s : owned) solvers.push_back(s.get());
+  const rom::InterleavedTiming timing = rom::time_interleaved(fom_solver, solvers, queries, a.repeats);
+  const double t_fom = timing.fom_median_s;
   j["fom_active_set"] = t_fom;
-  j["fom_active_set_rounds"] = fom_rounds;  // per-round medians: the machine's noise
-  for (const Timed& t : roms) {
-    const rom::OnlineTiming plain = t.plain_samples.timing(), clocked = t.clocked_samples.timing();
-    j[t.key] = plain.median_core_s;
-    j[t.key + "_with_reconstruction"] = plain.median_total_s;
-    if (clocked.median_without_operators_s >= 0.0) j[t.key + "_without_operators"] = clocked.median_without_operators_s;
+  j["fom_active_set_rounds"] = timing.fom_round_median_s;  // per-round medians: the machine's noise
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const rom::OnlineTiming &plain = timing.online[2 * i], &clocked = timing.online[2 * i + 1];
+    j[keys[i]] = plain.median_core_s;
+    j[keys[i] + "_with_reconstruction"] = plain.median_total_s;
+    if (clocked.median_without_operators_s >= 0.0) j[keys[i] + "_without_operators"] = clocked.median_without_operators_s;
   }
   if (!skipped.empty()) j["not_applicable"] = skipped;
 

@@ -438,6 +438,16 @@ BOOST_AUTO_TEST_CASE(registry_and_timing) {
   BOOST_TEST(t.median_core_s > 0.0);
   BOOST_TEST(t.median_total_s >= t.median_core_s * 0.5);
   BOOST_TEST(rom::time_fom(*h.solver, params, 1) > 0.0);
+  // Interleaved rounds: one FOM median per round, every solver timed every round.
+  const rom::InterleavedTiming it = rom::time_interleaved(*h.solver, {solver.get(), solver.get()}, params, 3);
+  BOOST_TEST(it.fom_round_median_s.size() == 3u);
+  BOOST_TEST(it.fom_median_s > 0.0);
+  BOOST_REQUIRE(it.online.size() == 2u);
+  for (const rom::OnlineTiming& o : it.online) {
+    BOOST_TEST(o.queries == 6);
+    BOOST_TEST(o.median_core_s > 0.0);
+    BOOST_TEST(o.median_without_operators_s == -1.0);  // not clocked
+  }
   BOOST_TEST(rom::median({3.0, 1.0, 2.0}) == 2.0);
   BOOST_TEST(rom::median({4.0, 1.0, 2.0, 3.0}) == 2.5);
 }
