@@ -7,7 +7,8 @@
 //                   convex-hull where it applies), nonlinear contact operators included
 //   rom_<method>_without_operators  the same, minus the construction of the contact
 //                   operators (search, assembly, reduced rows): the paper's timing
-//                   convention; from a second pass with OnlineSolverOptions::time_operators
+//                   convention; from a second, clocked solver (OnlineSolverOptions::
+//                   time_operators) timed in the same rounds
 //   fom_active_set_rounds  the FOM median of each round (how noisy the machine was)
 // Queries are the problem's validation parameters (thinned to --queries). The FOM
 // and the ROMs are timed in --repeats interleaved rounds (one pass of each per round,
