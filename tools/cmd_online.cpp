@@ -171,6 +171,7 @@ void run_online(const OnlineArgs& a) {
   model_options.delta = a.delta;
   model_options.lifting = a.lifting == "dirichlet" ? rom::LiftingKind::Dirichlet : rom::LiftingKind::Harmonic;
   const rom::ReducedModel model(*problem, db, model_options);
+  warn_if_no_primal_modes(model);
   const auto solver = rom::make_online_solver(a.method, model, options);
   if (!a.param.empty())
     run_single(a, *problem, model, *solver);

@@ -239,6 +239,7 @@ void run_verify(const VerifyArgs& a) {
   rom::ReducedModelOptions model_options;
   model_options.delta = a.delta;
   const rom::ReducedModel model(*problem, db, model_options);
+  warn_if_no_primal_modes(model);
   rom::OnlineSolverOptions options;
   options.tau = a.tau;
   options.tau_scaling = a.tau_scaling;

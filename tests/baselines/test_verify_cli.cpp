@@ -227,3 +227,15 @@ BOOST_AUTO_TEST_CASE(bad_input_is_one_line_exit_2_and_no_file) {
     BOOST_TEST(!fs::exists(csv), c);
   }
 }
+
+BOOST_AUTO_TEST_CASE(a_delta_that_keeps_no_mode_is_warned_about) {
+  // δ = 1 keeps no POD mode: a valid but degenerate request (exit 0) that says so
+  // on stderr; a usual δ does not.
+  const std::string base = exe + " online --db " + dbs().hertz + " --method greedy --param 0.1 --json";
+  const auto none = run_command(base + " --delta 1");
+  BOOST_TEST(none.exit_code == 0, none.err);
+  BOOST_TEST(none.err.find("keeps no POD mode") != std::string::npos, none.err);
+  const auto usual = run_command(base + " --delta 1e-8");
+  BOOST_TEST(usual.exit_code == 0, usual.err);
+  BOOST_TEST(usual.err.find("warning") == std::string::npos, usual.err);
+}
