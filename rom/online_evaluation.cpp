@@ -233,24 +233,36 @@ OnlineTiming time_online(const OnlineSolver& solver, const std::vector<fom::Para
 }
 
 InterleavedTiming time_interleaved(const fom::ActiveSetSolver& fom, const std::vector<const OnlineSolver*>& solvers,
-                                   const std::vector<fom::Param>& params, int rounds) {
+                                   const std::vector<fom::Param>& params, int rounds,
+                                   const std::vector<const OnlineSolver*>& clocked) {
   InterleavedTiming t;
   t.online.resize(solvers.size());
   if (params.empty()) return t;
+  // Each solver followed by its clocked twin, each timed as its own entry.
+  std::vector<const OnlineSolver*> all;
+  std::vector<size_t> own(solvers.size()), twin(solvers.size(), 0);
+  for (size_t i = 0; i < solvers.size(); ++i) {
+    own[i] = all.size();
+    all.push_back(solvers[i]);
+    if (i < clocked.size() && clocked[i]) twin[i] = all.size(), all.push_back(clocked[i]);
+  }
   (void)fom.solve(params.front());  // warm-up (caches, allocator)
-  for (const OnlineSolver* s : solvers)
+  for (const OnlineSolver* s : all)
     for (const fom::Param& mu : params) (void)s->solve(mu);
   std::vector<double> fom_samples;
-  std::vector<OnlineSamples> samples(solvers.size());
+  std::vector<OnlineSamples> samples(all.size());
   for (int round = 0; round < std::max(rounds, 1); ++round) {
     std::vector<double> this_round;
     time_fom_pass(fom, params, this_round);
     t.fom_round_median_s.push_back(median(this_round));
     fom_samples.insert(fom_samples.end(), this_round.begin(), this_round.end());
-    for (size_t i = 0; i < solvers.size(); ++i) time_online_pass(*solvers[i], params, samples[i]);
+    for (size_t i = 0; i < all.size(); ++i) time_online_pass(*all[i], params, samples[i]);
   }
   t.fom_median_s = median(fom_samples);
-  for (size_t i = 0; i < solvers.size(); ++i) t.online[i] = samples[i].timing();
+  for (size_t i = 0; i < solvers.size(); ++i) {
+    t.online[i] = samples[own[i]].timing();
+    if (twin[i] > 0) t.online[i].median_without_operators_s = samples[twin[i]].timing().median_without_operators_s;
+  }
   return t;
 }
 

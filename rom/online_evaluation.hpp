@@ -248,16 +248,23 @@ double time_fom(const fom::ActiveSetSolver& solver, const std::vector<fom::Param
 struct InterleavedTiming {
   double fom_median_s = 0.0;             ///< median FOM time per query over all rounds
   std::vector<double> fom_round_median_s;  ///< the FOM median of each round
-  std::vector<OnlineTiming> online;      ///< per solver, in the order given
+  /// Per solver, in the order given; median_without_operators_s comes from its
+  /// clocked twin (−1 without one).
+  std::vector<OnlineTiming> online;
 };
 
 /// \brief Times the FOM (factorisation reused) and every solver in `solvers` over
 /// `params`: one warm-up pass of each, then `rounds` rounds of one FOM pass followed
 /// by one pass of every solver; medians over all rounds. A slow spell of the machine
 /// then lands on all of them alike instead of on whichever was being timed, so
-/// their ratios are reproducible. On the calling thread; `solvers` must not be null.
+/// their ratios are reproducible. `clocked` is empty or holds, per solver, a twin
+/// built with OnlineSolverOptions::time_operators (or null): it is timed in the same
+/// rounds and gives that solver's median_without_operators_s, while the solver's own
+/// times stay free of the clock reads. On the calling thread; `solvers` must not
+/// hold null.
 InterleavedTiming time_interleaved(const fom::ActiveSetSolver& fom, const std::vector<const OnlineSolver*>& solvers,
-                                   const std::vector<fom::Param>& params, int rounds);
+                                   const std::vector<fom::Param>& params, int rounds,
+                                   const std::vector<const OnlineSolver*>& clocked = {});
 
 /// \brief Median of a list of numbers (0 for an empty list).
 double median(std::vector<double> values);

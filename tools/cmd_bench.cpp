@@ -102,7 +102,9 @@ void run_bench(const BenchArgs& a) {
   // reads do not touch the main times). All timed with the FOM in interleaved rounds.
   std::vector<std::string> keys;
   std::vector<std::unique_ptr<rom::OnlineSolver>> owned;
-  std::vector<const rom::OnlineSolver*> solvers;
+  std::vector<const rom::OnlineSolver*> solvers, clocked;
+  rom::OnlineSolverOptions clock_options;
+  clock_options.time_operators = true;
   for (const std::string& method : rom::online_solver_names()) {
     try {
       owned.push_back(rom::make_online_solver(method, model));
@@ -110,21 +112,20 @@ void run_bench(const BenchArgs& a) {
       skipped[method] = e.what();  // e.g. convex-hull on a non-convex feasible set
       continue;
     }
-    rom::OnlineSolverOptions clock_options;
-    clock_options.time_operators = true;
+    solvers.push_back(owned.back().get());
     owned.push_back(rom::make_online_solver(method, model, clock_options));
+    clocked.push_back(owned.back().get());
     keys.push_back(key_of(method));
   }
-  for (const auto& s : owned) solvers.push_back(s.get());
-  const rom::InterleavedTiming timing = rom::time_interleaved(fom_solver, solvers, queries, a.repeats);
+  const rom::InterleavedTiming timing = rom::time_interleaved(fom_solver, solvers, queries, a.repeats, clocked);
   const double t_fom = timing.fom_median_s;
   j["fom_active_set"] = t_fom;
   j["fom_active_set_rounds"] = timing.fom_round_median_s;  // per-round medians: the machine's noise
   for (size_t i = 0; i < keys.size(); ++i) {
-    const rom::OnlineTiming &plain = timing.online[2 * i], &clocked = timing.online[2 * i + 1];
-    j[keys[i]] = plain.median_core_s;
-    j[keys[i] + "_with_reconstruction"] = plain.median_total_s;
-    if (clocked.median_without_operators_s >= 0.0) j[keys[i] + "_without_operators"] = clocked.median_without_operators_s;
+    const rom::OnlineTiming& t = timing.online[i];
+    j[keys[i]] = t.median_core_s;
+    j[keys[i] + "_with_reconstruction"] = t.median_total_s;
+    if (t.median_without_operators_s >= 0.0) j[keys[i] + "_without_operators"] = t.median_without_operators_s;
   }
   if (!skipped.empty()) j["not_applicable"] = skipped;
 

@@ -12,10 +12,11 @@ the script runs the contactrom CLI:
 
 and writes one markdown table per case (stdout and --md) and a CSV (--csv) with:
 primal RB size, dual RB / dictionary size, mean time per query (online, one
-sequential pass), median time per query (verify --bench: rom::time_online),
-speed-up over the FOM with the factorisation reused (rom::time_fom), the median
-time without the construction of the contact operators (the paper's timing
-convention; verify --bench, second pass with the operator clock), mean primal
+sequential pass), median time per query and speed-up over the FOM with the
+factorisation reused (verify --bench: the FOM and the methods timed together in
+interleaved rounds, rom::time_interleaved), the median time without the
+construction of the contact operators (the paper's timing convention; a clocked
+twin of each method timed in the same rounds), mean primal
 H1 and dual L2 errors against the FOM, mean |I|, mean iterations, non-converged
 queries and the largest reduced-level penetration against tau.
 

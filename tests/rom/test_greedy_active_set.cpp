@@ -448,6 +448,16 @@ BOOST_AUTO_TEST_CASE(registry_and_timing) {
     BOOST_TEST(o.median_core_s > 0.0);
     BOOST_TEST(o.median_without_operators_s == -1.0);  // not clocked
   }
+  // A clocked twin gives its solver the time without the operators; no twin, none.
+  rom::OnlineSolverOptions clock_options;
+  clock_options.time_operators = true;
+  const auto clocked = rom::make_online_solver("greedy", model, clock_options);
+  const rom::InterleavedTiming ic =
+      rom::time_interleaved(*h.solver, {solver.get(), solver.get()}, params, 2, {clocked.get(), nullptr});
+  BOOST_REQUIRE(ic.online.size() == 2u);
+  BOOST_TEST(ic.online[0].median_without_operators_s >= 0.0);
+  BOOST_TEST(ic.online[0].queries == 4);
+  BOOST_TEST(ic.online[1].median_without_operators_s == -1.0);
   BOOST_TEST(rom::median({3.0, 1.0, 2.0}) == 2.0);
   BOOST_TEST(rom::median({4.0, 1.0, 2.0, 3.0}) == 2.5);
 }
