@@ -55,10 +55,9 @@ Eigen::VectorXd projection_errors_scaled(const Eigen::MatrixXd& a, const Eigen::
 
 }  // namespace
 
-double default_cpg_tolerance(const std::string& problem_name) {
-  if (problem_name == "hertz") return 1e-2;
-  if (problem_name == "ironing" || problem_name == "ironing2") return 5e-2;
-  return 1e-2;
+double default_cpg_tolerance(const fom::Problem& problem) {
+  const double from_file = problem.definition().rom.cpg_tolerance;
+  return from_file > 0.0 ? from_file : 1e-2;
 }
 
 Eigen::VectorXd cone_projection_errors(const Eigen::MatrixXd& snapshots, const Eigen::VectorXd& weights,
@@ -114,7 +113,7 @@ CpgBasis cone_projected_greedy(const Eigen::MatrixXd& snapshots, const Eigen::Ve
 
 CpgBasis build_cpg_basis(const rom::ReducedModel& model, const CpgOptions& options) {
   CpgOptions o = options;
-  if (o.tolerance < 0.0) o.tolerance = default_cpg_tolerance(model.problem().name());
+  if (o.tolerance < 0.0) o.tolerance = default_cpg_tolerance(model.problem());
   return cone_projected_greedy(model.dictionary(), model.problem().contact().weights(), o);
 }
 

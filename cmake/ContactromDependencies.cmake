@@ -1,11 +1,12 @@
 # Finds the Debian-packaged dependencies and wraps those without a CMake
-# config (CHOLMOD, gmsh) in IMPORTED targets. See ../shared/TOOLCHAIN.md.
+# config (CHOLMOD, gmsh) in IMPORTED targets.
 find_package(Eigen3 3.4 REQUIRED CONFIG)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(IPOPT REQUIRED IMPORTED_TARGET ipopt)
 find_package(HDF5 REQUIRED COMPONENTS C)
 find_package(Threads REQUIRED)
 find_package(nlohmann_json 3 REQUIRED CONFIG)
+find_package(tomlplusplus CONFIG REQUIRED)
 find_package(CLI11 CONFIG QUIET)
 if(NOT CLI11_FOUND)
   find_path(CLI11_INCLUDE_DIR CLI/CLI.hpp REQUIRED)

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <string>
+
+#include "fom/errors.hpp"
 
 namespace contactrom::fom {
 
@@ -41,42 +44,63 @@ void ContactModel::assemble_rows(const Pairing& pairing, const std::vector<int>&
   c.finalize();
 }
 
-// Surface dof layout: slave node k -> columns 2k, 2k+1; master node j -> 2(n_s+j), 2(n_s+j)+1.
-NodeToSegmentContact::NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const std::vector<int>& slave_chain,
-                                           const std::vector<int>& master_chain,
-                                           const std::vector<Eigen::Vector2d>& master_inside)
-    : m_slave(slave_chain), m_master(master_chain) {
-  const int ns = static_cast<int>(m_slave.size()), nm = static_cast<int>(m_master.size());
+NodeToSegmentContact::NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const std::vector<ContactPairChains>& pairs) {
+  // Surface nodes: every slave node (row order), then the master nodes not seen yet.
+  std::map<int, int> surface_of;  // mesh node -> surface node index
+  for (size_t q = 0; q < pairs.size(); ++q) {
+    if (pairs[q].slave.empty() || pairs[q].master.size() < 2)
+      throw InputError("contact pair " + std::to_string(q) + " has " + std::to_string(pairs[q].slave.size()) +
+                       " slave nodes and " + std::to_string(pairs[q].master.size()) +
+                       " master nodes; expected at least one slave node and one master segment");
+    for (int node : pairs[q].slave) {
+      if (!surface_of.emplace(node, static_cast<int>(m_slave.size())).second)
+        throw InputError("contact pairs share the slave node at (" + std::to_string(nodes(0, node)) + ", " +
+                         std::to_string(nodes(1, node)) + "); expected each slave node in one pair only");
+      m_slave.push_back(node);
+      m_row_pair.push_back(static_cast<int>(q));
+    }
+  }
+  const int ns = static_cast<int>(m_slave.size());
+  int next = ns;
+  std::vector<int> surface_nodes(m_slave);
+  int row = 0;
+  for (const ContactPairChains& chains : pairs) {
+    Pair pair;
+    pair.row_begin = row;
+    pair.row_end = row += static_cast<int>(chains.slave.size());
+    pair.master = chains.master;
+    pair.master_x.resize(2, static_cast<Eigen::Index>(chains.master.size()));
+    for (size_t j = 0; j < chains.master.size(); ++j) {
+      const int node = chains.master[j];
+      auto [it, inserted] = surface_of.emplace(node, next);
+      if (inserted) {
+        surface_nodes.push_back(node);
+        ++next;
+      }
+      if (it->second >= pair.row_begin && it->second < pair.row_end)
+        throw InputError("a contact pair's master curve contains its own slave node at (" +
+                         std::to_string(nodes(0, node)) + ", " + std::to_string(nodes(1, node)) + ")");
+      pair.master_surface.push_back(it->second);
+      pair.master_x.col(static_cast<Eigen::Index>(j)) = nodes.col(node);
+    }
+    m_pairs.push_back(std::move(pair));
+  }
+  for (int node : surface_nodes) m_surface_dofs.insert(m_surface_dofs.end(), {2 * node, 2 * node + 1});
   m_slave_x.resize(2, ns);
-  m_master_x.resize(2, nm);
   for (int k = 0; k < ns; ++k) m_slave_x.col(k) = nodes.col(m_slave[k]);
-  for (int j = 0; j < nm; ++j) m_master_x.col(j) = nodes.col(m_master[j]);
-  for (int node : m_slave) m_surface_dofs.insert(m_surface_dofs.end(), {2 * node, 2 * node + 1});
-  for (int node : m_master) m_surface_dofs.insert(m_surface_dofs.end(), {2 * node, 2 * node + 1});
   m_points = m_slave_x;
 
-  // Tributary lengths: half of each adjacent slave segment.
+  // Tributary lengths: half of each adjacent slave segment, within each pair's chain.
   m_weights = Eigen::VectorXd::Zero(ns);
-  for (int k = 0; k + 1 < ns; ++k) {
-    const double len = (m_slave_x.col(k + 1) - m_slave_x.col(k)).norm();
-    m_weights(k) += 0.5 * len;
-    m_weights(k + 1) += 0.5 * len;
-  }
-
-  // Outward orientation of each master segment: the normal must point away from
-  // the interior point(s) of the master body nearest to the segment.
-  m_orientation.resize(std::max(nm - 1, 0));
-  for (int j = 0; j + 1 < nm; ++j) {
-    const Eigen::Vector2d a = m_master_x.col(j), b = m_master_x.col(j + 1);
-    const Eigen::Vector2d t = b - a, mid = 0.5 * (a + b);
-    const Eigen::Vector2d n(t.y(), -t.x());
-    double best = std::numeric_limits<double>::max();
-    Eigen::Vector2d inside = master_inside.front();
-    for (const auto& p : master_inside)
-      if ((p - mid).norm() < best) best = (p - mid).norm(), inside = p;
-    m_orientation[j] = n.dot(inside - mid) < 0 ? 1.0 : -1.0;
-  }
+  for (const Pair& pair : m_pairs)
+    for (int k = pair.row_begin; k + 1 < pair.row_end; ++k) {
+      const double len = (m_slave_x.col(k + 1) - m_slave_x.col(k)).norm();
+      m_weights(k) += 0.5 * len;
+      m_weights(k + 1) += 0.5 * len;
+    }
 }
+
+int NodeToSegmentContact::pair_of_row(int row) const { return m_row_pair[static_cast<size_t>(row)]; }
 
 void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
                                        const Pairing* hint, Pairing& p) const {
@@ -85,7 +109,26 @@ void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const s
     search_rows(u_surface, rows, &copy, p);
     return;
   }
-  const int ns = static_cast<int>(m_slave.size()), nm = static_cast<int>(m_master.size());
+  const int ns = static_cast<int>(m_slave.size());
+  p.segment.assign(ns, -1);
+  p.xi.assign(ns, 0.0);
+  p.normal.setZero(2, ns);
+  // The listed rows are ascending, so each pair's rows are one contiguous run of them.
+  size_t r = 0;
+  for (const Pair& pair : m_pairs) {
+    if (!rows) {
+      search_pair(pair, u_surface, nullptr, pair.row_end - pair.row_begin, hint, p);
+      continue;
+    }
+    const size_t first = r;
+    while (r < rows->size() && (*rows)[r] < pair.row_end) ++r;
+    if (r > first) search_pair(pair, u_surface, rows->data() + first, static_cast<int>(r - first), hint, p);
+  }
+}
+
+void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& u_surface, const int* rows,
+                                       int nrows, const Pairing* hint, Pairing& p) const {
+  const int nm = static_cast<int>(pair.master.size());
   // Per-thread scratch arrays: a search takes a few microseconds inside the online
   // loops, where allocating them on every call would be a visible share.
   thread_local struct {
@@ -93,9 +136,8 @@ void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const s
     Eigen::VectorXd inv_len2, half, block_r;
   } scratch;
   Eigen::Matrix2Xd& xm = scratch.xm;
-  xm = m_master_x;
-  for (int j = 0; j < nm; ++j) xm.col(j) += u_surface.segment<2>(2 * (ns + j));
-
+  xm = pair.master_x;
+  for (int j = 0; j < nm; ++j) xm.col(j) += u_surface.segment<2>(2 * pair.master_surface[static_cast<size_t>(j)]);
   // Segment data for the distances: tangent t, midpoint, 1/|t|² and the radius of a
   // circle about the midpoint holding the segment (½(|t_x|+|t_y|) ≥ ½|t|, no root).
   const int nseg = std::max(nm - 1, 0);
@@ -129,18 +171,14 @@ void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const s
     block_r(b) = std::sqrt(r2);
   }
 
-  p.segment.assign(ns, -1);
-  p.xi.assign(ns, 0.0);
-  p.normal.setZero(2, ns);
   // Exact closest segment per slave node. Squared distances only; the segment of
   // the previous slave node is tried first (neighbouring slave nodes have
   // neighbouring pairs), then every block whose circle may hold a closer point,
   // then within it every segment whose circle (centre mid, radius half) may.
   // Ties (a slave node exactly at a master node) go to the lower segment index.
   int guess = 0, lowest = nseg, highest = -1;
-  const int nrows = rows ? static_cast<int>(rows->size()) : ns;
   for (int r = 0; r < nrows; ++r) {
-    const int k = rows ? (*rows)[r] : r;
+    const int k = rows ? rows[r] : pair.row_begin + r;
     const double px = m_slave_x(0, k) + u_surface(2 * k), py = m_slave_x(1, k) + u_surface(2 * k + 1);
     double best = std::numeric_limits<double>::max(), best_root = std::numeric_limits<double>::max();
     int best_seg = -1;
@@ -154,7 +192,7 @@ void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const s
       if (dist2 < best * (1.0 - 1e-14) || (best_seg >= 0 && dist2 <= best * (1.0 + 1e-14) && j < best_seg))
         best = dist2, best_root = std::sqrt(dist2), best_seg = j, best_xi = xi, best_raw = raw;
     };
-    if (hint && hint->segment.size() == static_cast<size_t>(ns) && hint->segment[k] >= 0) guess = hint->segment[k];
+    if (hint && hint->segment.size() == p.segment.size() && hint->segment[k] >= 0) guess = hint->segment[k];
     if (nseg > 0) {
       // The guess and its neighbours first: a good first distance prunes the rest.
       try_segment(guess);
@@ -192,48 +230,51 @@ void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const s
   node_normal.middleCols(lowest, highest + 2 - lowest).setZero();
   for (int j = std::max(lowest - 1, 0); j <= std::min(highest + 1, nseg - 1); ++j) {
     const Eigen::Vector2d t = seg_t.col(j);
-    const Eigen::Vector2d n = (m_orientation[j] / t.norm()) * Eigen::Vector2d(t.y(), -t.x());
+    // Chains run with their body on the left: (t_y, −t_x) points out of the master body.
+    const Eigen::Vector2d n = (1.0 / t.norm()) * Eigen::Vector2d(t.y(), -t.x());
     if (j >= lowest) node_normal.col(j) += n;
     if (j + 1 <= highest + 1) node_normal.col(j + 1) += n;
   }
   for (int j = lowest; j <= highest + 1; ++j) node_normal.col(j).normalize();
   for (int r = 0; r < nrows; ++r) {
-    const int k = rows ? (*rows)[r] : r, j = p.segment[k];
+    const int k = rows ? rows[r] : pair.row_begin + r, j = p.segment[k];
     if (j < 0) continue;
     const double xi = p.xi[k];
     p.normal.col(k) = ((1.0 - xi) * node_normal.col(j) + xi * node_normal.col(j + 1)).normalized();
   }
 }
 
+bool NodeToSegmentContact::row_entries(const Pairing& p, int k, int (&cols)[6], double (&vals)[6], double& g) const {
+  const int j = p.segment[static_cast<size_t>(k)];
+  g = 0.0;
+  if (j < 0) return false;
+  const Pair& pair = m_pairs[static_cast<size_t>(m_row_pair[static_cast<size_t>(k)])];
+  const double w = m_weights(k), xi = p.xi[static_cast<size_t>(k)];
+  const Eigen::Vector2d n = p.normal.col(k);
+  const Eigen::Vector2d xm = (1.0 - xi) * pair.master_x.col(j) + xi * pair.master_x.col(j + 1);
+  g = w * n.dot(m_slave_x.col(k) - xm);
+  const int a = pair.master_surface[static_cast<size_t>(j)], b = pair.master_surface[static_cast<size_t>(j + 1)];
+  const int c[6] = {2 * k, 2 * k + 1, 2 * a, 2 * a + 1, 2 * b, 2 * b + 1};
+  const double v[6] = {-w * n(0), -w * n(1), w * (1.0 - xi) * n(0), w * (1.0 - xi) * n(1), w * xi * n(0), w * xi * n(1)};
+  // Compressed rows keep their columns ascending: node k, a, b in increasing order.
+  int order[3] = {0, 1, 2};
+  const int node[3] = {k, a, b};
+  std::sort(order, order + 3, [&](int x, int y) { return node[x] < node[y]; });
+  for (int e = 0; e < 3; ++e)
+    for (int d = 0; d < 2; ++d) cols[2 * e + d] = c[2 * order[e] + d], vals[2 * e + d] = v[2 * order[e] + d];
+  return true;
+}
+
 void NodeToSegmentContact::assemble(const Pairing& p, ConstraintMatrix& c, Eigen::VectorXd& g) const {
-  const int ns = static_cast<int>(m_slave.size());
-  g = Eigen::VectorXd::Zero(ns);
-  // Row-major storage filled in order: a row's columns (slave node k, master
-  // nodes j and j+1, ascending since master columns follow all slave columns).
-  c.resize(ns, static_cast<int>(m_surface_dofs.size()));
-  c.reserve(6 * ns);
-  for (int k = 0; k < ns; ++k) {
-    c.startVec(k);
-    const int j = p.segment[k];
-    if (j < 0) continue;
-    const double w = m_weights(k), xi = p.xi[k];
-    const Eigen::Vector2d n = p.normal.col(k);
-    const Eigen::Vector2d xm = (1.0 - xi) * m_master_x.col(j) + xi * m_master_x.col(j + 1);
-    g(k) = w * n.dot(m_slave_x.col(k) - xm);
-    c.insertBack(k, 2 * k) = -w * n(0);
-    c.insertBack(k, 2 * k + 1) = -w * n(1);
-    c.insertBack(k, 2 * (ns + j)) = w * (1.0 - xi) * n(0);
-    c.insertBack(k, 2 * (ns + j) + 1) = w * (1.0 - xi) * n(1);
-    c.insertBack(k, 2 * (ns + j + 1)) = w * xi * n(0);
-    c.insertBack(k, 2 * (ns + j + 1) + 1) = w * xi * n(1);
-  }
-  c.finalize();
+  std::vector<int> all(m_slave.size());
+  for (size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
+  assemble_rows(p, all, c, g);
 }
 
 void NodeToSegmentContact::assemble_rows(const Pairing& p, const std::vector<int>& rows, ConstraintMatrix& c,
                                          Eigen::VectorXd& g) const {
-  // Same entries as assemble(), written straight into the compressed arrays.
-  const int ns = static_cast<int>(m_slave.size()), nr = static_cast<int>(rows.size());
+  // Written straight into the compressed arrays (reused storage, no allocation).
+  const int nr = static_cast<int>(rows.size());
   g.resize(nr);
   c.resize(nr, static_cast<int>(m_surface_dofs.size()));
   c.resizeNonZeros(6 * nr);
@@ -243,15 +284,9 @@ void NodeToSegmentContact::assemble_rows(const Pairing& p, const std::vector<int
   int nnz = 0;
   for (int i = 0; i < nr; ++i) {
     outer[i] = nnz;
-    const int k = rows[static_cast<size_t>(i)], j = p.segment[static_cast<size_t>(k)];
-    g(i) = 0.0;
-    if (j < 0) continue;
-    const double w = m_weights(k), xi = p.xi[static_cast<size_t>(k)];
-    const Eigen::Vector2d n = p.normal.col(k);
-    const Eigen::Vector2d xm = (1.0 - xi) * m_master_x.col(j) + xi * m_master_x.col(j + 1);
-    g(i) = w * n.dot(m_slave_x.col(k) - xm);
-    const int cols[6] = {2 * k, 2 * k + 1, 2 * (ns + j), 2 * (ns + j) + 1, 2 * (ns + j + 1), 2 * (ns + j + 1) + 1};
-    const double vals[6] = {-w * n(0), -w * n(1), w * (1.0 - xi) * n(0), w * (1.0 - xi) * n(1), w * xi * n(0), w * xi * n(1)};
+    int cols[6];
+    double vals[6];
+    if (!row_entries(p, rows[static_cast<size_t>(i)], cols, vals, g(i))) continue;
     for (int e = 0; e < 6; ++e) inner[nnz + e] = cols[e], value[nnz + e] = vals[e];
     nnz += 6;
   }

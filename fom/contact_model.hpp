@@ -87,15 +87,25 @@ class ContactModel {
   Eigen::Matrix2Xd m_points;
 };
 
-/// \brief Two-body node-to-segment contact (slave nodes against master segments).
+/// \brief One contact pair of NodeToSegmentContact: node chains of the slave and
+/// master curves, each in the mesh's chain order (its body on the left, so that a
+/// master segment a→b has the outward normal (t_y, −t_x) of its own body).
+struct ContactPairChains {
+  std::vector<int> slave;   ///< slave node ids in chain order
+  std::vector<int> master;  ///< master node ids in chain order
+};
+
+/// \brief Node-to-segment contact of any number of pairs (slave nodes against
+/// master segments). Rows are the slave nodes of pair 0, then of pair 1, …; the
+/// surface dofs are the slave nodes in row order (row s ↔ surface node s), then the
+/// master nodes that are not slave nodes, pair after pair in chain order. A slave
+/// node is paired only with the master chain of its own pair.
 class NodeToSegmentContact final : public ContactModel {
  public:
   /// \param nodes reference coordinates of the mesh (2 x n_nodes)
-  /// \param slave_chain slave node ids in chain order
-  /// \param master_chain master node ids in chain order
-  /// \param master_inside a point inside the master body (orients normals outward)
-  NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const std::vector<int>& slave_chain,
-                       const std::vector<int>& master_chain, const std::vector<Eigen::Vector2d>& master_inside);
+  /// \param pairs the pairs' chains; slave nodes must be distinct across pairs
+  /// \throws InputError if a slave node appears twice or a chain is too short
+  NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const std::vector<ContactPairChains>& pairs);
 
   bool has_pairing() const override { return true; }
   using ContactModel::search_rows;
@@ -105,14 +115,30 @@ class NodeToSegmentContact final : public ContactModel {
   void assemble_rows(const Pairing& pairing, const std::vector<int>& rows, ConstraintMatrix& c,
                      Eigen::VectorXd& g) const override;
 
+  /// Slave node ids of every row, in row order.
   const std::vector<int>& slave_nodes() const { return m_slave; }
-  const std::vector<int>& master_nodes() const { return m_master; }
+  int num_pairs() const { return static_cast<int>(m_pairs.size()); }
+  /// Pair of a constraint row.
+  int pair_of_row(int row) const;
 
  private:
-  std::vector<int> m_slave, m_master;
-  Eigen::Matrix2Xd m_slave_x, m_master_x;  // reference coordinates
-  std::vector<double> m_orientation;       // +1/-1 per master segment: outward normal sign
-  int m_block = 8;                         // segments per bounding circle of the search
+  struct Pair {
+    int row_begin = 0, row_end = 0;     // rows [row_begin, row_end)
+    std::vector<int> master;            // master node ids, chain order
+    std::vector<int> master_surface;    // surface node index of each master node
+    Eigen::Matrix2Xd master_x;          // reference coordinates
+  };
+  /// Search of one pair's rows (all of them when rows is nullptr).
+  void search_pair(const Pair& pair, const Eigen::VectorXd& u_surface, const int* rows, int nrows,
+                   const Pairing* hint, Pairing& p) const;
+  /// The six (column, value) entries of row k and g_k; returns false for an unpaired row.
+  bool row_entries(const Pairing& p, int k, int (&cols)[6], double (&vals)[6], double& g) const;
+
+  std::vector<int> m_slave;
+  Eigen::Matrix2Xd m_slave_x;  // reference coordinates
+  std::vector<Pair> m_pairs;
+  std::vector<int> m_row_pair;  // pair of each row
+  int m_block = 8;              // segments per bounding circle of the search
 };
 
 /// \brief Scalar obstacle constraint \f$ u_i \ge \psi(x_i) \f$ on 1D nodes (rope).

@@ -10,8 +10,13 @@ namespace {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
-Eigen::Matrix3d plane_strain_matrix(const Material& m) {
+Eigen::Matrix3d constitutive_matrix(const Material& m) {
   const double e = m.young, nu = m.poisson;
+  if (m.plane_stress) {
+    Eigen::Matrix3d d;
+    d << 1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, 0.5 * (1.0 - nu);
+    return (e / (1.0 - nu * nu)) * d;
+  }
   const double c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
   Eigen::Matrix3d d;
   d << 1.0 - nu, nu, 0.0, nu, 1.0 - nu, 0.0, 0.0, 0.0, 0.5 * (1.0 - 2.0 * nu);
@@ -88,7 +93,7 @@ SparseMatrix assemble_stiffness(const Mesh& mesh, const std::vector<Material>& m
     if (body < 0 || body >= static_cast<int>(materials.size()))
       throw InputError("mesh quad " + std::to_string(q) + " belongs to body " + std::to_string(body) +
                        " but only " + std::to_string(materials.size()) + " materials are defined");
-    const Eigen::Matrix3d d = plane_strain_matrix(materials[body]);
+    const Eigen::Matrix3d d = constitutive_matrix(materials[body]);
     Eigen::Matrix<double, 8, 8> ke = Eigen::Matrix<double, 8, 8>::Zero();
     for (double xi : {-kGauss, kGauss})
       for (double eta : {-kGauss, kGauss}) {
@@ -127,8 +132,8 @@ Eigen::MatrixXd element_stresses(const Mesh& mesh, const std::vector<Material>& 
     physical_gradients(mesh, q, shape(0.0, 0.0), grad);
     Eigen::Matrix<double, 8, 1> ue;
     for (int a = 0; a < 4; ++a) ue.segment<2>(2 * a) = u.segment<2>(2 * mesh.quads[q][a]);
-    const Eigen::Vector3d s = plane_strain_matrix(m) * strain_matrix(grad) * ue;
-    const double szz = m.poisson * (s(0) + s(1));
+    const Eigen::Vector3d s = constitutive_matrix(m) * strain_matrix(grad) * ue;
+    const double szz = m.plane_stress ? 0.0 : m.poisson * (s(0) + s(1));
     const double vm = std::sqrt(0.5 * ((s(0) - s(1)) * (s(0) - s(1)) + (s(1) - szz) * (s(1) - szz) +
                                        (szz - s(0)) * (szz - s(0))) +
                                 3.0 * s(2) * s(2));

@@ -32,7 +32,7 @@ void ensure_directory(const std::string& dir) {
     throw InputError("cannot create output folder '" + dir + "': " + (ec ? ec.message() : "not a folder"));
 }
 
-void write_vtu(const std::string& path, const Problem& problem, const Eigen::VectorXd& u,
+void write_vtu(const std::string& path, const Problem& problem, const Param& mu, const Eigen::VectorXd& u,
                const Eigen::VectorXd& lambda) {
   const Mesh* mesh = problem.mesh();
   const ContactModel& contact = problem.contact();
@@ -73,7 +73,7 @@ void write_vtu(const std::string& path, const Problem& problem, const Eigen::Vec
     data_array(out, "contact_pressure", 1, press);
     out << "      </PointData>\n";
     if (mesh) {
-      const Eigen::MatrixXd stress = element_stresses(*mesh, problem.materials(), u);
+      const Eigen::MatrixXd stress = element_stresses(*mesh, problem.materials(mu), u);
       Eigen::MatrixXd body(ncell, 1);
       for (int c = 0; c < ncell; ++c) body(c, 0) = mesh->quad_body[c];
       out << "      <CellData>\n";

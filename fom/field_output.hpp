@@ -14,7 +14,7 @@ namespace contactrom::fom {
 /// `displacement` (3 components) and `contact_pressure` (on constrained nodes),
 /// cell data `stress` (σxx, σyy, σxy, σzz), `von_mises` and `body`.
 /// The 1D rope is written as line cells with a scalar `displacement`.
-void write_vtu(const std::string& path, const Problem& problem, const Eigen::VectorXd& u,
+void write_vtu(const std::string& path, const Problem& problem, const Param& mu, const Eigen::VectorXd& u,
                const Eigen::VectorXd& lambda);
 
 /// \brief Writes the contact surface CSV: columns `x,y,gap,pressure` (one row per

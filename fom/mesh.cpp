@@ -396,7 +396,7 @@ std::string Mesh::fingerprint() const {
   return buf;
 }
 
-Mesh load_mesh(const std::string& path) {
+Mesh load_mesh(const std::string& path, int refine) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh file '" + path + "' not found");
   if (!std::ifstream(path)) throw InputError("mesh file '" + path + "' is not readable");
@@ -412,6 +412,12 @@ Mesh load_mesh(const std::string& path) {
       gmsh::model::mesh::generate(2);
       if (std::string err = session.take_first_error(); !err.empty())
         throw InputError(where + ": gmsh meshing failed: " + err);
+    }
+    for (int level = 0; level < refine; ++level) {
+      gmsh::option::setNumber("Mesh.SubdivisionAlgorithm", 1);  // quads stay quads
+      gmsh::model::mesh::refine();
+      if (std::string err = session.take_first_error(); !err.empty())
+        throw InputError(where + ": gmsh refinement failed: " + err);
     }
     return read_current_model(where);
   } catch (const InputError&) {

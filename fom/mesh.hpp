@@ -65,11 +65,13 @@ struct Mesh {
 /// holds a gmsh session (gmsh keeps its state in globals). Keep it out of hot
 /// loops: a session costs about 0.01-0.1 s.
 /// \param path file to read
+/// \param refine uniform refinements after meshing (each splits every quad in
+///   four, new boundary nodes on the geometry's curves), default 0
 /// \throws InputError if the file is missing ("mesh file 'X' not found"),
 ///   unreadable, rejected by gmsh (syntax error, meshing error; the message names
 ///   the file and quotes gmsh), produces non-quad elements, lacks physical
 ///   groups, or has a curve group that is not a single chain.
-Mesh load_mesh(const std::string& path);
+Mesh load_mesh(const std::string& path, int refine = 0);
 
 /// \brief The folder holding the project's `.geo` files: `$CONTACTROM_MESH_DIR`
 /// if set, else the source tree's `meshes/` recorded at configure time.

@@ -2,25 +2,14 @@
 
 #include <cmath>
 #include <cstdio>
-#include <limits>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "fom/errors.hpp"
 
 namespace contactrom::fom {
 namespace {
-
-std::string format_number(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-
-std::string join(const std::vector<std::string>& names) {
-  std::string out;
-  for (size_t i = 0; i < names.size(); ++i) out += (i ? ", " : "") + names[i];
-  return out;
-}
 
 std::string hash_text(const std::string& text) {
   std::uint64_t h = 1469598103934665603ULL;
@@ -30,211 +19,175 @@ std::string hash_text(const std::string& text) {
   return buf;
 }
 
-/// Sorted node ids of a set of physical curves, marking both dofs Dirichlet.
-void mark_dirichlet(const Mesh& mesh, const std::string& group, std::vector<char>& is_dirichlet) {
-  for (int node : mesh.group_nodes(group)) is_dirichlet[2 * node] = is_dirichlet[2 * node + 1] = 1;
+std::string point_text(const Mesh& mesh, int node) {
+  std::ostringstream s;
+  s << "(" << mesh.nodes(0, node) << ", " << mesh.nodes(1, node) << ")";
+  return s.str();
 }
 
-std::vector<Eigen::Vector2d> body_centroids(const Mesh& mesh, int body) {
-  std::vector<Eigen::Vector2d> out;
-  for (int q = 0; q < mesh.num_quads(); ++q) {
-    if (mesh.quad_body[q] != body) continue;
-    Eigen::Vector2d c = Eigen::Vector2d::Zero();
-    for (int a = 0; a < 4; ++a) c += 0.25 * mesh.nodes.col(mesh.quads[q][a]);
-    out.push_back(c);
-  }
+std::string joined_keys(const std::map<std::string, std::vector<int>>& groups) {
+  std::string out;
+  for (const auto& [name, nodes] : groups) out += (out.empty() ? "" : ", ") + name;
   return out;
 }
 
-int body_index(const Mesh& mesh, const std::string& name, const std::string& file) {
-  for (size_t b = 0; b < mesh.body_names.size(); ++b)
-    if (mesh.body_names[b] == name) return static_cast<int>(b);
-  throw InputError("mesh '" + file + "' has no physical surface '" + name + "'");
-}
-
-/// Base for the two-body Q1 problems: loads the mesh, assembles K and the H¹
-/// Gram matrix, sets Dirichlet dofs and the node-to-segment contact.
-class TwoBodyProblem : public Problem {
- protected:
-  void setup_mesh(const ProblemOptions& opt, const std::string& file, const std::string& master_body,
-                  const std::vector<std::string>& dirichlet_groups) {
-    const std::string dir = opt.mesh_dir.empty() ? mesh_directory() : opt.mesh_dir;
-    const std::string path = dir + "/" + file;
-    m_mesh = std::make_unique<Mesh>(load_mesh(path));
-    const Mesh& mesh = *m_mesh;
-    m_materials.assign(mesh.body_names.size(), Material{});
-    m_k_terms = {assemble_stiffness(mesh, m_materials)};
-    m_h1 = assemble_h1_gram(mesh);
-    m_is_dirichlet.assign(2 * mesh.num_nodes(), 0);
-    for (const auto& g : dirichlet_groups) mark_dirichlet(mesh, g, m_is_dirichlet);
-    finalize_dofs();
-    m_contact = std::make_unique<NodeToSegmentContact>(
-        mesh.nodes, mesh.group_nodes("slave"), mesh.group_nodes("master"),
-        body_centroids(mesh, body_index(mesh, master_body, path)));
-  }
-  /// Lifting vector: `value` on component `comp` of the nodes of `group`.
-  Eigen::VectorXd lift(const std::string& group, int comp, double value) const {
-    Eigen::VectorXd l = Eigen::VectorXd::Zero(num_dofs());
-    for (int node : m_mesh->group_nodes(group)) l(2 * node + comp) = value;
-    return l;
+/// Affine terms: index 0 is the constant, index 1+i the coefficient of parameter i.
+/// A term whose vectors are all zero is dropped by the caller.
+struct AffineVectors {
+  std::vector<Eigen::VectorXd> terms;  // 1 + num_params vectors
+  AffineVectors(int num_params, int n) : terms(static_cast<size_t>(num_params + 1), Eigen::VectorXd::Zero(n)) {}
+  void add(int dof, const AffineExpression& e, double factor = 1.0) {
+    terms[0](dof) += factor * e.constant;
+    for (int i = 0; i < e.coefficients.size(); ++i) terms[static_cast<size_t>(i + 1)](dof) += factor * e.coefficients(i);
   }
 };
 
-class HertzProblem final : public TwoBodyProblem {
+/// Builds a problem from its definition and mesh (see build_problem).
+class Builder {
  public:
-  explicit HertzProblem(const ProblemOptions& opt) {
-    m_name = "hertz";
-    m_param_names = {"d"};
-    m_lower = Eigen::VectorXd::Constant(1, 0.0);
-    m_upper = Eigen::VectorXd::Constant(1, 0.3);
-    m_lower_open = true;
-    setup_mesh(opt, "hertz.geo", "bottom", {"bottom_clamp", "top_load"});
-    m_lift_terms = {lift("top_load", 1, -1.0)};
-    m_fext_terms = {Eigen::VectorXd::Zero(num_dofs())};
-    m_u_scale = 0.3;
-    m_fingerprint = hash_text("hertz|" + m_mesh->fingerprint());
-  }
-  Eigen::VectorXd stiffness_coefficients(const Param&) const override { return Eigen::VectorXd::Ones(1); }
-  Eigen::VectorXd load_coefficients(const Param& mu) const override { return mu.head(1); }
-  std::vector<Param> training_set(int n) const override {
-    if (n < 1 || n > 100000) throw InputError("hertz training size " + std::to_string(n) + " invalid; expected 1..100000");
-    std::vector<Param> out;
-    for (int i = 1; i <= n; ++i) out.push_back(Eigen::VectorXd::Constant(1, 0.3 * i / n));
-    return out;
-  }
-  std::vector<Param> validation_set(int) const override {
-    std::vector<Param> out;
-    for (int i = 1; i < 120; ++i) out.push_back(Eigen::VectorXd::Constant(1, 0.3 * (i + 0.5) / 120.0));
-    return out;
-  }
-};
+  Builder(Problem& p, const ProblemDefinition& def, const Mesh& mesh) : m_p(p), m_def(def), m_mesh(mesh) {}
 
-class IroningProblem final : public TwoBodyProblem {
- public:
-  IroningProblem(const ProblemOptions& opt, bool free_dy) : m_free_dy(free_dy), m_dy(opt.ironing_dy) {
-    if (!(opt.ironing_length > 0)) throw InputError("ironing length " + format_number(opt.ironing_length) + " invalid; expected > 0");
-    m_name = free_dy ? "ironing2" : "ironing";
-    m_param_names = free_dy ? std::vector<std::string>{"d_x", "d_y"} : std::vector<std::string>{"d_x"};
-    if (free_dy) {
-      m_lower = Eigen::Vector2d(0.0, 0.1);
-      m_upper = Eigen::Vector2d(opt.ironing_length, 0.3);
-    } else {
-      m_lower = Eigen::VectorXd::Constant(1, 0.0);
-      m_upper = Eigen::VectorXd::Constant(1, opt.ironing_length);
+  void check_bodies() {
+    for (const BodySpec& b : m_def.bodies)
+      if (body_index(b.group) < 0)
+        throw InputError(m_def.where(b.where) + ": the mesh has no physical surface '" + b.group +
+                         "'; expected one of: " + body_list());
+    for (const std::string& surface : m_mesh.body_names) {
+      bool listed = false;
+      for (const BodySpec& b : m_def.bodies) listed = listed || b.group == surface;
+      if (!listed)
+        throw InputError(m_def.where({0, "bodies"}) + ": the mesh's physical surface '" + surface +
+                         "' has no [[bodies]] entry; expected every surface of '" + m_def.mesh + "' listed");
     }
-    setup_mesh(opt, "ironing.geo", "slab", {"slab_bottom", "iron_top"});
-    m_lift_terms = {lift("iron_top", 0, 1.0), lift("iron_top", 1, -1.0)};
-    m_fext_terms = {Eigen::VectorXd::Zero(num_dofs()), Eigen::VectorXd::Zero(num_dofs())};
-    m_u_scale = 0.3;
-    m_fingerprint = hash_text(m_name + "|" + m_mesh->fingerprint() + "|" + format_number(opt.ironing_length) +
-                              "|" + format_number(m_dy));
   }
-  bool uses_levels() const override { return true; }
-  Eigen::VectorXd stiffness_coefficients(const Param&) const override { return Eigen::VectorXd::Ones(1); }
-  Eigen::VectorXd load_coefficients(const Param& mu) const override {
-    return Eigen::Vector2d(mu(0), m_free_dy ? mu(1) : m_dy);
-  }
-  std::vector<Param> training_set(int level) const override { return grid(check_level(level)); }
-  std::vector<Param> validation_set(int level) const override {
-    // ironing: level 8 minus level 7 (fixed); ironing2: next level minus current.
-    const int fine = m_free_dy ? check_level(level) + 1 : 8;
-    std::vector<Param> out;
-    const int nx = 1 << fine;
-    for (const Param& p : grid(fine)) {
-      const long ix = std::lround(p(0) / m_upper(0) * nx);
-      long iy = 0;
-      if (m_free_dy) iy = std::lround((p(1) - m_lower(1)) / (m_upper(1) - m_lower(1)) * nx);
-      if (ix % 2 == 1 || iy % 2 == 1) out.push_back(p);
+
+  /// Material terms: K_q assembled with E = the q-th affine coefficient of each body.
+  void assemble_stiffness_terms(std::vector<SparseMatrix>& terms, std::vector<AffineExpression>& coeffs) const {
+    const int np = m_def.parameters.size();
+    for (int q = 0; q <= np; ++q) {
+      std::vector<Material> mats(m_mesh.body_names.size());
+      bool any = false;
+      for (const BodySpec& b : m_def.bodies) {
+        Material& m = mats[static_cast<size_t>(body_index(b.group))];
+        m.young = q == 0 ? b.young.constant : b.young.coefficients(q - 1);
+        m.poisson = b.poisson;
+        m.plane_stress = m_def.plane_stress;
+        any = any || m.young != 0.0;
+      }
+      if (!any) continue;
+      terms.push_back(assemble_stiffness(m_mesh, mats));
+      AffineExpression theta = AffineExpression::constant_value(q == 0 ? 1.0 : 0.0, np);
+      if (q > 0) theta.coefficients(q - 1) = 1.0;
+      coeffs.push_back(theta);
     }
-    return out;
+  }
+
+  /// Dirichlet dofs and lifting; refuses two groups that prescribe different values on a dof.
+  void dirichlet(std::vector<char>& is_dirichlet, AffineVectors& lift) const {
+    std::vector<int> owner(is_dirichlet.size(), -1);
+    for (size_t s = 0; s < m_def.dirichlet.size(); ++s) {
+      const DirichletSpec& d = m_def.dirichlet[s];
+      for (int node : group_nodes(d.group, d.where, "physical curve")) {
+        for (int c = 0; c < 2; ++c) {
+          const auto& value = d.displacement[static_cast<size_t>(c)];
+          if (!value) continue;
+          const int dof = 2 * node + c;
+          if (owner[dof] >= 0) {
+            const auto& other = *m_def.dirichlet[static_cast<size_t>(owner[dof])].displacement[static_cast<size_t>(c)];
+            if (other.constant != value->constant || other.coefficients != value->coefficients)
+              throw InputError(m_def.where(d.where) + ": prescribes another displacement than dirichlet[" +
+                               std::to_string(owner[dof]) + "] at the shared node " + point_text(m_mesh, node) +
+                               "; expected equal values where Dirichlet groups meet");
+            continue;
+          }
+          owner[dof] = static_cast<int>(s);
+          is_dirichlet[dof] = 1;
+          lift.add(dof, *value);
+        }
+      }
+    }
+  }
+
+  /// Consistent nodal forces of the tractions (force per unit length, linear elements).
+  void tractions(AffineVectors& fext) const {
+    for (const TractionSpec& t : m_def.traction) {
+      group_nodes(t.group, t.where, "physical curve");
+      for (const auto& seg : m_mesh.group_segments(t.group)) {
+        const double half = 0.5 * (m_mesh.nodes.col(seg[1]) - m_mesh.nodes.col(seg[0])).norm();
+        for (int node : seg)
+          for (int c = 0; c < 2; ++c) fext.add(2 * node + c, t.traction[static_cast<size_t>(c)], half);
+      }
+    }
+  }
+
+  std::unique_ptr<ContactModel> contact() const {
+    // Boundary edges: quad edges used once.
+    std::map<std::pair<int, int>, int> edge_count;
+    for (const auto& q : m_mesh.quads)
+      for (int a = 0; a < 4; ++a) {
+        const int i = q[a], j = q[(a + 1) % 4];
+        ++edge_count[{std::min(i, j), std::max(i, j)}];
+      }
+    std::vector<ContactPairChains> pairs;
+    for (const ContactPairSpec& c : m_def.contact) {
+      ContactPairChains chains;
+      chains.slave = group_nodes(c.slave, c.where, "physical curve");
+      chains.master = group_nodes(c.master, c.where, "physical curve");
+      for (const std::string* name : {&c.slave, &c.master}) {
+        if (m_mesh.segments.count(*name) == 0 || m_mesh.segments.at(*name).empty())
+          throw InputError(m_def.where(c.where) + ": '" + *name + "' is not a physical curve with segments");
+        for (const auto& seg : m_mesh.segments.at(*name))
+          if (edge_count[{std::min(seg[0], seg[1]), std::max(seg[0], seg[1])}] != 1)
+            throw InputError(m_def.where(c.where) + ": the curve '" + *name + "' has the segment " +
+                             point_text(m_mesh, seg[0]) + "-" + point_text(m_mesh, seg[1]) +
+                             " inside a body; expected a contact curve on the boundary of its body");
+      }
+      pairs.push_back(std::move(chains));
+    }
+    try {
+      return std::make_unique<NodeToSegmentContact>(m_mesh.nodes, pairs);
+    } catch (const InputError& e) {
+      throw InputError(m_def.where({0, "contact"}) + ": " + e.what());
+    }
   }
 
  private:
-  int check_level(int level) const {
-    const int max_level = m_free_dy ? 7 : 12;
-    if (level < 1 || level > max_level)
-      throw InputError(m_name + " level " + std::to_string(level) + " invalid; expected 1.." + std::to_string(max_level));
-    return level;
+  int body_index(const std::string& name) const {
+    for (size_t b = 0; b < m_mesh.body_names.size(); ++b)
+      if (m_mesh.body_names[b] == name) return static_cast<int>(b);
+    return -1;
   }
-  std::vector<Param> grid(int level) const {
-    const int n = 1 << level;
-    std::vector<Param> out;
-    for (int i = 0; i <= n; ++i) {
-      const double dx = m_upper(0) * i / n;
-      if (!m_free_dy) {
-        out.push_back(Eigen::VectorXd::Constant(1, dx));
-        continue;
-      }
-      for (int j = 0; j <= n; ++j) out.push_back(Eigen::Vector2d(dx, m_lower(1) + (m_upper(1) - m_lower(1)) * j / n));
-    }
+  std::string body_list() const {
+    std::string out;
+    for (const auto& n : m_mesh.body_names) out += (out.empty() ? "" : ", ") + n;
     return out;
   }
-  bool m_free_dy;
-  double m_dy;
+  const std::vector<int>& group_nodes(const std::string& group, const SourceLocation& where, const char* kind) const {
+    auto it = m_mesh.curve_nodes.find(group);
+    if (it == m_mesh.curve_nodes.end())
+      throw InputError(m_def.where(where) + ": the mesh has no " + kind + " '" + group + "'; expected one of: " +
+                       joined_keys(m_mesh.curve_nodes));
+    return it->second;
+  }
+
+  Problem& m_p;
+  const ProblemDefinition& m_def;
+  const Mesh& m_mesh;
 };
 
-/// 1D elastic rope on [0,1] above an obstacle (paper appendix B):
-/// energy ½∫ν(u')² + ∫ f u, u(0)=u(1)=0, u ≥ ψ(x) = −0.2(sin πx − sin 3πx) − 0.5,
-/// ν = γ for x < 0.5 and 30 otherwise.
-class RopeProblem final : public Problem {
- public:
-  explicit RopeProblem(const ProblemOptions& opt) {
-    const int ne = opt.rope_elements;
-    if (ne < 2 || ne > 1000000) throw InputError("rope elements " + std::to_string(ne) + " invalid; expected 2..1000000");
-    m_name = "rope";
-    m_param_names = {"gamma"};
-    m_lower = Eigen::VectorXd::Constant(1, 10.0);
-    m_upper = Eigen::VectorXd::Constant(1, 50.0);
-    m_dofs_per_node = 1;
-    const int n = ne + 1;
-    const double h = 1.0 / ne;
-    m_rope_x = Eigen::VectorXd::LinSpaced(n, 0.0, 1.0);
-    std::vector<Eigen::Triplet<double>> left, right, gram;
-    for (int e = 0; e < ne; ++e) {
-      auto& t = (0.5 * (m_rope_x(e) + m_rope_x(e + 1)) < 0.5) ? left : right;
-      const double k = 1.0 / h;
-      t.insert(t.end(), {{e, e, k}, {e, e + 1, -k}, {e + 1, e, -k}, {e + 1, e + 1, k}});
-      const double m = h / 6.0;  // H¹ Gram: mass + stiffness
-      gram.insert(gram.end(), {{e, e, 2 * m + k}, {e, e + 1, m - k}, {e + 1, e, m - k}, {e + 1, e + 1, 2 * m + k}});
-    }
-    SparseMatrix kl(n, n), kr(n, n);
-    kl.setFromTriplets(left.begin(), left.end());
-    kr.setFromTriplets(right.begin(), right.end());
-    m_k_terms = {kl, kr};
-    m_h1.resize(n, n);
-    m_h1.setFromTriplets(gram.begin(), gram.end());
-    m_is_dirichlet.assign(n, 0);
-    m_is_dirichlet.front() = m_is_dirichlet.back() = 1;
-    finalize_dofs();
-    Eigen::VectorXd w = Eigen::VectorXd::Constant(n, h);
-    w(0) = w(n - 1) = 0.5 * h;
-    Eigen::VectorXd psi(n);
-    for (int i = 0; i < n; ++i) {
-      const double x = m_rope_x(i);
-      psi(i) = -0.2 * (std::sin(M_PI * x) - std::sin(3 * M_PI * x)) - 0.5;
-    }
-    m_contact = std::make_unique<ObstacleContact>(m_rope_x, psi, w);
-    Eigen::VectorXd fext = -opt.rope_load * w;
-    fext(0) = fext(n - 1) = 0.0;
-    m_fext_terms = {fext};
-    m_lift_terms = {Eigen::VectorXd::Zero(n)};
-    m_u_scale = 0.5;
-    m_fingerprint = hash_text("rope|" + std::to_string(ne) + "|" + format_number(opt.rope_load));
+/// Keeps the terms of `v` that are not all zero, with their coefficient functions.
+void keep_nonzero_terms(const AffineVectors& lift, const AffineVectors& fext, int num_params,
+                        std::vector<Eigen::VectorXd>& lift_terms, std::vector<Eigen::VectorXd>& fext_terms,
+                        std::vector<AffineExpression>& coeffs) {
+  for (size_t q = 0; q < lift.terms.size(); ++q) {
+    if (lift.terms[q].cwiseAbs().maxCoeff() == 0.0 && fext.terms[q].cwiseAbs().maxCoeff() == 0.0) continue;
+    lift_terms.push_back(lift.terms[q]);
+    fext_terms.push_back(fext.terms[q]);
+    AffineExpression phi = AffineExpression::constant_value(q == 0 ? 1.0 : 0.0, num_params);
+    if (q > 0) phi.coefficients(static_cast<Eigen::Index>(q - 1)) = 1.0;
+    coeffs.push_back(phi);
   }
-  bool convex_parameter_independent_feasible_set() const override { return true; }
-  Eigen::VectorXd stiffness_coefficients(const Param& mu) const override { return Eigen::Vector2d(mu(0), 30.0); }
-  Eigen::VectorXd load_coefficients(const Param&) const override { return Eigen::VectorXd::Ones(1); }
-  std::vector<Param> training_set(int) const override {
-    std::vector<Param> out;
-    for (int i = 0; i <= 8; ++i) out.push_back(Eigen::VectorXd::Constant(1, 10.0 + 5.0 * i));
-    return out;
-  }
-  std::vector<Param> validation_set(int) const override {
-    std::vector<Param> out;
-    for (int i = 0; i < 8; ++i) out.push_back(Eigen::VectorXd::Constant(1, 12.5 + 5.0 * i));
-    return out;
-  }
-};
+}
 
 }  // namespace
 
@@ -244,25 +197,27 @@ void Problem::finalize_dofs() {
     if (!m_is_dirichlet[i]) m_free_dofs.push_back(i);
 }
 
-void Problem::check_param(const Param& mu) const {
-  if (mu.size() != num_params())
-    throw InputError("problem '" + m_name + "' takes " + std::to_string(num_params()) + " parameter value(s) (" +
-                     range_text() + "), got " + std::to_string(mu.size()));
-  for (int i = 0; i < mu.size(); ++i) {
-    const bool below = m_lower_open ? !(mu(i) > m_lower(i)) : !(mu(i) >= m_lower(i));
-    if (below || !(mu(i) <= m_upper(i)) || !std::isfinite(mu(i)))
-      throw InputError("parameter " + m_param_names[i] + " = " + format_number(mu(i)) + " is outside the range of '" +
-                       m_name + "'; expected " + range_text());
-  }
+Eigen::VectorXd Problem::stiffness_coefficients(const Param& mu) const {
+  Eigen::VectorXd theta(num_stiffness_terms());
+  for (int q = 0; q < theta.size(); ++q) theta(q) = m_k_coeff[static_cast<size_t>(q)](mu);
+  return theta;
 }
 
-std::string Problem::range_text() const {
-  std::string out;
-  for (int i = 0; i < num_params(); ++i) {
-    if (i) out += ", ";
-    out += m_param_names[i] + " in " + (m_lower_open ? "(" : "[") + format_number(m_lower(i)) + ", " +
-           format_number(m_upper(i)) + "]";
-  }
+Eigen::VectorXd Problem::load_coefficients(const Param& mu) const {
+  Eigen::VectorXd phi(num_load_terms());
+  for (int k = 0; k < phi.size(); ++k) phi(k) = m_load_coeff[static_cast<size_t>(k)](mu);
+  return phi;
+}
+
+std::vector<Material> Problem::materials(const Param& mu) const {
+  std::vector<Material> out;
+  if (!m_mesh) return out;
+  out.resize(m_mesh->body_names.size());
+  for (const BodySpec& b : m_definition.bodies)
+    for (size_t i = 0; i < out.size(); ++i)
+      if (m_mesh->body_names[i] == b.group)
+        out[i] = Material{mu.size() == b.young.coefficients.size() ? b.young(mu) : b.young.constant, b.poisson,
+                          m_definition.plane_stress};
   return out;
 }
 
@@ -303,39 +258,119 @@ SparseMatrix free_block(const SparseMatrix& k, const std::vector<int>& free_inde
   return kff;
 }
 
-const std::vector<std::string>& problem_names() {
-  static const std::vector<std::string> names = {"rope", "hertz", "ironing", "ironing2"};
-  return names;
-}
-
-std::unique_ptr<Problem> make_problem(const std::string& name, const ProblemOptions& options) {
-  if (name == "rope") return std::make_unique<RopeProblem>(options);
-  if (name == "hertz") return std::make_unique<HertzProblem>(options);
-  if (name == "ironing") return std::make_unique<IroningProblem>(options, false);
-  if (name == "ironing2") return std::make_unique<IroningProblem>(options, true);
-  throw InputError("unknown problem '" + name + "'; expected one of: " + join(problem_names()));
-}
-
-Param parse_param(const Problem& problem, const std::string& text) {
-  std::vector<double> values;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    size_t used = 0;
-    double v = 0.0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    while (used < item.size() && std::isspace(static_cast<unsigned char>(item[used]))) ++used;
-    if (item.empty() || used != item.size())
-      throw InputError("parameter value '" + item + "' is not a number; expected " + problem.range_text());
-    values.push_back(v);
+std::unique_ptr<Problem> build_problem(ProblemDefinition definition, Mesh mesh) {
+  std::unique_ptr<Problem> p(new Problem());
+  p->m_definition = std::move(definition);
+  p->m_mesh = std::make_unique<Mesh>(std::move(mesh));
+  const ProblemDefinition& def = p->m_definition;
+  const Mesh& m = *p->m_mesh;
+  const int n = 2 * m.num_nodes(), np = def.parameters.size();
+  Builder b(*p, def, m);
+  b.check_bodies();
+  b.assemble_stiffness_terms(p->m_k_terms, p->m_k_coeff);
+  p->m_h1 = assemble_h1_gram(m);
+  p->m_is_dirichlet.assign(static_cast<size_t>(n), 0);
+  AffineVectors lift(np, n), fext(np, n);
+  b.dirichlet(p->m_is_dirichlet, lift);
+  b.tractions(fext);
+  p->finalize_dofs();
+  keep_nonzero_terms(lift, fext, np, p->m_lift_terms, p->m_fext_terms, p->m_load_coeff);
+  if (p->m_lift_terms.empty()) {  // no load at all: keep one zero term so φ has a size
+    p->m_lift_terms.push_back(Eigen::VectorXd::Zero(n));
+    p->m_fext_terms.push_back(Eigen::VectorXd::Zero(n));
+    p->m_load_coeff.push_back(AffineExpression::constant_value(1.0, np));
   }
-  Param mu = Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
-  problem.check_param(mu);
-  return mu;
+  p->m_contact = b.contact();
+
+  // U: the file's value, else the largest prescribed displacement over the box.
+  double scale = def.displacement_scale;
+  if (!(scale > 0)) {
+    for (const DirichletSpec& d : def.dirichlet)
+      for (const auto& v : d.displacement)
+        if (v) scale = std::max({scale, std::abs(v->min_over(def.parameters)), std::abs(v->max_over(def.parameters))});
+    if (!(scale > 0)) scale = 1.0;
+  }
+  p->m_u_scale = scale;
+  p->m_fingerprint = hash_text(def.text + "|" + m.fingerprint());
+  return p;
 }
+
+std::unique_ptr<Problem> make_rope_problem(const ProblemOptions& opt) {
+  // 1D elastic rope on [0,1] above an obstacle (paper appendix B):
+  // energy ½∫ν(u')² + ∫ f u, u(0)=u(1)=0, u ≥ ψ(x) = −0.2(sin πx − sin 3πx) − 0.5,
+  // ν = γ for x < 0.5 and 30 otherwise.
+  const int ne = opt.rope_elements;
+  if (ne < 2 || ne > 1000000) throw InputError("rope elements " + std::to_string(ne) + " invalid; expected 2..1000000");
+  std::unique_ptr<Problem> p(new Problem());
+  ProblemDefinition& def = p->m_definition;
+  def.name = "rope";
+  def.builtin = "rope";
+  def.parameters.add("gamma", 10.0, 50.0);
+  def.training.kind = SamplingPlan::Kind::List;
+  for (int i = 0; i <= 8; ++i) def.training.points.push_back(Eigen::VectorXd::Constant(1, 10.0 + 5.0 * i));
+  def.validation.kind = SamplingPlan::Kind::List;
+  for (int i = 0; i < 8; ++i) def.validation.points.push_back(Eigen::VectorXd::Constant(1, 12.5 + 5.0 * i));
+  def.rom.convex_hull = true;
+  p->m_dofs_per_node = 1;
+  const int n = ne + 1;
+  const double h = 1.0 / ne;
+  p->m_rope_x = Eigen::VectorXd::LinSpaced(n, 0.0, 1.0);
+  std::vector<Eigen::Triplet<double>> left, right, gram;
+  for (int e = 0; e < ne; ++e) {
+    auto& t = (0.5 * (p->m_rope_x(e) + p->m_rope_x(e + 1)) < 0.5) ? left : right;
+    const double k = 1.0 / h;
+    t.insert(t.end(), {{e, e, k}, {e, e + 1, -k}, {e + 1, e, -k}, {e + 1, e + 1, k}});
+    const double m = h / 6.0;  // H¹ Gram: mass + stiffness
+    gram.insert(gram.end(), {{e, e, 2 * m + k}, {e, e + 1, m - k}, {e + 1, e, m - k}, {e + 1, e + 1, 2 * m + k}});
+  }
+  SparseMatrix kl(n, n), kr(n, n);
+  kl.setFromTriplets(left.begin(), left.end());
+  kr.setFromTriplets(right.begin(), right.end());
+  p->m_k_terms = {kl, kr};
+  AffineExpression gamma = AffineExpression::constant_value(0.0, 1);
+  gamma.coefficients(0) = 1.0;
+  p->m_k_coeff = {gamma, AffineExpression::constant_value(30.0, 1)};
+  p->m_h1.resize(n, n);
+  p->m_h1.setFromTriplets(gram.begin(), gram.end());
+  p->m_is_dirichlet.assign(n, 0);
+  p->m_is_dirichlet.front() = p->m_is_dirichlet.back() = 1;
+  p->finalize_dofs();
+  Eigen::VectorXd w = Eigen::VectorXd::Constant(n, h);
+  w(0) = w(n - 1) = 0.5 * h;
+  Eigen::VectorXd psi(n);
+  for (int i = 0; i < n; ++i) {
+    const double x = p->m_rope_x(i);
+    psi(i) = -0.2 * (std::sin(M_PI * x) - std::sin(3 * M_PI * x)) - 0.5;
+  }
+  p->m_contact = std::make_unique<ObstacleContact>(p->m_rope_x, psi, w);
+  Eigen::VectorXd fext = -opt.rope_load * w;
+  fext(0) = fext(n - 1) = 0.0;
+  p->m_fext_terms = {fext};
+  p->m_lift_terms = {Eigen::VectorXd::Zero(n)};
+  p->m_load_coeff = {AffineExpression::constant_value(1.0, 1)};
+  p->m_u_scale = 0.5;
+  p->m_fingerprint = hash_text("rope|" + std::to_string(ne) + "|" + format_number(opt.rope_load));
+  return p;
+}
+
+std::unique_ptr<Problem> make_problem(const std::string& name_or_path, const ProblemOptions& options) {
+  if (name_or_path == "rope") return make_rope_problem(options);
+  ProblemDefinition def = read_problem_file(find_problem_file(name_or_path));
+  if (options.refine < 0 || options.refine > 6)
+    throw InputError("refine " + std::to_string(options.refine) + " is invalid; expected 0..6");
+  def.refine += options.refine;
+  Mesh mesh = load_mesh(def.mesh, def.refine);
+  return build_problem(std::move(def), std::move(mesh));
+}
+
+std::vector<Param> training_set(const Problem& problem, int n) {
+  return problem.definition().training.points_for(problem.parameters(), n);
+}
+
+std::vector<Param> validation_set(const Problem& problem, int n) {
+  return problem.definition().validation.points_for(problem.parameters(), n);
+}
+
+Param parse_param(const Problem& problem, const std::string& text) { return problem.parameters().parse(text, problem.name()); }
 
 }  // namespace contactrom::fom

@@ -98,5 +98,5 @@ Physical Surface("bottom", 1) = {1};
 Physical Surface("top", 2) = {11};
 Physical Curve("bottom_clamp", 11) = {1};
 Physical Curve("top_load", 12) = {11};
-Physical Curve("master", 13) = {3, 4, 5};
-Physical Curve("slave", 14) = {13, 14, 15};
+Physical Curve("bottom_arc", 13) = {3, 4, 5};
+Physical Curve("top_arc", 14) = {13, 14, 15};

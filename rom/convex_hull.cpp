@@ -17,14 +17,6 @@ using Eigen::VectorXd;
 
 namespace {
 
-/// Problems whose feasible set is not convex and parameter-independent but whose
-/// pairing changes so little over the parameter range that the hull of the
-/// snapshots stays (nearly) feasible: the DESIGN runs convex-hull on them.
-const std::set<std::string>& small_sliding_problems() {
-  static const std::set<std::string> names = {"hertz"};
-  return names;
-}
-
 /// Uniform [0, 1) draw with 53 random bits, written out so that the sequence is the
 /// same with every standard library (std::uniform_real_distribution is not
 /// specified bit for bit; std::mt19937_64 is).
@@ -104,10 +96,10 @@ ProjectedSolve solve_projected(const MatrixXd& a, const VectorXd& b, const Conve
 }  // namespace
 
 void check_convex_hull_applicable(const fom::Problem& problem) {
-  if (problem.convex_parameter_independent_feasible_set()) return;
-  if (small_sliding_problems().count(problem.name())) return;
-  throw InputError("convex-hull needs a convex, parameter-independent feasible set; '" + problem.name() +
-                   "' has large sliding contact whose pairing changes with the parameter");
+  if (problem.definition().rom.convex_hull) return;
+  throw InputError("convex-hull needs a convex, parameter-independent feasible set; problem '" + problem.name() +
+                   "' does not declare one (set convex_hull = true in its problem file's [rom] table when the "
+                   "pairing changes little over the parameter range)");
 }
 
 MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const ConvexHullOptions& options)

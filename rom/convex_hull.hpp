@@ -46,9 +46,9 @@
 ///
 /// Applicability: the hull of non-penetrating snapshots is non-penetrating only
 /// when the feasible set is convex and parameter-independent
-/// (Problem::convex_parameter_independent_feasible_set(), rope). Hertz is accepted
-/// as well (its pairing changes little over the range, so the hull is nearly
-/// feasible); problems with large sliding (ironing, ironing2) are refused.
+/// (rope). A problem file declares it with `[rom] convex_hull = true`: hertz does
+/// (its pairing changes little over the range, so the hull is nearly feasible);
+/// problems with large sliding (ironing, ironing2) do not and are refused.
 ///
 /// Exact command lines (docs/convex_hull.md):
 /// \code

@@ -77,12 +77,10 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
   const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
 
   SnapshotDatabase db;
-  db.problem = problem.name();
-  db.mesh_fingerprint = problem.fingerprint();
+  describe_problem(problem, db);
   db.created_by = options.created_by;
   db.training_kind = training_kind;
   db.training_size = training_size;
-  db.param_names = problem.param_names();
   db.parameters.resize(problem.num_params(), n);
   for (int j = 0; j < n; ++j) db.parameters.col(j) = params[j];
   db.primal = Eigen::MatrixXd::Zero(nd, n);
@@ -123,7 +121,7 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
 }
 
 SnapshotDatabase generate_snapshots(const fom::Problem& problem, int n, const OfflineOptions& options) {
-  return generate_snapshots(problem, problem.training_set(n), problem.uses_levels() ? "level" : "train", n, options);
+  return generate_snapshots(problem, fom::training_set(problem, n), problem.definition().training.selector(), n, options);
 }
 
 ProgressBar::ProgressBar(std::ostream& out, std::string label, bool enabled)

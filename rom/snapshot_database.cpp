@@ -2,6 +2,8 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -54,16 +56,40 @@ void check(herr_t rc, const std::string& what) {
 
 // ---------------------------------------------------------------- writing
 
+/// Fixed-length, null-padded UTF-8 string type of `size` bytes (at least 1).
+/// Fixed-length strings only: libhdf5 1.10 can crash on corrupted variable-length ones.
+hid_t fixed_string_type(size_t size) {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  if (type < 0) return type;
+  H5Tset_size(type, std::max<size_t>(size, 1));
+  H5Tset_strpad(type, H5T_STR_NULLPAD);
+  H5Tset_cset(type, H5T_CSET_UTF8);
+  return type;
+}
+
 void write_string_attribute(hid_t loc, const char* name, const std::string& value) {
-  // Variable-length UTF-8 string: h5py returns it as a Python str.
-  Handle type(H5Tcopy(H5T_C_S1), H5Tclose, std::string("attribute ") + name);
-  check(H5Tset_size(type.id(), H5T_VARIABLE), std::string("attribute ") + name);
-  check(H5Tset_cset(type.id(), H5T_CSET_UTF8), std::string("attribute ") + name);
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose, std::string("attribute ") + name);
-  Handle attr(H5Acreate2(loc, name, type.id(), space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-              std::string("attribute ") + name);
-  const char* data = value.c_str();
-  check(H5Awrite(attr.id(), type.id(), &data), std::string("attribute ") + name);
+  // h5py returns a fixed-length string as bytes: f.attrs[name].decode().
+  const std::string what = std::string("attribute ") + name;
+  Handle type(fixed_string_type(value.size()), H5Tclose, what);
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, what);
+  Handle attr(H5Acreate2(loc, name, type.id(), space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
+  std::string padded = value;
+  padded.resize(std::max<size_t>(value.size(), 1), '\0');
+  check(H5Awrite(attr.id(), type.id(), padded.data()), what);
+}
+
+/// A 1-D dataset of fixed-length strings (one element per item).
+void write_string_list(hid_t loc, hid_t dcpl, const char* name, const std::vector<std::string>& items) {
+  const std::string what = std::string("dataset ") + name;
+  size_t width = 1;
+  for (const auto& item : items) width = std::max(width, item.size());
+  Handle type(fixed_string_type(width), H5Tclose, what);
+  const hsize_t dims[1] = {items.size()};
+  Handle space(H5Screate_simple(1, dims, nullptr), H5Sclose, what);
+  Handle set(H5Dcreate2(loc, name, type.id(), space.id(), H5P_DEFAULT, dcpl, H5P_DEFAULT), H5Dclose, what);
+  std::string buf(width * items.size(), '\0');
+  for (size_t i = 0; i < items.size(); ++i) buf.replace(i * width, items[i].size(), items[i]);
+  if (!items.empty()) check(H5Dwrite(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()), what);
 }
 
 void write_scalar_attribute(hid_t loc, const char* name, hid_t file_type, hid_t mem_type, const void* value) {
@@ -91,22 +117,41 @@ std::string read_string_attribute(hid_t loc, const char* name) {
   Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose, what);
   Handle type(H5Aget_type(attr.id()), H5Tclose, what);
   if (H5Tget_class(type.id()) != H5T_STRING) throw Hdf5Failure(what + " is not a string");
-  if (H5Tis_variable_str(type.id()) > 0) {
-    Handle mem(H5Tcopy(H5T_C_S1), H5Tclose, what);
-    check(H5Tset_size(mem.id(), H5T_VARIABLE), what);
-    check(H5Tset_cset(mem.id(), H5Tget_cset(type.id())), what);
-    char* data = nullptr;
-    check(H5Aread(attr.id(), mem.id(), &data), what);
-    std::string out = data ? data : "";
-    H5free_memory(data);
-    return out;
-  }
+  // Variable-length strings are refused without reading them (libhdf5 1.10 can
+  // crash on corrupted ones); contactrom writes fixed-length strings only.
+  if (H5Tis_variable_str(type.id()) != 0) throw Hdf5Failure(what + " is a variable-length string");
+  Handle space(H5Aget_space(attr.id()), H5Sclose, what);
+  if (H5Sget_simple_extent_npoints(space.id()) != 1) throw Hdf5Failure(what + " is not a scalar");
   const size_t size = H5Tget_size(type.id());
-  if (size == 0) throw Hdf5Failure(what);
+  if (size == 0 || size > (16u << 20)) throw Hdf5Failure(what + " has an implausible size");
   std::string buf(size, '\0');
   check(H5Aread(attr.id(), type.id(), buf.data()), what);
   const size_t end = buf.find('\0');
   return end == std::string::npos ? buf : buf.substr(0, end);
+}
+
+/// Reads a 1-D dataset of fixed-length strings (refuses variable-length ones unread).
+std::vector<std::string> read_string_list(hid_t loc, const char* name) {
+  const std::string what = std::string("dataset ") + name;
+  Handle set(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose, what);
+  Handle type(H5Dget_type(set.id()), H5Tclose, what);
+  if (H5Tget_class(type.id()) != H5T_STRING || H5Tis_variable_str(type.id()) != 0)
+    throw Hdf5Failure(what + " is not a list of fixed-length strings");
+  Handle space(H5Dget_space(set.id()), H5Sclose, what);
+  if (H5Sget_simple_extent_ndims(space.id()) != 1) throw Hdf5Failure(what + " is not one-dimensional");
+  hsize_t n = 0;
+  H5Sget_simple_extent_dims(space.id(), &n, nullptr);
+  const size_t width = H5Tget_size(type.id());
+  if (width == 0 || width > (1u << 20) || n > (1u << 20)) throw Hdf5Failure(what + " has an implausible size");
+  std::string buf(width * n, '\0');
+  if (n > 0) check(H5Dread(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()), what);
+  std::vector<std::string> out;
+  for (hsize_t i = 0; i < n; ++i) {
+    std::string item = buf.substr(i * width, width);
+    item.resize(std::min(item.find('\0'), item.size()));
+    out.push_back(item);
+  }
+  return out;
 }
 
 template <typename T>
@@ -180,6 +225,83 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return out;
 }
 
+/// The problem part of format 2: problem file text, mesh, contact rows, lifting.
+void write_problem(hid_t f, hid_t dcpl, const SnapshotDatabase& db) {
+  const hsize_t nc = static_cast<hsize_t>(db.contact_weights.size());
+  if (db.contact_points.cols() != db.contact_weights.size() || db.lifting_terms.rows() != db.primal.rows())
+    throw std::invalid_argument("write_database: inconsistent problem description");
+  if (!db.problem_text.empty()) write_string_list(f, dcpl, "problem_file", {db.problem_text});
+  Handle contact(H5Gcreate2(f, "contact", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "group /contact");
+  write_dataset(f, dcpl, "contact/points", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, nc, 2, db.contact_points.data());
+  write_dataset(f, dcpl, "contact/weights", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, nc, 0, db.contact_weights.data());
+  // n_dofs × n_terms column-major == row-major n_terms × n_dofs: one term per row.
+  write_dataset(f, dcpl, "lifting", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, static_cast<hsize_t>(db.lifting_terms.cols()),
+                static_cast<hsize_t>(db.lifting_terms.rows()), db.lifting_terms.data());
+  if (!db.mesh) return;
+  const fom::Mesh& m = *db.mesh;
+  Handle group(H5Gcreate2(f, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "group /mesh");
+  write_dataset(f, dcpl, "mesh/nodes", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, static_cast<hsize_t>(m.num_nodes()), 2,
+                m.nodes.data());
+  write_dataset(f, dcpl, "mesh/quads", H5T_STD_I32LE, H5T_NATIVE_INT, 2, static_cast<hsize_t>(m.num_quads()), 4,
+                m.quads.data());
+  write_dataset(f, dcpl, "mesh/quad_body", H5T_STD_I32LE, H5T_NATIVE_INT, 1, static_cast<hsize_t>(m.num_quads()), 0,
+                m.quad_body.data());
+  write_string_list(f, dcpl, "mesh/body_names", m.body_names);
+  std::vector<std::string> curves;
+  for (const auto& [name, nodes] : m.curve_nodes) curves.push_back(name);
+  write_string_list(f, dcpl, "mesh/curve_names", curves);
+  for (size_t i = 0; i < curves.size(); ++i) {
+    const auto& nodes = m.curve_nodes.at(curves[i]);
+    const auto& segs = m.segments.at(curves[i]);
+    const std::string base = "mesh/curve_" + std::to_string(i);
+    write_dataset(f, dcpl, (base + "_nodes").c_str(), H5T_STD_I32LE, H5T_NATIVE_INT, 1, nodes.size(), 0, nodes.data());
+    write_dataset(f, dcpl, (base + "_segments").c_str(), H5T_STD_I32LE, H5T_NATIVE_INT, 2, segs.size(), 2, segs.data());
+  }
+}
+
+/// Reads the mesh of format 2, checking every index against the node count.
+std::shared_ptr<const fom::Mesh> read_mesh(hid_t f) {
+  auto mesh = std::make_shared<fom::Mesh>();
+  std::vector<double> xy;
+  hsize_t rows = 0, cols = 0;
+  read_dataset(f, "mesh/nodes", H5T_NATIVE_DOUBLE, xy, rows, cols);
+  if (cols != 2) throw Hdf5Failure("dataset /mesh/nodes does not have 2 columns");
+  for (double v : xy)
+    if (!std::isfinite(v)) throw Hdf5Failure("dataset /mesh/nodes holds a non-finite coordinate");
+  mesh->nodes = Eigen::Map<Eigen::Matrix2Xd>(xy.data(), 2, static_cast<Eigen::Index>(rows));
+  const int nn = static_cast<int>(rows);
+  auto check_ids = [&](const std::vector<int>& ids, const std::string& what) {
+    for (int id : ids)
+      if (id < 0 || id >= nn) throw Hdf5Failure("dataset /" + what + " refers to node " + std::to_string(id) +
+                                                ", expected 0.." + std::to_string(nn - 1));
+  };
+  std::vector<int> quads;
+  read_dataset(f, "mesh/quads", H5T_NATIVE_INT, quads, rows, cols);
+  if (cols != 4) throw Hdf5Failure("dataset /mesh/quads does not have 4 columns");
+  check_ids(quads, "mesh/quads");
+  for (size_t q = 0; q + 3 < quads.size(); q += 4) mesh->quads.push_back({quads[q], quads[q + 1], quads[q + 2], quads[q + 3]});
+  mesh->quad_body = read_vector<int>(f, "mesh/quad_body", H5T_NATIVE_INT, rows);
+  mesh->body_names = read_string_list(f, "mesh/body_names");
+  for (int b : mesh->quad_body)
+    if (b < 0 || b >= static_cast<int>(mesh->body_names.size()))
+      throw Hdf5Failure("dataset /mesh/quad_body holds the body " + std::to_string(b) + " of " +
+                        std::to_string(mesh->body_names.size()));
+  const std::vector<std::string> curves = read_string_list(f, "mesh/curve_names");
+  for (size_t i = 0; i < curves.size(); ++i) {
+    const std::string base = "mesh/curve_" + std::to_string(i);
+    std::vector<int> nodes, segs;
+    read_dataset(f, (base + "_nodes").c_str(), H5T_NATIVE_INT, nodes, rows, cols);
+    read_dataset(f, (base + "_segments").c_str(), H5T_NATIVE_INT, segs, rows, cols);
+    if (cols != 2 && !segs.empty()) throw Hdf5Failure("dataset /" + base + "_segments does not have 2 columns");
+    check_ids(nodes, base + "_nodes");
+    check_ids(segs, base + "_segments");
+    mesh->curve_nodes[curves[i]] = nodes;
+    auto& out = mesh->segments[curves[i]];
+    for (size_t k = 0; k + 1 < segs.size(); k += 2) out.push_back({segs[k], segs[k + 1]});
+  }
+  return mesh;
+}
+
 }  // namespace
 
 std::vector<int> SnapshotDatabase::successful_snapshots() const {
@@ -233,6 +355,7 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
     write_dataset(f, dcpl.id(), "pairing_iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0,
                   db.pairing_iterations.data());
     write_dataset(f, dcpl.id(), "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, n, 0, db.time_s.data());
+    write_problem(f, dcpl.id(), db);
     file.close("file close");
   } catch (const Hdf5Failure& e) {
     std::remove(tmp.c_str());
@@ -291,8 +414,28 @@ SnapshotDatabase read_database(const std::string& path) {
     if (db.parameters.rows() != static_cast<Eigen::Index>(db.param_names.size()))
       throw Hdf5Failure("dataset /parameters has " + std::to_string(db.parameters.rows()) +
                         " columns but param_names lists " + std::to_string(db.param_names.size()));
-    if (db.training_kind != "train" && db.training_kind != "level")
-      throw Hdf5Failure("attribute training_kind is '" + db.training_kind + "', expected 'train' or 'level'");
+    if (db.training_kind != "train" && db.training_kind != "level" && db.training_kind != "list")
+      throw Hdf5Failure("attribute training_kind is '" + db.training_kind + "', expected 'train', 'level' or 'list'");
+    if (H5Lexists(f, "problem_file", H5P_DEFAULT) > 0) {
+      const std::vector<std::string> text = read_string_list(f, "problem_file");
+      if (text.size() != 1) throw Hdf5Failure("dataset /problem_file does not hold one text");
+      db.problem_text = text[0];
+    }
+    if (H5Lexists(f, "mesh", H5P_DEFAULT) > 0) db.mesh = read_mesh(f);
+    const Eigen::MatrixXd points = read_matrix(f, "contact/points", static_cast<hsize_t>(db.dual.rows()));
+    if (points.rows() != 2) throw Hdf5Failure("dataset /contact/points does not have 2 columns");
+    db.contact_points = points;
+    const std::vector<double> weights =
+        read_vector<double>(f, "contact/weights", H5T_NATIVE_DOUBLE, static_cast<hsize_t>(db.dual.rows()));
+    db.contact_weights = Eigen::Map<const Eigen::VectorXd>(weights.data(), static_cast<Eigen::Index>(weights.size()));
+    std::vector<double> lift;
+    hsize_t terms = 0, width = 0;
+    read_dataset(f, "lifting", H5T_NATIVE_DOUBLE, lift, terms, width);
+    if (width != static_cast<hsize_t>(db.primal.rows()))
+      throw Hdf5Failure("dataset /lifting has " + std::to_string(width) + " columns, expected one per dof (" +
+                        std::to_string(db.primal.rows()) + ")");
+    db.lifting_terms = Eigen::Map<Eigen::MatrixXd>(lift.data(), static_cast<Eigen::Index>(width),
+                                                   static_cast<Eigen::Index>(terms));
     file.close("file close");
   } catch (const Hdf5Failure& e) {
     throw InputError("database '" + path + "' is truncated or corrupt (HDF5 cannot read " + e.what() + ")");
@@ -314,17 +457,47 @@ void check_database(const SnapshotDatabase& db, const fom::Problem& problem, con
                      std::to_string(db.parameters.rows()) + " parameters, but " + problem.name() + " has " +
                      std::to_string(problem.num_dofs()) + ", " + std::to_string(problem.contact().num_constraints()) +
                      " and " + std::to_string(problem.num_params()));
-  if ((db.training_kind == "level") != problem.uses_levels())
+  const std::string selector = problem.definition().training.selector();
+  if (db.training_kind != selector)
     throw InputError("database '" + path + "' selects its training set by '" + db.training_kind + "', but " +
-                     problem.name() + " uses " + (problem.uses_levels() ? "'level'" : "'train'"));
+                     problem.name() + " uses '" + selector + "'");
+}
+
+void describe_problem(const fom::Problem& problem, SnapshotDatabase& db) {
+  db.problem = problem.name();
+  db.mesh_fingerprint = problem.fingerprint();
+  db.param_names = problem.param_names();
+  db.problem_text = problem.definition().builtin.empty() ? problem.definition().text : "";
+  db.mesh = problem.mesh() ? std::make_shared<const fom::Mesh>(*problem.mesh()) : nullptr;
+  db.contact_points = problem.contact().constraint_points();
+  db.contact_weights = problem.contact().weights();
+  db.lifting_terms.resize(problem.num_dofs(), problem.num_load_terms());
+  for (int k = 0; k < problem.num_load_terms(); ++k) db.lifting_terms.col(k) = problem.lifting_terms()[k];
+}
+
+std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, const std::string& path) {
+  std::unique_ptr<fom::Problem> problem;
+  if (db.problem_text.empty()) {
+    if (db.problem != "rope")
+      throw InputError("database '" + path + "' stores no problem file for problem '" + db.problem +
+                       "'; expected a database written by contactrom offline");
+    problem = fom::make_rope_problem();
+  } else {
+    if (!db.mesh) throw InputError("database '" + path + "' stores a problem file but no mesh (dataset /mesh)");
+    // Messages about the stored file name the database.
+    fom::ProblemDefinition def = fom::parse_problem_text(db.problem_text, path + ":/problem_file");
+    problem = fom::build_problem(std::move(def), *db.mesh);
+  }
+  check_database(db, *problem, path);
+  return problem;
 }
 
 std::vector<fom::Param> database_training_set(const SnapshotDatabase& db, const fom::Problem& problem) {
-  return problem.training_set(db.training_size);
+  return fom::training_set(problem, db.training_size);
 }
 
 std::vector<fom::Param> database_validation_set(const SnapshotDatabase& db, const fom::Problem& problem) {
-  return problem.validation_set(db.training_size);
+  return fom::validation_set(problem, db.training_size);
 }
 
 }  // namespace contactrom::rom

@@ -12,10 +12,17 @@
 /// `/primal[n_snap][n_dofs]` (one snapshot per row, as h5py users expect) and are
 /// written and read without any transposition.
 ///
+/// Format version 2 also stores the problem itself — the problem file's text, the
+/// mesh (nodes, quads, bodies, curve groups), the contact points and weights and
+/// the lifting terms — so that problem_from_database() rebuilds the problem from the
+/// file alone (the .toml and .geo may be gone).
+///
 /// Writing is atomic (temporary file + rename). Reading refuses, with one-line
 /// InputError messages naming the file: a missing file, a file that is not HDF5,
-/// a truncated or corrupt file, a wrong `format_version`, and (check_database)
-/// a database built for another mesh or problem options.
+/// a truncated or corrupt file, a wrong `format_version` (version-1 files are
+/// refused: rebuild them with `contactrom offline`), and (check_database) a
+/// database built for another mesh or problem options.
+#include <memory>
 #include <Eigen/Dense>
 #include <string>
 #include <vector>
@@ -26,15 +33,21 @@
 namespace contactrom::rom {
 
 /// \brief Version of the file layout written by write_database (attribute `format_version`).
-inline constexpr int kDatabaseFormatVersion = 1;
+inline constexpr int kDatabaseFormatVersion = 2;
 
 /// \brief FOM snapshots at the training parameters; see the file comment.
 struct SnapshotDatabase {
-  std::string problem;           ///< problem name (make_problem)
+  std::string problem;           ///< problem name
+  /// Text of the problem file the snapshots were computed for ("" for `rope`, which is built in).
+  std::string problem_text;
+  std::shared_ptr<const fom::Mesh> mesh;  ///< the (refined) mesh; null for `rope`
+  Eigen::Matrix2Xd contact_points;        ///< reference coordinates of the constraint rows (2 × n_c)
+  Eigen::VectorXd contact_weights;        ///< tributary lengths of the constraint rows
+  Eigen::MatrixXd lifting_terms;          ///< n_dofs × n_terms: the lifting basis L_k
   std::string mesh_fingerprint;  ///< Problem::fingerprint() of the discretisation
   std::string created_by;        ///< program and version that wrote the file
-  /// How the training set was selected: "train" (size n, `hertz`/`rope`) or
-  /// "level" (nested level n, `ironing`/`ironing2`).
+  /// How the training set was selected: "train" (`--train n`), "level" (`--level n`)
+  /// or "list" (the problem's listed points).
   std::string training_kind = "train";
   int training_size = 0;                  ///< n of `--train n` or `--level n`
   std::vector<std::string> param_names;   ///< names of the parameter components
@@ -77,12 +90,21 @@ SnapshotDatabase read_database(const std::string& path);
 ///   current hertz mesh is B".
 void check_database(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path);
 
+/// \brief Rebuilds the problem from the database alone (problem-file text and mesh;
+/// `rope` by name) and checks that it matches (check_database).
+/// \throws InputError naming `path` if the stored problem cannot be rebuilt.
+std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, const std::string& path);
+
+/// \brief Fills the problem fields of `db` (name, fingerprint, text, mesh, contact
+/// points, lifting terms) from `problem`.
+void describe_problem(const fom::Problem& problem, SnapshotDatabase& db);
+
 /// \brief Training set of `problem` selected by the database's options
 /// (training_set(training_size)).
 std::vector<fom::Param> database_training_set(const SnapshotDatabase& db, const fom::Problem& problem);
 
 /// \brief Validation set associated with the database's training options
-/// (validation_set(training_size), DESIGN §1).
+/// (validation_set(training_size)).
 std::vector<fom::Param> database_validation_set(const SnapshotDatabase& db, const fom::Problem& problem);
 
 }  // namespace contactrom::rom

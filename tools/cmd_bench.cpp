@@ -53,10 +53,7 @@ void run_bench(const BenchArgs& a) {
   if (a.repeats < 1) throw InputError("--repeats " + std::to_string(a.repeats) + " invalid; expected >= 1");
   if (a.queries < 1) throw InputError("--queries " + std::to_string(a.queries) + " invalid; expected >= 1");
   auto problem = fom::make_problem(a.problem);
-  int n = problem->uses_levels() ? a.level : a.train;
-  if (problem->uses_levels() && a.train) throw InputError("problem '" + a.problem + "' takes --level, not --train");
-  if (!problem->uses_levels() && a.level) throw InputError("problem '" + a.problem + "' takes --train, not --level");
-  if (n == 0) n = a.problem == "hertz" ? 30 : a.problem == "ironing" ? 7 : a.problem == "ironing2" ? 3 : 9;
+  const int n = fom::resolve_training_size(problem->definition().training, problem->name(), a.train, a.level, true);
 
   nlohmann::json j;
   j["problem"] = problem->name();
@@ -163,7 +160,7 @@ void run_bench(const BenchArgs& a) {
 CommandRegistrar reg("bench", [](CLI::App& app) {
   auto a = std::make_shared<BenchArgs>();
   auto* sub = app.add_subcommand("bench", "Median per-query times of the FOM solvers and every ROM, in one run");
-  sub->add_option("--problem", a->problem, "rope | hertz | ironing | ironing2")->required();
+  sub->add_option("--problem", a->problem, "a shipped problem (contactrom problems) or a problem file path")->required();
   sub->add_option("--train", a->train, "training size (hertz; default 30)");
   sub->add_option("--level", a->level, "training level (ironing default 7, ironing2 default 3)");
   sub->add_option("--delta", a->delta, "POD energy tolerance (default 1e-8)");

@@ -61,8 +61,7 @@ struct ChlsArgs {
 
 void run_chls(const ChlsArgs& a) {
   const rom::SnapshotDatabase db = rom::read_database(a.db);
-  auto problem = fom::make_problem(db.problem);
-  rom::check_database(db, *problem, a.db);
+  auto problem = rom::problem_from_database(db, a.db);
   const std::vector<int> used = db.successful_snapshots();
   if (used.size() < 2)
     throw InputError("database " + a.db + " holds " + std::to_string(used.size()) +
@@ -146,8 +145,7 @@ struct HullRow {
 
 void run_hull_report(const HullArgs& a) {
   const rom::SnapshotDatabase db = rom::read_database(a.db);
-  auto problem = fom::make_problem(db.problem);
-  rom::check_database(db, *problem, a.db);
+  auto problem = rom::problem_from_database(db, a.db);
   rom::check_convex_hull_applicable(*problem);
   rom::ReducedModelOptions model_options;
   model_options.delta = a.delta;

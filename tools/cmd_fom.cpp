@@ -18,11 +18,14 @@ namespace {
 
 struct FomArgs {
   std::string problem, param, solver = "active-set", out;
+  int refine = 0;
   bool json = false;
 };
 
 void run_fom(const FomArgs& a) {
-  auto problem = fom::make_problem(a.problem);
+  fom::ProblemOptions popt;
+  popt.refine = a.refine;
+  auto problem = fom::make_problem(a.problem, popt);
   const fom::Param mu = fom::parse_param(*problem, a.param);
   fom::FomSolution sol;
   double setup = 0.0;
@@ -38,7 +41,7 @@ void run_fom(const FomArgs& a) {
   const fom::KktResiduals kkt = fom::kkt_residuals(*problem, mu, sol.u, sol.lambda);
   if (!a.out.empty()) {
     fom::ensure_directory(a.out);
-    fom::write_vtu(a.out + "/" + problem->name() + ".vtu", *problem, sol.u, sol.lambda);
+    fom::write_vtu(a.out + "/" + problem->name() + ".vtu", *problem, mu, sol.u, sol.lambda);
     fom::write_surface_csv(a.out + "/" + problem->name() + "_surface.csv", *problem, sol.u, sol.lambda);
   }
   nlohmann::json j;
@@ -74,8 +77,10 @@ void run_fom(const FomArgs& a) {
 CommandRegistrar reg("fom", [](CLI::App& app) {
   auto args = std::make_shared<FomArgs>();
   auto* sub = app.add_subcommand("fom", "Solve one full-order contact problem");
-  sub->add_option("--problem", args->problem, "rope | hertz | ironing | ironing2")->required();
-  sub->add_option("--param", args->param, "parameter value, V or V1,V2 (ironing2)")->required();
+  sub->add_option("--problem", args->problem, "a shipped problem (contactrom problems) or a problem file path")->required();
+  sub->add_option("--param", args->param, "parameter values V or V1,V2,... in the problem's order (contactrom problems)")->required();
+  sub->add_option("--refine", args->refine, "extra uniform mesh refinements (each splits every quad in four)")
+      ->check(CLI::Range(0, 6));
   sub->add_option("--solver", args->solver, "active-set (default) | ipopt")
       ->check(CLI::IsMember({"active-set", "ipopt"}));
   sub->add_option("--out", args->out, "folder for <problem>.vtu and <problem>_surface.csv");

@@ -22,7 +22,7 @@ namespace {
 
 struct OfflineArgs {
   std::string problem, out;
-  int train = 0, level = 0, threads = 0;
+  int train = 0, level = 0, threads = 0, refine = 0;
   bool progress = false, json = false;
 };
 
@@ -37,27 +37,20 @@ std::string param_text(const fom::Problem& problem, const fom::Param& mu) {
 }
 
 void run_offline(const OfflineArgs& a) {
-  auto problem = fom::make_problem(a.problem);
-  int n = 0;
-  if (problem->uses_levels()) {
-    if (a.train) throw InputError("problem '" + a.problem + "' selects its training set with --level n, not --train");
-    if (!a.level) throw InputError("problem '" + a.problem + "' needs --level n");
-    n = a.level;
-  } else {
-    if (a.level) throw InputError("problem '" + a.problem + "' selects its training set with --train N, not --level");
-    if (!a.train && problem->name() != "rope") throw InputError("problem '" + a.problem + "' needs --train N");
-    // rope has one fixed training set (DESIGN §1); record its size.
-    n = a.train ? a.train : static_cast<int>(problem->training_set(1).size());
-  }
+  fom::ProblemOptions popt;
+  popt.refine = a.refine;
+  auto problem = fom::make_problem(a.problem, popt);
+  const fom::SamplingPlan& plan = problem->definition().training;
+  const int n = fom::resolve_training_size(plan, problem->name(), a.train, a.level, false);
   if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
-  const std::vector<fom::Param> params = problem->training_set(n);
+  const std::vector<fom::Param> params = fom::training_set(*problem, n);
 
   rom::ProgressBar bar(std::cerr, "offline " + problem->name(), a.progress || ::isatty(STDERR_FILENO));
   rom::OfflineOptions options;
   options.threads = a.threads;
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
   const rom::SnapshotDatabase db =
-      rom::generate_snapshots(*problem, params, problem->uses_levels() ? "level" : "train", n, options);
+      rom::generate_snapshots(*problem, params, plan.selector(), n, options);
   bar.finish();
 
   int failed = 0;
@@ -95,11 +88,13 @@ void run_offline(const OfflineArgs& a) {
 CommandRegistrar reg("offline", [](CLI::App& app) {
   auto args = std::make_shared<OfflineArgs>();
   auto* sub = app.add_subcommand("offline", "Compute FOM snapshots at the training parameters into an HDF5 database");
-  sub->add_option("--problem", args->problem, "rope | hertz | ironing | ironing2")->required();
-  auto* train = sub->add_option("--train", args->train, "training size N (hertz: d_i = 0.3 i/N)")
-                    ->check(CLI::Range(1, 100000));
-  auto* level = sub->add_option("--level", args->level, "nested training level n (ironing, ironing2)")
-                    ->check(CLI::Range(1, 12));
+  sub->add_option("--problem", args->problem, "a shipped problem (contactrom problems) or a problem file path")->required();
+  auto* train = sub->add_option("--train", args->train, "training size N, for problems with uniform or random training (hertz: d_i = 0.3 i/N)")
+                    ->check(CLI::Range(1, 10000000));
+  auto* level = sub->add_option("--level", args->level, "training level n, for problems with nested training (ironing: 2^n+1 points)")
+                    ->check(CLI::Range(0, 20));
+  sub->add_option("--refine", args->refine, "extra uniform mesh refinements (each splits every quad in four)")
+      ->check(CLI::Range(0, 6));
   train->excludes(level);
   sub->add_option("--out", args->out, "output database (.h5)")->required();
   sub->add_option("--threads", args->threads, "worker threads (default: hardware concurrency)")

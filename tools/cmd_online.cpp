@@ -51,7 +51,7 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
   if (!a.out.empty()) {
     fom::ensure_directory(a.out);
     const std::string stem = a.out + "/" + problem.name() + "_" + solver.name();
-    fom::write_vtu(stem + ".vtu", problem, res.u, res.lambda);
+    fom::write_vtu(stem + ".vtu", problem, mu, res.u, res.lambda);
     fom::write_surface_csv(stem + "_surface.csv", problem, res.u, res.lambda);
   }
   nlohmann::json j;
@@ -148,8 +148,7 @@ void run_online(const OnlineArgs& a) {
   if (!a.param.empty() && a.validation)
     throw InputError("--param and --validation exclude each other; give one");
   const rom::SnapshotDatabase db = rom::read_database(a.db);
-  auto problem = fom::make_problem(db.problem);
-  rom::check_database(db, *problem, a.db);
+  auto problem = rom::problem_from_database(db, a.db);
   rom::OnlineSolverOptions options;
   options.tau = a.tau;
   options.tau_scaling = a.tau_scaling;

@@ -234,8 +234,7 @@ void run_verify(const VerifyArgs& a) {
     throw InputError("--reference '" + a.reference + "' unknown; expected ipopt or fom");
 
   const rom::SnapshotDatabase db = rom::read_database(a.db);
-  auto problem = fom::make_problem(db.problem);
-  rom::check_database(db, *problem, a.db);
+  auto problem = rom::problem_from_database(db, a.db);
   rom::ReducedModelOptions model_options;
   model_options.delta = a.delta;
   const rom::ReducedModel model(*problem, db, model_options);

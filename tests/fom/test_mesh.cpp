@@ -188,7 +188,7 @@ BOOST_AUTO_TEST_CASE(hertz_quads_have_a_decent_shape) {
 
 BOOST_AUTO_TEST_CASE(hertz_arcs_have_78_segments_on_the_right_circles) {
   const Mesh& m = hertz();
-  for (const auto& [name, body, yc] : {std::tuple{"master", 0, -1.0}, std::tuple{"slave", 1, 1.0}}) {
+  for (const auto& [name, body, yc] : {std::tuple{"bottom_arc", 0, -1.0}, std::tuple{"top_arc", 1, 1.0}}) {
     const auto& nodes = m.group_nodes(name);
     BOOST_TEST(nodes.size() == 79u);
     BOOST_TEST(m.group_segments(name).size() == 78u);
@@ -227,8 +227,8 @@ constexpr double kContactPointTol = 1e-9;
 
 BOOST_AUTO_TEST_CASE(hertz_contact_point_has_one_distinct_node_per_body) {
   const Mesh& m = hertz();
-  const int master = node_at(m, m.group_nodes("master"), 0.0, 0.0, kContactPointTol);
-  const int slave = node_at(m, m.group_nodes("slave"), 0.0, 0.0, kContactPointTol);
+  const int master = node_at(m, m.group_nodes("bottom_arc"), 0.0, 0.0, kContactPointTol);
+  const int slave = node_at(m, m.group_nodes("top_arc"), 0.0, 0.0, kContactPointTol);
   BOOST_TEST(master >= 0);
   BOOST_TEST(slave >= 0);
   BOOST_TEST(master != slave);
@@ -236,7 +236,7 @@ BOOST_AUTO_TEST_CASE(hertz_contact_point_has_one_distinct_node_per_body) {
 
 BOOST_AUTO_TEST_CASE(hertz_arc_spacing_is_finest_at_the_contact_point) {
   const Mesh& m = hertz();
-  for (const char* name : {"master", "slave"}) {
+  for (const char* name : {"bottom_arc", "top_arc"}) {
     const auto& nodes = m.group_nodes(name);
     double h_contact = INFINITY, h_end = 0;
     for (std::size_t k = 0; k + 1 < nodes.size(); ++k) {
@@ -311,12 +311,12 @@ BOOST_AUTO_TEST_CASE(ironing_only_the_two_iron_corner_quads_are_flat) {
 
 BOOST_AUTO_TEST_CASE(ironing_groups_lie_on_their_curves) {
   const Mesh& m = ironing();
-  const auto& master = m.group_nodes("master");
+  const auto& master = m.group_nodes("slab_top");
   BOOST_TEST(master.size() == 50u);
   for (int n : master) BOOST_TEST(std::abs(m.nodes(1, n)) < 1e-12);
   BOOST_TEST(node_at(m, master, -1.0, 0.0) >= 0);
   BOOST_TEST(node_at(m, master, 5.0, 0.0) >= 0);
-  check_chain(m, "master", 0);
+  check_chain(m, "slab_top", 0);
 
   const auto& bottom = m.group_nodes("slab_bottom");
   BOOST_TEST(bottom.size() == 50u);
@@ -329,7 +329,7 @@ BOOST_AUTO_TEST_CASE(ironing_groups_lie_on_their_curves) {
   check_chain(m, "iron_top", 1);
 
   // The slave is the iron's whole curved bottom, from (-0.5,0.5) to (0.5,0.5).
-  const auto& slave = m.group_nodes("slave");
+  const auto& slave = m.group_nodes("iron_bottom");
   BOOST_TEST(slave.size() == 27u);
   for (int n : slave) {
     const double x = m.nodes(0, n), y = m.nodes(1, n);
@@ -338,7 +338,7 @@ BOOST_AUTO_TEST_CASE(ironing_groups_lie_on_their_curves) {
   }
   BOOST_TEST(node_at(m, slave, -0.5, 0.5) >= 0);
   BOOST_TEST(node_at(m, slave, 0.5, 0.5) >= 0);
-  check_chain(m, "slave", 1);
+  check_chain(m, "iron_bottom", 1);
 
   // The iron's lowest point touches the slab at the origin; its node is the iron's own.
   const int tip = node_at(m, slave, 0.0, 0.0);

@@ -1,0 +1,211 @@
+#include "fom/parameter_space.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "fom/errors.hpp"
+
+namespace contactrom::fom {
+
+std::string format_number(double value) {
+  char buf[64];
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+    if (std::strtod(buf, nullptr) == value) break;
+  }
+  return buf;
+}
+
+int ParameterSpace::index_of(const std::string& name) const {
+  for (int i = 0; i < size(); ++i)
+    if (names[i] == name) return i;
+  return -1;
+}
+
+void ParameterSpace::add(const std::string& name, double lo, double hi, bool open_lower) {
+  if (index_of(name) >= 0) throw InputError("parameter '" + name + "' is defined twice; expected distinct names");
+  if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi))
+    throw InputError("parameter '" + name + "' has range [" + format_number(lo) + ", " + format_number(hi) +
+                     "]; expected finite bounds with lo < hi");
+  names.push_back(name);
+  lower.conservativeResize(size());
+  upper.conservativeResize(size());
+  lower(size() - 1) = lo;
+  upper(size() - 1) = hi;
+  lower_open.push_back(open_lower ? 1 : 0);
+}
+
+bool ParameterSpace::contains(const Param& mu) const {
+  if (mu.size() != size()) return false;
+  for (int i = 0; i < size(); ++i) {
+    const bool below = lower_open[i] ? !(mu(i) > lower(i)) : !(mu(i) >= lower(i));
+    if (below || !(mu(i) <= upper(i))) return false;
+  }
+  return true;
+}
+
+void ParameterSpace::check(const Param& mu, const std::string& problem_name) const {
+  if (mu.size() != size())
+    throw InputError("problem '" + problem_name + "' takes " + std::to_string(size()) + " parameter value(s) (" +
+                     range_text() + "), got " + std::to_string(mu.size()));
+  for (int i = 0; i < size(); ++i) {
+    const bool below = lower_open[i] ? !(mu(i) > lower(i)) : !(mu(i) >= lower(i));
+    if (below || !(mu(i) <= upper(i)))
+      throw InputError("parameter " + names[i] + " = " + format_number(mu(i)) + " is outside the range of '" +
+                       problem_name + "'; expected " + range_text());
+  }
+}
+
+std::string ParameterSpace::range_text() const {
+  std::string out;
+  for (int i = 0; i < size(); ++i) {
+    if (i) out += ", ";
+    out += names[i] + " in " + (lower_open[i] ? "(" : "[") + format_number(lower(i)) + ", " +
+           format_number(upper(i)) + "]";
+  }
+  return out;
+}
+
+Param ParameterSpace::parse(const std::string& text, const std::string& problem_name) const {
+  std::vector<double> values;
+  size_t start = 0;
+  for (;;) {
+    const size_t end = text.find(',', start);
+    const std::string item = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    const char* begin = item.c_str();
+    char* stop = nullptr;
+    const double v = std::strtod(begin, &stop);
+    const char* rest = stop;
+    while (*rest && std::isspace(static_cast<unsigned char>(*rest))) ++rest;
+    bool blank = true;
+    for (char ch : item) blank = blank && std::isspace(static_cast<unsigned char>(ch));
+    if (blank || stop == begin || *rest || !std::isfinite(v))
+      throw InputError("parameter value '" + item + "' in '" + text + "' is not a finite number; expected " +
+                       range_text());
+    values.push_back(v);
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  Param mu = Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  check(mu, problem_name);
+  return mu;
+}
+
+AffineExpression AffineExpression::constant_value(double value, int num_params) {
+  AffineExpression e;
+  e.constant = value;
+  e.coefficients = Eigen::VectorXd::Zero(num_params);
+  return e;
+}
+
+double AffineExpression::min_over(const ParameterSpace& space) const {
+  double v = constant;
+  for (int i = 0; i < coefficients.size(); ++i)
+    v += coefficients(i) * (coefficients(i) > 0 ? space.lower(i) : space.upper(i));
+  return v;
+}
+
+double AffineExpression::max_over(const ParameterSpace& space) const {
+  double v = constant;
+  for (int i = 0; i < coefficients.size(); ++i)
+    v += coefficients(i) * (coefficients(i) > 0 ? space.upper(i) : space.lower(i));
+  return v;
+}
+
+namespace {
+
+/// Recursive-descent reader of `[+|-] term {(+|-) term}`, term = number | name | number*name.
+class AffineReader {
+ public:
+  AffineReader(const std::string& text, const ParameterSpace& space) : m_text(text), m_space(space) {}
+
+  AffineExpression read() {
+    AffineExpression e = AffineExpression::constant_value(0.0, m_space.size());
+    skip_space();
+    if (at_end()) fail("is empty");
+    double sign = 1.0;
+    if (peek() == '+' || peek() == '-') sign = take() == '-' ? -1.0 : 1.0;
+    term(sign, e);
+    for (skip_space(); !at_end(); skip_space()) {
+      const char op = take();
+      if (op != '+' && op != '-') fail(std::string("has '") + op + "' where '+' or '-' was expected");
+      term(op == '-' ? -1.0 : 1.0, e);
+    }
+    return e;
+  }
+
+ private:
+  void term(double sign, AffineExpression& e) {
+    skip_space();
+    if (at_end()) fail("ends with an operator");
+    if (is_name_start(peek())) {
+      add_name(sign, e);
+      check_no_product();
+      return;
+    }
+    const double value = sign * number();
+    skip_space();
+    if (!at_end() && peek() == '*') {
+      take();
+      skip_space();
+      if (at_end() || !is_name_start(peek())) fail("has a product that is not number*name");
+      add_name(value, e);
+      check_no_product();
+      return;
+    }
+    e.constant += value;
+  }
+  void check_no_product() {
+    skip_space();
+    if (!at_end() && (peek() == '*' || peek() == '/'))
+      fail("multiplies or divides a parameter; expected an affine expression (terms number, name or number*name)");
+  }
+  void add_name(double factor, AffineExpression& e) {
+    const size_t start = m_pos;
+    while (!at_end() && (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_')) ++m_pos;
+    const std::string name = m_text.substr(start, m_pos - start);
+    const int i = m_space.index_of(name);
+    if (i < 0) fail("names the unknown parameter '" + name + "'");
+    e.coefficients(i) += factor;
+  }
+  double number() {
+    const char* begin = m_text.c_str() + m_pos;
+    char* stop = nullptr;
+    const double v = std::strtod(begin, &stop);
+    if (stop == begin || !std::isfinite(v)) fail("has '" + std::string(1, peek()) + "' where a number or a parameter name was expected");
+    // strtod also reads "inf", "nan" and hex; accept plain decimal numbers only.
+    for (const char* c = begin; c < stop; ++c)
+      if (!std::isdigit(static_cast<unsigned char>(*c)) && *c != '.' && *c != 'e' && *c != 'E' && *c != '+' &&
+          *c != '-')
+        fail("has the number '" + std::string(begin, static_cast<size_t>(stop - begin)) + "'; expected a decimal number");
+    m_pos += static_cast<size_t>(stop - begin);
+    return v;
+  }
+  static bool is_name_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+  bool at_end() const { return m_pos >= m_text.size(); }
+  char peek() const { return m_text[m_pos]; }
+  char take() { return m_text[m_pos++]; }
+  void skip_space() {
+    while (!at_end() && std::isspace(static_cast<unsigned char>(peek()))) ++m_pos;
+  }
+  [[noreturn]] void fail(const std::string& what) const {
+    std::string names;
+    for (int i = 0; i < m_space.size(); ++i) names += (i ? ", " : "") + m_space.names[i];
+    throw InputError("expression '" + m_text + "' " + what + "; expected a number or an affine expression of the parameters (" +
+                     (names.empty() ? "none defined" : names) + "), e.g. \"-d\" or \"0.5*d + 0.1\"");
+  }
+
+  const std::string& m_text;
+  const ParameterSpace& m_space;
+  size_t m_pos = 0;
+};
+
+}  // namespace
+
+AffineExpression parse_affine_expression(const std::string& text, const ParameterSpace& space) {
+  return AffineReader(text, space).read();
+}
+
+}  // namespace contactrom::fom
