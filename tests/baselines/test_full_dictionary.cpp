@@ -38,7 +38,7 @@ struct Hertz {
     offline.threads = 2;
     db = rom::generate_snapshots(*problem, 12, offline);
     model = std::make_unique<rom::ReducedModel>(*problem, db);
-    const std::vector<fom::Param> validation = problem->validation_set(12);
+    const std::vector<fom::Param> validation = fom::validation_set(*problem, 12);
     for (size_t i = 3; i < validation.size(); i += 16) params.push_back(validation[i]);
   }
 };

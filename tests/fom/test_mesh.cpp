@@ -363,7 +363,7 @@ BOOST_AUTO_TEST_CASE(fingerprint_is_stable_and_tells_meshes_apart) {
 
 BOOST_AUTO_TEST_CASE(unknown_group_names_the_group_and_lists_the_existing_ones) {
   const std::string msg = input_error_of([] { hertz().group_nodes("contact"); });
-  BOOST_TEST(msg == "mesh has no physical group 'contact' (has: bottom_clamp, master, slave, top_load)");
+  BOOST_TEST(msg == "mesh has no physical group 'contact' (has: bottom_arc, bottom_clamp, top_arc, top_load)");
   BOOST_TEST(contains(input_error_of([] { hertz().group_segments("nope"); }), "'nope'"));
 }
 

@@ -32,8 +32,8 @@ namespace {
 
 const std::string kExe = CONTACTROM_EXE;
 const std::string kIroningMessage =
-    "convex-hull needs a convex, parameter-independent feasible set; 'ironing' has large sliding contact whose "
-    "pairing changes with the parameter";
+    "convex-hull needs a convex, parameter-independent feasible set; problem 'ironing' does not declare one (set "
+    "convex_hull = true in its problem file's [rom] table when the pairing changes little over the parameter range)";
 
 /// A problem with its snapshot database and FOM solver, built once per test program.
 struct Setup {
@@ -118,7 +118,7 @@ BOOST_AUTO_TEST_CASE(rope_training_set_is_reproduced) {
   const Setup& s = rope();
   const rom::ReducedModel model = model_of(s, 1e-7);
   const rom::ConvexHullSolver solver(model);
-  for (const fom::Param& mu : s.problem->training_set(9)) {
+  for (const fom::Param& mu : fom::training_set(*s.problem, 9)) {
     const rom::ConvexHullResult r = solver.solve_detailed(mu);
     const fom::FomSolution ref = s.fom_solver->solve(mu);
     const double primal = fom::relative_h1_error(*s.problem, r.online.u, ref.u);
@@ -145,7 +145,7 @@ BOOST_AUTO_TEST_CASE(rope_validation_selects_the_training_neighbours) {
     if (!polish) options.sum_weight = 1.0;  // the paper's variant: convexity from the weighted row only
     const rom::ConvexHullSolver solver(model, options);
     double max_sum = 0.0, max_pen = 0.0, max_comp = 0.0, max_primal = 0.0, max_dual = 0.0;
-    for (const fom::Param& mu : s.problem->validation_set(9)) {
+    for (const fom::Param& mu : fom::validation_set(*s.problem, 9)) {
       const rom::ConvexHullResult r = solver.solve_detailed(mu);
       const fom::FomSolution ref = s.fom_solver->solve(mu);
       const int below = training_index(s, mu(0) - 2.5), above = training_index(s, mu(0) + 2.5);
@@ -186,7 +186,7 @@ BOOST_AUTO_TEST_CASE(random_basis_is_reproducible_and_matches_svd_at_full_rank) 
   const rom::ConvexHullSolver a(model, random), b(model, random);
   BOOST_TEST(a.dictionary().projection_rank() == model.primal_rank());  // L defaults to the SVD rank
   BOOST_TEST((a.dictionary().projection_basis().array() == b.dictionary().projection_basis().array()).all());
-  const std::vector<fom::Param> params = s.problem->validation_set(9);
+  const std::vector<fom::Param> params = fom::validation_set(*s.problem, 9);
   for (const fom::Param& mu : params) {
     const VectorXd alpha_a = a.solve_detailed(mu).alpha, alpha_b = b.solve_detailed(mu).alpha;
     BOOST_TEST((alpha_a.array() == alpha_b.array()).all());  // bitwise

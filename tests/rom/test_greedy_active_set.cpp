@@ -49,7 +49,7 @@ struct Setup {
   /// References on validation_set(n) (the same set for every n of hertz/ironing).
   const std::vector<fom::FomSolution>& refs(int n) {
     if (references.empty()) {
-      validation = problem->validation_set(n);
+      validation = fom::validation_set(*problem, n);
       references = rom::compute_references(*solver, validation, 2);
       for (const auto& r : references) BOOST_REQUIRE(r.status == Status::Success);
     }
@@ -254,7 +254,7 @@ BOOST_AUTO_TEST_CASE(reduced_constraint_holds_at_the_solutions_own_pairing) {
     const rom::ReducedModel model(*setup->problem, setup->db(n), options);
     const rom::GreedyActiveSet greedy(model, greedy_options);
     const fom::ContactModel& contact = setup->problem->contact();
-    const std::vector<fom::Param> params = setup->problem->validation_set(n);
+    const std::vector<fom::Param> params = fom::validation_set(*setup->problem, n);
     int converged = 0;
     for (const fom::Param& mu : params) {
       const rom::OnlineResult res = greedy.solve(mu);
@@ -340,7 +340,7 @@ BOOST_AUTO_TEST_CASE(support_row_kernels_match_the_dense_operators) {
     const rom::ReducedModel model(problem, setup->db(setup == &rope ? 9 : 12));
     const rom::SupportRows support(model.dictionary());
     BOOST_REQUIRE(!support.rows.empty());
-    const fom::Param mu = problem.validation_set(12)[5];
+    const fom::Param mu = fom::validation_set(problem, 12)[5];
     const rom::GreedyActiveSet greedy(model);
     const rom::OnlineResult res = greedy.solve(mu);
     const Eigen::VectorXd lift_s = model.surface_lifting(mu);
@@ -405,7 +405,7 @@ BOOST_AUTO_TEST_CASE(parameter_dependent_stiffness_rope) {
     const rom::OnlineResult res = greedy.solve(db.parameter(j));
     BOOST_TEST(fom::relative_l2_pressure_error(*rope.problem, res.lambda, db.dual.col(j)) <= 1e-8);
   }
-  const rom::EvaluationSummary s = rom::evaluate_online(greedy, rope.problem->validation_set(9), rope.refs(9));
+  const rom::EvaluationSummary s = rom::evaluate_online(greedy, fom::validation_set(*rope.problem, 9), rope.refs(9));
   log_summary("rope 9, delta 1e-10", s);
   BOOST_TEST(s.mean_primal_error <= 1e-2);
   BOOST_TEST(s.nonconverged == 0);
