@@ -24,7 +24,7 @@ struct IpoptOptions {
   double mu_min = 1e-16;
   int max_iterations = 3000;        ///< Ipopt `max_iter` per QP solve (default 3000)
   int print_level = 0;              ///< Ipopt `print_level`; 0 with `sb = yes` silences Ipopt (default 0)
-  int max_pairing_iterations = 50;  ///< cap of the pairing fixed point (default 50)
+  int max_pairing_iterations = 300;  ///< cap of the pairing fixed point (default 300)
   double pairing_tolerance = 1e-12; ///< max change of ξ and normals to stop (default 1e-12)
   /// Anderson acceleration depth of the pairing fixed point, as in fom::ActiveSetSolver
   /// (0: plain iteration, whose rate is ≈ 0.8 on `hertz` d = 0.3) (default 5).

@@ -45,7 +45,7 @@ struct FomSolution {
 
 /// \brief Options of ActiveSetSolver (documented defaults).
 struct ActiveSetOptions {
-  int max_pairing_iterations = 50;  ///< cap of the pairing fixed point, default 50
+  int max_pairing_iterations = 300;  ///< cap of the pairing fixed point, default 300
   /// The pairing loop stops when re-pairing at the current solution changes the
   /// contact forces Cᵀλ (relative to |Cᵀλ|), the gaps of active rows and the
   /// penetration (relative to the displacement scale) by at most this; default 1e-12.

@@ -383,7 +383,7 @@ SnapshotDatabase read_database(const std::string& path) {
     const int version = read_scalar_attribute<int>(f, "format_version", H5T_NATIVE_INT);
     if (version != kDatabaseFormatVersion)
       throw InputError("database '" + path + "' has format_version " + std::to_string(version) +
-                       ", but this contactrom reads version " + std::to_string(kDatabaseFormatVersion));
+                       ", but this contactrom reads version " + std::to_string(kDatabaseFormatVersion) + "; rebuild it with contactrom offline");
     db.problem = read_string_attribute(f, "problem");
     db.mesh_fingerprint = read_string_attribute(f, "mesh_fingerprint");
     db.created_by = read_string_attribute(f, "created_by");

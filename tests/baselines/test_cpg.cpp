@@ -238,6 +238,20 @@ BOOST_AUTO_TEST_CASE(options_from_the_registry_extras) {
   BOOST_CHECK_THROW(baselines::reduced_active_set_options(inner), InputError);
 }
 
+BOOST_AUTO_TEST_CASE(ironing_level7_basis_needs_many_vectors) {
+  // With the pressure on the slab every snapshot has its own support: the cone of
+  // the 129 level-7 snapshots needs at least 30 of them at tolerance 5e-2.
+  const auto problem = fom::make_problem("ironing");
+  rom::OfflineOptions offline;
+  offline.threads = 2;
+  const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, 7, offline);
+  const rom::ReducedModel model(*problem, db);
+  const baselines::CpgActiveSet cpg(model);
+  BOOST_TEST_MESSAGE("ironing level 7: CPG basis of " << cpg.basis().columns.size() << " vectors");
+  BOOST_TEST(cpg.basis().tolerance == 5e-2);
+  BOOST_TEST(cpg.basis().columns.size() >= 30u);
+}
+
 BOOST_AUTO_TEST_CASE(hertz_basis_and_online_solver) {
   const auto problem = fom::make_problem("hertz");
   rom::OfflineOptions offline;

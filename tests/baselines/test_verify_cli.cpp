@@ -101,8 +101,9 @@ BOOST_AUTO_TEST_CASE(ironing_greedy_cpg_full_dictionary_against_ipopt) {
   const json j = run_json("verify --db " + dbs().ironing + " --method greedy,cpg,full-dictionary --limit 5 --threads 2");
   check_report(j, "ironing", 5);
   BOOST_TEST(j["level"] == 4);
-  // The ironing default CPG tolerance is 5e-2: fewer vectors than the dictionary.
-  BOOST_TEST(j["methods"]["cpg"]["dual_basis_size"].get<int>() < j["methods"]["cpg"]["dictionary_size"].get<int>());
+  // The pressure moves with the iron, so no level-4 snapshot lies in the cone of the
+  // others at the default tolerance 5e-2: CPG keeps every one of them.
+  BOOST_TEST(j["methods"]["cpg"]["dual_basis_size"].get<int>() == j["methods"]["cpg"]["dictionary_size"].get<int>());
 }
 
 BOOST_AUTO_TEST_CASE(summary_table_and_csv) {

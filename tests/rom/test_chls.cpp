@@ -202,7 +202,7 @@ BOOST_AUTO_TEST_CASE(cli_chls_rope) {
   namespace fs = std::filesystem;
   const std::string dir = contactrom::test::temp_dir();
   const std::string db = dir + "/rope.h5", csv = dir + "/chls.csv";
-  auto r = contactrom::test::run_command(kExe + " offline --problem rope --train 9 --out " + db);
+  auto r = contactrom::test::run_command(kExe + " offline --problem rope --out " + db);
   BOOST_REQUIRE_EQUAL(r.exit_code, 0);
   r = contactrom::test::run_command(kExe + " chls --db " + db + " --out " + csv + " --json");
   BOOST_REQUIRE_EQUAL(r.exit_code, 0);

@@ -289,7 +289,7 @@ BOOST_AUTO_TEST_CASE(cli_online_hull_report_and_refusal) {
   using contactrom::test::run_command;
   const std::string dir = contactrom::test::temp_dir();
   const std::string db = dir + "/rope.h5", iron = dir + "/iron.h5", csv = dir + "/report.csv";
-  BOOST_REQUIRE_EQUAL(run_command(kExe + " offline --problem rope --train 9 --out " + db).exit_code, 0);
+  BOOST_REQUIRE_EQUAL(run_command(kExe + " offline --problem rope --out " + db).exit_code, 0);
   auto r = run_command(kExe + " online --db " + db + " --method convex-hull --delta 1e-7 --json");
   BOOST_REQUIRE_EQUAL(r.exit_code, 0);
   auto j = nlohmann::json::parse(r.out);

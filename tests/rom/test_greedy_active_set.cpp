@@ -187,16 +187,37 @@ BOOST_AUTO_TEST_CASE(hertz_dual_error_falls_tenfold_from_12_to_120_snapshots) {
   BOOST_TEST(s12.mean_primal_error > s120.mean_primal_error);
 }
 
-BOOST_AUTO_TEST_CASE(ironing_dual_error_falls_monotonically_from_level_3_to_7) {
+BOOST_AUTO_TEST_CASE(ironing_dual_error_falls_from_level_3_to_7) {
+  // The pressure lives on the slab and moves with d_x: more snapshots, better pressures.
   Setup ironing("ironing");
-  double previous = 1e300;
-  for (int level = 3; level <= 7; ++level) {
-    const rom::EvaluationSummary s = ironing.evaluate(level, 1e-10);
-    log_summary("ironing level " + std::to_string(level) + ", delta 1e-10", s);
-    BOOST_TEST(s.rows.size() == 128u);
-    BOOST_TEST(s.mean_dual_error < previous, "level " << level);
-    previous = s.mean_dual_error;
+  const rom::EvaluationSummary s3 = ironing.evaluate(3, 1e-8), s7 = ironing.evaluate(7, 1e-8);
+  log_summary("ironing level 3, delta 1e-8", s3);
+  log_summary("ironing level 7, delta 1e-8", s7);
+  BOOST_TEST(s3.rows.size() == 128u);
+  BOOST_TEST(s7.mean_dual_error < 0.5 * s3.mean_dual_error);
+}
+
+BOOST_AUTO_TEST_CASE(ironing_selections_form_the_band_of_the_paper) {
+  // Level 5 (33 snapshots, d_x step 0.125): the greedy picks snapshots taken near
+  // the query's d_x, so the sparsity pattern is a band along the diagonal. Required:
+  // for at least 90 % of the validation queries every selected snapshot lies within
+  // two grid steps of d_x.
+  Setup ironing("ironing");
+  rom::ReducedModelOptions options;
+  options.delta = 1e-8;
+  const rom::ReducedModel model(*ironing.problem, ironing.db(5), options);
+  const rom::GreedyActiveSet greedy(model);
+  const std::vector<fom::Param> params = fom::validation_set(*ironing.problem, 5);
+  const Eigen::MatrixXd& trained = ironing.db(5).parameters;
+  int in_band = 0;
+  for (const fom::Param& mu : params) {
+    const rom::OnlineResult res = greedy.solve(mu);
+    bool near = !res.selected.empty();
+    for (int c : res.selected) near = near && std::abs(trained(0, model.dictionary_snapshots()[c]) - mu(0)) <= 2 * 0.125 + 1e-12;
+    in_band += near;
   }
+  BOOST_TEST_MESSAGE("ironing level 5: " << in_band << " of " << params.size() << " queries select within two steps of d_x");
+  BOOST_TEST(in_band >= 0.9 * static_cast<double>(params.size()));
 }
 
 BOOST_AUTO_TEST_CASE(converged_solution_satisfies_reduced_kkt_conditions) {
@@ -242,12 +263,12 @@ BOOST_AUTO_TEST_CASE(converged_solution_satisfies_reduced_kkt_conditions) {
 }
 
 BOOST_AUTO_TEST_CASE(reduced_constraint_holds_at_the_solutions_own_pairing) {
-  // Every converged query of the hertz-30 and ironing-129 validation sets:
+  // Every converged query of the hertz-30 and ironing level-5 validation sets:
   // max_p D_pᵀ(C(u)u − g(u)) ≤ τ with the pairing searched at the returned u (not
   // the one of the last iteration; issue #7 found 6/128 ironing violations before).
   Setup ironing("ironing");
   for (const auto& [schedule, greedy_options] : schedules())
-  for (auto [setup, n] : {std::pair<Setup*, int>{&hertz(), 30}, std::pair<Setup*, int>{&ironing, 7}}) {
+  for (auto [setup, n] : {std::pair<Setup*, int>{&hertz(), 30}, std::pair<Setup*, int>{&ironing, 5}}) {
     BOOST_TEST_CONTEXT(schedule) {
     rom::ReducedModelOptions options;
     options.delta = 1e-8;
