@@ -4,8 +4,11 @@
 // database (docs/database_format.md). A progress bar is drawn on stderr when it
 // is a terminal (or with --progress); snapshots that did not converge are
 // reported on stderr and stored with their status.
+//   mpirun -np N contactrom offline ...   (built with CONTACTROM_MPI) distributes the
+// parameters over the ranks; rank 0 gathers them and writes the same database.
 #include <unistd.h>
 
+#include <memory>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
@@ -13,6 +16,9 @@
 
 #include "fom/errors.hpp"
 #include "rom/offline.hpp"
+#ifdef CONTACTROM_HAVE_MPI
+#include "rom/offline_mpi.hpp"
+#endif
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
@@ -36,7 +42,40 @@ std::string param_text(const fom::Problem& problem, const fom::Param& mu) {
   return out;
 }
 
+/// Rank and size of the MPI run this process belongs to ({0, 1} when serial).
+struct Ranks {
+  int rank = 0, size = 1;
+  bool root() const { return rank == 0; }
+};
+
+/// Writes the database on rank 0; every rank then agrees on the outcome, so that
+/// all of them exit with an error if the write failed.
+void write_on_root(const std::string& path, const rom::SnapshotDatabase& db, const Ranks& ranks) {
+  bool ok = true;
+  try {
+    if (ranks.root()) rom::write_database(path, db);
+  } catch (...) {
+    ok = false;
+#ifdef CONTACTROM_HAVE_MPI
+    if (ranks.size > 1) rom::mpi::all_ranks_ok(false);
+#endif
+    throw;
+  }
+#ifdef CONTACTROM_HAVE_MPI
+  if (ranks.size > 1 && !rom::mpi::all_ranks_ok(ok))
+    throw rom::mpi::RankFailure("rank 0 could not write the database");
+#endif
+}
+
 void run_offline(const OfflineArgs& a) {
+#ifdef CONTACTROM_HAVE_MPI
+  // Under mpirun, the snapshots are distributed over the ranks (rom/offline_mpi.hpp).
+  std::unique_ptr<rom::mpi::Session> session;
+  if (rom::mpi::launched_by_mpi()) session = std::make_unique<rom::mpi::Session>();
+  const Ranks ranks = session ? Ranks{session->rank(), session->size()} : Ranks{};
+#else
+  const Ranks ranks;
+#endif
   auto problem = fom::make_problem(a.problem);
   int n = 0;
   if (problem->uses_levels()) {
@@ -52,13 +91,24 @@ void run_offline(const OfflineArgs& a) {
   if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
   const std::vector<fom::Param> params = problem->training_set(n);
 
-  rom::ProgressBar bar(std::cerr, "offline " + problem->name(), a.progress || ::isatty(STDERR_FILENO));
+  const std::string label =
+      "offline " + problem->name() + (ranks.size > 1 ? " (rank 0 of " + std::to_string(ranks.size) + ")" : "");
+  rom::ProgressBar bar(std::cerr, label, ranks.root() && (a.progress || ::isatty(STDERR_FILENO)));
   rom::OfflineOptions options;
   options.threads = a.threads;
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
-  const rom::SnapshotDatabase db =
-      rom::generate_snapshots(*problem, params, problem->uses_levels() ? "level" : "train", n, options);
+  const std::string kind = problem->uses_levels() ? "level" : "train";
+#ifdef CONTACTROM_HAVE_MPI
+  const rom::SnapshotDatabase db = session ? rom::mpi::generate_snapshots_distributed(*problem, params, kind, n, options)
+                                           : rom::generate_snapshots(*problem, params, kind, n, options);
+#else
+  const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, params, kind, n, options);
+#endif
   bar.finish();
+  if (!ranks.root()) {
+    write_on_root(a.out, db, ranks);
+    return;
+  }
 
   int failed = 0;
   for (int j = 0; j < db.num_snapshots(); ++j) {
@@ -67,7 +117,7 @@ void run_offline(const OfflineArgs& a) {
     std::cerr << "contactrom: warning: snapshot " << j << " (" << param_text(*problem, db.parameter(j))
               << ") status " << to_string(db.status[j]) << "; stored with its status and left out of the ROM\n";
   }
-  rom::write_database(a.out, db);
+  write_on_root(a.out, db, ranks);
 
   double fom_sum = 0.0;
   for (double t : db.time_s) fom_sum += t;
@@ -78,6 +128,7 @@ void run_offline(const OfflineArgs& a) {
     j["snapshots"] = db.num_snapshots();
     j["failed"] = failed;
     j["threads"] = db.threads;
+    j["ranks"] = ranks.size;
     j["wall_time_s"] = db.wall_time_s;
     j["setup_time_s"] = db.setup_time_s;
     j["mean_fom_time_s"] = db.num_snapshots() ? fom_sum / db.num_snapshots() : 0.0;
@@ -86,7 +137,8 @@ void run_offline(const OfflineArgs& a) {
     return;
   }
   std::cout << "offline " << problem->name() << ": " << db.num_snapshots() << " snapshots (" << db.training_kind << " "
-            << n << "), " << failed << " failed, " << db.threads << " threads\n"
+            << n << "), " << failed << " failed, " << db.threads << " threads"
+            << (ranks.size > 1 ? " on " + std::to_string(ranks.size) + " MPI ranks" : std::string()) << "\n"
             << std::setprecision(3) << "wall time " << db.wall_time_s << " s (factorisation " << db.setup_time_s
             << " s, mean FOM query " << (db.num_snapshots() ? 1e3 * fom_sum / db.num_snapshots() : 0.0) << " ms)\n"
             << "database written to " << a.out << "\n";
