@@ -1,5 +1,7 @@
 #include "fom/problem.hpp"
 
+#include <cstdlib>
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -60,7 +62,9 @@ class TwoBodyProblem : public Problem {
                   const std::vector<std::string>& dirichlet_groups) {
     const std::string dir = opt.mesh_dir.empty() ? mesh_directory() : opt.mesh_dir;
     const std::string path = dir + "/" + file;
-    m_mesh = std::make_unique<Mesh>(load_mesh(path));
+    MeshOptions mo;  // LOCAL HACK, not to be committed
+    if (const char* r = std::getenv("CONTACTROM_REFINE_HACK")) mo.refine = std::atoi(r);
+    m_mesh = std::make_unique<Mesh>(load_mesh(path, mo));
     const Mesh& mesh = *m_mesh;
     m_materials.assign(mesh.body_names.size(), Material{});
     m_k_terms = {assemble_stiffness(mesh, m_materials)};
