@@ -61,31 +61,53 @@ bool condense(const Problem& problem, const Param& mu, Condensation& out) {
   std::vector<int> free_index(n, -1);
   for (int i = 0; i < nf; ++i) free_index[free[i]] = i;
   const SparseMatrix k = problem.stiffness(mu);
-  Eigen::CholmodSupernodalLLT<SparseMatrix> llt(free_block(k, free_index, nf));
-  if (llt.info() != Eigen::Success) return false;
+  Condensation cond;
+  cond.free_dofs = free;
 
+  // The free surface dofs are eliminated last, so S is the inverse of the Schur
+  // complement held in the factor's trailing block.
   const std::vector<int>& surf = problem.contact().surface_dofs();
   const int ns = static_cast<int>(surf.size()), nt = problem.num_load_terms();
-  // Right-hand sides: unit loads on free surface dofs, then the load terms.
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(nf, ns + nt);
-  for (int j = 0; j < ns; ++j)
-    if (free_index[surf[j]] >= 0) rhs(free_index[surf[j]], j) = 1.0;
+  std::vector<int> last, last_of_free(nf, -1);
+  cond.surface_position.assign(ns, -1);
+  for (int j = 0; j < ns; ++j) {
+    const int f = free_index[surf[j]];
+    if (f < 0) continue;
+    if (last_of_free[f] < 0) last_of_free[f] = static_cast<int>(last.size()), last.push_back(f);
+    cond.surface_position[j] = last_of_free[f];
+  }
+  cond.factor = std::make_unique<SparseCholesky>();
+  if (cond.factor->compute(free_block(k, free_index, nf), last).info() != Status::Success) return false;
+  const Eigen::MatrixXd s_free = cond.factor->inverse_block();
+  const std::vector<int>& pos = cond.surface_position;
+  cond.s = Eigen::MatrixXd::Zero(ns, ns);
+  for (int b = 0; b < ns; ++b)
+    for (int a = 0; a < ns; ++a)
+      if (pos[a] >= 0 && pos[b] >= 0) cond.s(a, b) = s_free(pos[a], pos[b]);
+
+  // Unconstrained solutions of the load terms, lifting included.
+  Eigen::MatrixXd rhs(nf, nt);
   for (int t = 0; t < nt; ++t) {
     const Eigen::VectorXd r = problem.external_load_terms()[t] - k * problem.lifting_terms()[t];
-    for (int i = 0; i < nf; ++i) rhs(i, ns + t) = r(free[i]);
+    for (int i = 0; i < nf; ++i) rhs(i, t) = r(free[i]);
   }
-  const Eigen::MatrixXd x = llt.solve(rhs);
-  if (!x.allFinite()) return false;
-  out.z_surface = Eigen::MatrixXd::Zero(n, ns);
-  out.z_load = Eigen::MatrixXd::Zero(n, nt);
-  for (int i = 0; i < nf; ++i) {
-    out.z_surface.row(free[i]) = x.row(i).head(ns);
-    out.z_load.row(free[i]) = x.row(i).tail(nt);
-  }
-  for (int t = 0; t < nt; ++t) out.z_load.col(t) += problem.lifting_terms()[t];
-  out.s.resize(ns, ns);
-  for (int a = 0; a < ns; ++a) out.s.row(a) = out.z_surface.row(surf[a]);
+  const Eigen::MatrixXd x = cond.factor->solve(rhs);
+  if (x.rows() != nf || !x.allFinite() || !cond.s.allFinite()) return false;
+  cond.z_load = Eigen::MatrixXd::Zero(n, nt);
+  for (int i = 0; i < nf; ++i) cond.z_load.row(free[i]) = x.row(i);
+  for (int t = 0; t < nt; ++t) cond.z_load.col(t) += problem.lifting_terms()[t];
+  out = std::move(cond);
   return true;
+}
+
+Eigen::VectorXd Condensation::surface_response(const Eigen::VectorXd& surface_force) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(factor->trailing_size());
+  for (size_t j = 0; j < surface_position.size(); ++j)
+    if (surface_position[j] >= 0) f(surface_position[j]) += surface_force(j);
+  const Eigen::VectorXd x = factor->solve_trailing(f);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(z_load.rows());
+  for (size_t i = 0; i < free_dofs.size(); ++i) u(free_dofs[i]) = x(i);
+  return u;
 }
 
 ActiveSetSolver::ActiveSetSolver(const Problem& problem, ActiveSetOptions options)
@@ -237,15 +259,12 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
   }
   // The constraint operator of the returned solution is the one λ was solved with;
   // on convergence the pairing recomputed from u agrees with it to the tolerance.
-  // u = u0 − Z_s Cᵀλ over the non-zero entries of Cᵀλ only (the surface dofs of
-  // the active rows): Z_s is n x n_s and dense, the full product dominates a query.
+  sol.active = static_cast<int>((lambda.array() > 0.0).count());
+  // u = u0 − K⁻¹ E_s Cᵀλ: one solve with the factor.
   sol.u = u0;
-  const Eigen::VectorXd force = c.transpose() * lambda;
-  for (int j = 0; j < force.size(); ++j)
-    if (force(j) != 0.0) sol.u.noalias() -= force(j) * cond.z_surface.col(j);
+  if (sol.active > 0) sol.u -= cond.surface_response(c.transpose() * lambda);
   sol.lambda = lambda;
   sol.pairing = pairing;
-  sol.active = static_cast<int>((lambda.array() > 0.0).count());
   sol.time_s = seconds_since(t0);
   return sol;
 }

@@ -4,15 +4,18 @@
 /// condensed primal–dual active-set QP solve.
 ///
 /// Algorithm (DESIGN §2):
-///  1. Offline per stiffness: factorise K_ff once (CHOLMOD) and condense onto the
-///     contact surface: \f$ Z_s = K^{-1} E_s \f$, \f$ S = E_s^T K^{-1} E_s \f$, and
-///     the unconstrained solutions of the affine load terms. For `hertz`/`ironing`
-///     this happens once in the constructor and is reused for every parameter.
+///  1. Offline per stiffness: factorise K_ff once (CHOLMOD, SparseCholesky) with the
+///     contact-surface dofs eliminated last, and condense onto the contact surface:
+///     \f$ S = E_s^T K^{-1} E_s \f$ is read from the factor's trailing block (no
+///     dense dofs x surface matrix is formed), plus the unconstrained solutions of
+///     the affine load terms. Setup time and memory grow like the factorisation and
+///     \f$ n_s^2 \f$. For `hertz`/`ironing` this happens once in the constructor
+///     and is reused for every parameter.
 ///  2. Per query: \f$ u_0(\mu) \f$ unconstrained; loop { pairing from u (deformed
 ///     configuration) → \f$ C, g \f$ → Delassus \f$ G = C S C^T \f$,
 ///     \f$ h = C u_{0,s} - g \f$ → dual QP (DualQpSolver) →
 ///     \f$ u_s = u_{0,s} - S C^T\lambda \f$ } until re-pairing no longer changes the KKT system;
-///     then \f$ u = u_0 - Z_s C^T \lambda \f$ (over the non-zero entries of Cᵀλ).
+///     then \f$ u = u_0 - K^{-1} E_s C^T \lambda \f$ (one solve with the factor).
 ///     The dual QP runs on a working set W of rows (active, or within
 ///     working_set_margin·U of contact at the current iterate): G_W = C_W S C_Wᵀ,
 ///     then rows outside W that penetrate join W and the QP is solved again, so λ
@@ -26,6 +29,7 @@
 #include "fom/contact_model.hpp"
 #include "fom/dual_qp.hpp"
 #include "fom/problem.hpp"
+#include "fom/sparse_cholesky.hpp"
 
 namespace contactrom::fom {
 
@@ -61,9 +65,15 @@ struct ActiveSetOptions {
 
 /// \brief Condensed operators of one stiffness matrix (see file comment).
 struct Condensation {
-  Eigen::MatrixXd z_surface;  ///< K⁻¹ E_s on all dofs (zero Dirichlet rows), n x n_s
-  Eigen::MatrixXd s;          ///< E_sᵀ K⁻¹ E_s, n_s x n_s
-  Eigen::MatrixXd z_load;     ///< unconstrained solution of each load term (lifting included), n x n_terms
+  std::unique_ptr<SparseCholesky> factor;  ///< K_ff, the free surface dofs eliminated last
+  std::vector<int> free_dofs;              ///< the problem's free dofs (rows of the factor)
+  std::vector<int> surface_position;       ///< per surface dof: its index in the factor's trailing set (−1: Dirichlet)
+  Eigen::MatrixXd s;       ///< E_sᵀ K⁻¹ E_s, n_s x n_s (zero rows/columns for Dirichlet surface dofs)
+  Eigen::MatrixXd z_load;  ///< unconstrained solution of each load term (lifting included), n x n_terms
+
+  /// \brief \f$ K^{-1} E_s f_s \f$ on all n dofs (zero on Dirichlet dofs): the
+  /// displacement of the surface forces `surface_force` (n_s), by one solve.
+  Eigen::VectorXd surface_response(const Eigen::VectorXd& surface_force) const;
 };
 
 /// \brief Factorises K(μ) (CHOLMOD) and builds the condensation for `problem`.

@@ -396,7 +396,10 @@ std::string Mesh::fingerprint() const {
   return buf;
 }
 
-Mesh load_mesh(const std::string& path, int refine) {
+Mesh load_mesh(const std::string& path, const MeshOptions& options) {
+  if (options.refine < 0 || options.refine > MeshOptions::kMaxRefine)
+    throw InputError("mesh refinement " + std::to_string(options.refine) + " invalid; expected an integer in 0.." +
+                     std::to_string(MeshOptions::kMaxRefine));
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh file '" + path + "' not found");
   if (!std::ifstream(path)) throw InputError("mesh file '" + path + "' is not readable");
@@ -413,8 +416,10 @@ Mesh load_mesh(const std::string& path, int refine) {
       if (std::string err = session.take_first_error(); !err.empty())
         throw InputError(where + ": gmsh meshing failed: " + err);
     }
-    for (int level = 0; level < refine; ++level) {
-      gmsh::option::setNumber("Mesh.SubdivisionAlgorithm", 1);  // quads stay quads
+    // gmsh's refine splits each quad in four through its mid-edge and centre nodes,
+    // placed on the model's curves and surfaces (not at straight-line midpoints)
+    // because Mesh.SecondOrderLinear is 0 by default.
+    for (int level = 0; level < options.refine; ++level) {
       gmsh::model::mesh::refine();
       if (std::string err = session.take_first_error(); !err.empty())
         throw InputError(where + ": gmsh refinement failed: " + err);

@@ -49,6 +49,19 @@ struct Mesh {
   std::string fingerprint() const;
 };
 
+/// \brief Options of load_mesh (documented defaults).
+struct MeshOptions {
+  /// Uniform refinement levels applied after meshing (or reading): each level splits
+  /// every quad in four (`gmsh::model::mesh::refine()`), so node and quad counts grow
+  /// about fourfold per level and every boundary division doubles. New boundary nodes
+  /// of a `.geo` model are placed on the geometry's curves (arcs stay round); a `.msh`
+  /// file has no geometry, so its new boundary nodes are segment midpoints. Physical
+  /// groups keep their names and stay chains. Range 0..kMaxRefine; default 0.
+  int refine = 0;
+  /// Largest accepted `refine` (8 levels multiply the node count by about 65536).
+  static constexpr int kMaxRefine = 8;
+};
+
 /// \brief Meshes a `.geo` file (or reads a `.msh`) with the gmsh API and returns
 /// the Q1 mesh. Only quadrilateral surface elements are accepted.
 ///
@@ -65,13 +78,12 @@ struct Mesh {
 /// holds a gmsh session (gmsh keeps its state in globals). Keep it out of hot
 /// loops: a session costs about 0.01-0.1 s.
 /// \param path file to read
-/// \param refine uniform refinements after meshing (each splits every quad in
-///   four, new boundary nodes on the geometry's curves), default 0
-/// \throws InputError if the file is missing ("mesh file 'X' not found"),
+/// \param options refinement (see MeshOptions)
+/// \throws InputError if `options.refine` is outside 0..MeshOptions::kMaxRefine, if the file is missing ("mesh file 'X' not found"),
 ///   unreadable, rejected by gmsh (syntax error, meshing error; the message names
 ///   the file and quotes gmsh), produces non-quad elements, lacks physical
 ///   groups, or has a curve group that is not a single chain.
-Mesh load_mesh(const std::string& path, int refine = 0);
+Mesh load_mesh(const std::string& path, const MeshOptions& options = {});
 
 /// \brief The folder holding the project's `.geo` files: `$CONTACTROM_MESH_DIR`
 /// if set, else the source tree's `meshes/` recorded at configure time.

@@ -359,7 +359,9 @@ std::unique_ptr<Problem> make_problem(const std::string& name_or_path, const Pro
   if (options.refine < 0 || options.refine > 6)
     throw InputError("refine " + std::to_string(options.refine) + " is invalid; expected 0..6");
   def.refine += options.refine;
-  Mesh mesh = load_mesh(def.mesh, def.refine);
+  MeshOptions mesh_options;
+  mesh_options.refine = def.refine;
+  Mesh mesh = load_mesh(def.mesh, mesh_options);
   return build_problem(std::move(def), std::move(mesh));
 }
 

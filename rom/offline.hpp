@@ -59,7 +59,7 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
                                     const OfflineOptions& options = {});
 
 /// \brief Same, with the training set selected by `n` as the problem expects
-/// (training_set(n); `--level n` if problem.uses_levels(), else `--train n`).
+/// (fom::training_set(problem, n): `--train n` or `--level n` as its training plan says).
 SnapshotDatabase generate_snapshots(const fom::Problem& problem, int n, const OfflineOptions& options = {});
 
 /// \brief A one-line progress bar "label [#####.....] 17/30  42.1/s  ETA 0.3 s"

@@ -1,18 +1,25 @@
-// contactrom offline --problem P (--train N | --level n) --out DB.h5 [--threads T] [--progress] [--json]
+// contactrom offline --problem P (--train N | --level n) --out DB.h5 [--threads T] [--part k/K] [--progress] [--json]
 // Computes the FOM snapshots at the training parameters in parallel (one shared
 // factorisation, no warm start, deterministic) and writes them to an HDF5
 // database (docs/database_format.md). A progress bar is drawn on stderr when it
 // is a terminal (or with --progress); snapshots that did not converge are
 // reported on stderr and stored with their status.
+//   mpirun -np N contactrom offline ...   (built with CONTACTROM_MPI) distributes the
+// parameters over the ranks; rank 0 gathers them and writes the same database.
 #include <unistd.h>
 
+#include <memory>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "fom/errors.hpp"
+#include "rom/database_merge.hpp"
 #include "rom/offline.hpp"
+#ifdef CONTACTROM_HAVE_MPI
+#include "rom/offline_mpi.hpp"
+#endif
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
@@ -23,6 +30,7 @@ namespace {
 struct OfflineArgs {
   std::string problem, out;
   int train = 0, level = 0, threads = 0, refine = 0;
+  std::string part;  // "k/K": only the k-th of K contiguous parts of the training set
   bool progress = false, json = false;
 };
 
@@ -36,22 +44,75 @@ std::string param_text(const fom::Problem& problem, const fom::Param& mu) {
   return out;
 }
 
+/// The part "k/K" of the training set (rom::part_range), for splitting a run over jobs.
+std::vector<fom::Param> training_part(const std::vector<fom::Param>& params, const std::string& text) {
+  int k = 0, parts = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%d/%d%c", &k, &parts, &tail) != 2)
+    throw InputError("--part '" + text + "' invalid; expected k/K, e.g. 1/4");
+  const auto [begin, end] = rom::part_range(static_cast<int>(params.size()), k, parts);
+  return std::vector<fom::Param>(params.begin() + begin, params.begin() + end);
+}
+
+/// Rank and size of the MPI run this process belongs to ({0, 1} when serial).
+struct Ranks {
+  int rank = 0, size = 1;
+  bool root() const { return rank == 0; }
+};
+
+/// Writes the database on rank 0; every rank then agrees on the outcome, so that
+/// all of them exit with an error if the write failed.
+void write_on_root(const std::string& path, const rom::SnapshotDatabase& db, const Ranks& ranks) {
+  try {
+    if (ranks.root()) rom::write_database(path, db);
+  } catch (...) {
+#ifdef CONTACTROM_HAVE_MPI
+    if (ranks.size > 1) rom::mpi::all_ranks_ok(false);
+#endif
+    throw;
+  }
+#ifdef CONTACTROM_HAVE_MPI
+  if (ranks.size > 1 && !rom::mpi::all_ranks_ok(true))
+    throw rom::mpi::RankFailure("rank 0 could not write the database");
+#endif
+}
+
 void run_offline(const OfflineArgs& a) {
+#ifdef CONTACTROM_HAVE_MPI
+  // Under mpirun, the snapshots are distributed over the ranks (rom/offline_mpi.hpp).
+  std::unique_ptr<rom::mpi::Session> session;
+  if (rom::mpi::launched_by_mpi()) session = std::make_unique<rom::mpi::Session>();
+  const Ranks ranks = session ? Ranks{session->rank(), session->size()} : Ranks{};
+#else
+  const Ranks ranks;
+#endif
   fom::ProblemOptions popt;
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);
   const fom::SamplingPlan& plan = problem->definition().training;
   const int n = fom::resolve_training_size(plan, problem->name(), a.train, a.level, false);
   if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
-  const std::vector<fom::Param> params = fom::training_set(*problem, n);
+  std::vector<fom::Param> params = fom::training_set(*problem, n);
+  if (!a.part.empty()) params = training_part(params, a.part);
 
-  rom::ProgressBar bar(std::cerr, "offline " + problem->name(), a.progress || ::isatty(STDERR_FILENO));
+  const std::string label =
+      "offline " + problem->name() + (ranks.size > 1 ? " (rank 0 of " + std::to_string(ranks.size) + ")" : "");
+  rom::ProgressBar bar(std::cerr, label, ranks.root() && (a.progress || ::isatty(STDERR_FILENO)));
   rom::OfflineOptions options;
   options.threads = a.threads;
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
-  const rom::SnapshotDatabase db =
-      rom::generate_snapshots(*problem, params, plan.selector(), n, options);
+  const std::string kind = plan.selector();
+#ifdef CONTACTROM_HAVE_MPI
+  const rom::SnapshotDatabase db = session ? rom::mpi::generate_snapshots_distributed(*problem, params, kind, n, options)
+                                           : rom::generate_snapshots(*problem, params, kind, n, options);
+#else
+  const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, params, kind, n, options);
+#endif
   bar.finish();
+  if (!ranks.root()) {
+    write_on_root(a.out, db, ranks);
+    return;
+  }
 
   int failed = 0;
   for (int j = 0; j < db.num_snapshots(); ++j) {
@@ -60,7 +121,7 @@ void run_offline(const OfflineArgs& a) {
     std::cerr << "contactrom: warning: snapshot " << j << " (" << param_text(*problem, db.parameter(j))
               << ") status " << to_string(db.status[j]) << "; stored with its status and left out of the ROM\n";
   }
-  rom::write_database(a.out, db);
+  write_on_root(a.out, db, ranks);
 
   double fom_sum = 0.0;
   for (double t : db.time_s) fom_sum += t;
@@ -71,6 +132,7 @@ void run_offline(const OfflineArgs& a) {
     j["snapshots"] = db.num_snapshots();
     j["failed"] = failed;
     j["threads"] = db.threads;
+    j["ranks"] = ranks.size;
     j["wall_time_s"] = db.wall_time_s;
     j["setup_time_s"] = db.setup_time_s;
     j["mean_fom_time_s"] = db.num_snapshots() ? fom_sum / db.num_snapshots() : 0.0;
@@ -79,7 +141,8 @@ void run_offline(const OfflineArgs& a) {
     return;
   }
   std::cout << "offline " << problem->name() << ": " << db.num_snapshots() << " snapshots (" << db.training_kind << " "
-            << n << "), " << failed << " failed, " << db.threads << " threads\n"
+            << n << "), " << failed << " failed, " << db.threads << " threads"
+            << (ranks.size > 1 ? " on " + std::to_string(ranks.size) + " MPI ranks" : std::string()) << "\n"
             << std::setprecision(3) << "wall time " << db.wall_time_s << " s (factorisation " << db.setup_time_s
             << " s, mean FOM query " << (db.num_snapshots() ? 1e3 * fom_sum / db.num_snapshots() : 0.0) << " ms)\n"
             << "database written to " << a.out << "\n";
@@ -99,6 +162,8 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
   sub->add_option("--out", args->out, "output database (.h5)")->required();
   sub->add_option("--threads", args->threads, "worker threads (default: hardware concurrency)")
       ->check(CLI::Range(1, 1024));
+  sub->add_option("--part", args->part,
+                  "k/K: only the k-th of K contiguous parts of the training set (join the parts with merge)");
   sub->add_flag("--progress", args->progress, "draw the progress bar even when stderr is not a terminal");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_offline(*args); });

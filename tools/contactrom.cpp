@@ -12,6 +12,9 @@
 
 #include "fom/errors.hpp"
 #include "tools/cli.hpp"
+#ifdef CONTACTROM_HAVE_MPI
+#include "rom/offline_mpi.hpp"
+#endif
 
 namespace contactrom::cli {
 std::vector<CommandEntry>& command_table() {
@@ -28,6 +31,11 @@ int main(int argc, char** argv) {
   auto& table = cli::command_table();
   std::sort(table.begin(), table.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   for (auto& entry : table) entry.setup(app);
+#ifdef CONTACTROM_HAVE_MPI
+  // Under mpirun every rank runs this program; only rank 0 reports errors, so a
+  // bad argument gives one message (every rank still exits with the error code).
+  if (rom::mpi::launcher_rank() != 0) std::cerr.setstate(std::ios::badbit);
+#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -275,3 +275,48 @@ BOOST_AUTO_TEST_CASE(row_subset_and_hint_do_not_change_the_search) {
     }
   }
 }
+
+BOOST_AUTO_TEST_CASE(condensation_matches_dense_inverse_columns) {
+  // S = E_sᵀ K⁻¹ E_s read from the factor, the load responses and the surface
+  // response agree with K⁻¹ applied column by column by an independent factorisation
+  // (Eigen's simplicial LDLᵀ), i.e. with the former dense condensation K⁻¹E_s.
+  for (const std::string name : {"hertz", "ironing"}) {
+    const Problem& problem = fixture().solver(name).problem();
+    const Param mu = 0.5 * (problem.param_lower() + problem.param_upper());
+    Condensation cond;
+    BOOST_REQUIRE(condense(problem, mu, cond));
+    const std::vector<int>& free = problem.free_dofs();
+    const int n = problem.num_dofs(), nf = static_cast<int>(free.size());
+    std::vector<int> free_index(n, -1);
+    for (int i = 0; i < nf; ++i) free_index[free[i]] = i;
+    const SparseMatrix k = problem.stiffness(mu);
+    const Eigen::SimplicialLDLT<SparseMatrix> ldlt(free_block(k, free_index, nf));
+    BOOST_REQUIRE(ldlt.info() == Eigen::Success);
+    const std::vector<int>& surf = problem.contact().surface_dofs();
+    const int ns = static_cast<int>(surf.size());
+    Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(nf, ns);
+    for (int j = 0; j < ns; ++j)
+      if (free_index[surf[j]] >= 0) unit(free_index[surf[j]], j) = 1.0;
+    const Eigen::MatrixXd z = ldlt.solve(unit);  // K⁻¹E_s on the free dofs
+    Eigen::MatrixXd s(ns, ns);
+    for (int a = 0; a < ns; ++a)
+      s.row(a) = free_index[surf[a]] >= 0 ? Eigen::RowVectorXd(z.row(free_index[surf[a]])) : Eigen::RowVectorXd::Zero(ns);
+    BOOST_TEST_CONTEXT(name) {
+      BOOST_TEST((cond.s - s).norm() <= 1e-10 * s.norm());
+      const Eigen::VectorXd force = Eigen::VectorXd::LinSpaced(ns, -1.0, 2.0);
+      Eigen::VectorXd expected = Eigen::VectorXd::Zero(n);
+      const Eigen::VectorXd zf = z * force;
+      for (int i = 0; i < nf; ++i) expected(free[i]) = zf(i);
+      BOOST_TEST((cond.surface_response(force) - expected).norm() <= 1e-10 * expected.norm());
+      for (int t = 0; t < problem.num_load_terms(); ++t) {
+        const Eigen::VectorXd r = problem.external_load_terms()[t] - k * problem.lifting_terms()[t];
+        Eigen::VectorXd rf(nf);
+        for (int i = 0; i < nf; ++i) rf(i) = r(free[i]);
+        const Eigen::VectorXd x = ldlt.solve(rf);
+        Eigen::VectorXd u = problem.lifting_terms()[t];
+        for (int i = 0; i < nf; ++i) u(free[i]) += x(i);
+        BOOST_TEST((cond.z_load.col(t) - u).norm() <= 1e-10 * u.norm());
+      }
+    }
+  }
+}

@@ -348,6 +348,56 @@ BOOST_AUTO_TEST_CASE(ironing_groups_lie_on_their_curves) {
 
 // ------------------------------------------------------- fingerprint, groups --
 
+// ------------------------------------------------------------ refinement --
+
+BOOST_AUTO_TEST_CASE(hertz_refined_once_splits_every_quad_in_four_and_keeps_groups) {
+  contactrom::fom::MeshOptions options;
+  options.refine = 1;
+  const Mesh& coarse = hertz();
+  const Mesh fine = load_mesh(kMeshDir + "hertz.geo", options);
+  check_quads_ccw_and_valid(fine);
+  BOOST_TEST(fine.body_names == coarse.body_names);
+  BOOST_TEST(fine.num_quads() == 4 * coarse.num_quads());
+  // Per body (a disk-like surface, Euler characteristic 1: edges = nodes + quads - 1)
+  // the split adds a node per edge and per quad: nodes' = 2 nodes + 2 quads - 1.
+  for (int b = 0; b < 2; ++b) {
+    const int nodes = static_cast<int>(body_nodes(coarse, b).size()), quads = count_quads(coarse, b);
+    BOOST_TEST(static_cast<int>(body_nodes(fine, b).size()) == 2 * nodes + 2 * quads - 1);
+    BOOST_TEST(count_quads(fine, b) == 4 * quads);
+  }
+  double worst = INFINITY;
+  for (int q = 0; q < fine.num_quads(); ++q) worst = std::min(worst, scaled_jacobian(fine, q));
+  BOOST_TEST(worst > 0.5);  // the split keeps the corner angles of the coarse quads
+  for (const auto& [name, segments] : coarse.segments) {
+    BOOST_TEST_CONTEXT("group " << name) {
+      BOOST_REQUIRE(fine.segments.count(name) == 1u);
+      BOOST_TEST(fine.group_segments(name).size() == 2 * segments.size());
+    }
+  }
+  for (const auto& [name, body, yc] : {std::tuple{"bottom_arc", 0, -1.0}, std::tuple{"top_arc", 1, 1.0}}) {
+    check_chain(fine, name, body);
+    // The new mid-segment nodes lie on the arc, not on the coarse chords (whose
+    // midpoints are up to 1e-3 inside the circle here).
+    for (int n : fine.group_nodes(name)) {
+      const double x = fine.nodes(0, n), y = fine.nodes(1, n);
+      BOOST_TEST(std::abs(x * x + (y - yc) * (y - yc) - 1.0) < 1e-9, name << " node off its circle");
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(refinement_outside_its_range_is_an_input_error_naming_it) {
+  for (int refine : {-1, contactrom::fom::MeshOptions::kMaxRefine + 1}) {
+    contactrom::fom::MeshOptions options;
+    options.refine = refine;
+    try {
+      load_mesh(kMeshDir + "hertz.geo", options);
+      BOOST_ERROR("refine " << refine << " accepted");
+    } catch (const InputError& e) {
+      BOOST_TEST(contains(e.what(), "refinement " + std::to_string(refine)), e.what());
+    }
+  }
+}
+
 BOOST_AUTO_TEST_CASE(fingerprint_is_stable_and_tells_meshes_apart) {
   const std::string a = hertz().fingerprint();
   BOOST_TEST(a.size() == 16u);

@@ -1,0 +1,152 @@
+#include "rom/offline_mpi.hpp"
+
+#include <mpi.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <stdexcept>
+
+namespace contactrom::rom::mpi {
+namespace {
+
+/// Values stored per snapshot besides its primal and dual columns: status,
+/// iterations, pairing iterations (small integers, exact as doubles) and time.
+constexpr int kScalarsPerSnapshot = 4;
+
+/// Sends the failing rank's message to every rank (MPI_Bcast from that rank).
+std::string broadcast_message(const std::string& message, int root) {
+  int length = static_cast<int>(message.size());
+  MPI_Bcast(&length, 1, MPI_INT, root, MPI_COMM_WORLD);
+  std::string text(message);
+  text.resize(static_cast<size_t>(length));
+  MPI_Bcast(text.data(), length, MPI_CHAR, root, MPI_COMM_WORLD);
+  return text;
+}
+
+/// Local snapshots packed one after the other: primal, dual, then the scalars.
+std::vector<double> pack(const SnapshotDatabase& db) {
+  const int nd = db.num_dofs(), nc = db.num_constraints(), stride = nd + nc + kScalarsPerSnapshot;
+  std::vector<double> buffer(static_cast<size_t>(stride) * db.num_snapshots());
+  for (int k = 0; k < db.num_snapshots(); ++k) {
+    double* p = buffer.data() + static_cast<size_t>(stride) * k;
+    Eigen::Map<Eigen::VectorXd>(p, nd) = db.primal.col(k);
+    Eigen::Map<Eigen::VectorXd>(p + nd, nc) = db.dual.col(k);
+    p[nd + nc] = static_cast<double>(static_cast<int>(db.status[k]));
+    p[nd + nc + 1] = db.iterations[k];
+    p[nd + nc + 2] = db.pairing_iterations[k];
+    p[nd + nc + 3] = db.time_s[k];
+  }
+  return buffer;
+}
+
+/// Number of parameters rank r computes under the cyclic assignment.
+int share(int n, int rank, int size) { return n / size + (rank < n % size ? 1 : 0); }
+
+}  // namespace
+
+bool launched_by_mpi() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK"})
+    if (std::getenv(name)) return true;
+  return false;
+}
+
+int launcher_rank() {
+  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"})
+    if (const char* value = std::getenv(name)) return std::atoi(value);
+  return 0;
+}
+
+Session::Session() {
+  int initialised = 0;
+  MPI_Initialized(&initialised);
+  if (!initialised) MPI_Init(nullptr, nullptr);
+  MPI_Comm_rank(MPI_COMM_WORLD, &m_rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &m_size);
+}
+
+Session::~Session() {
+  int finalised = 0;
+  MPI_Finalized(&finalised);
+  if (!finalised) MPI_Finalize();
+}
+
+bool all_ranks_ok(bool ok) {
+  int local = ok ? 1 : 0, all = 0;
+  MPI_Allreduce(&local, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  return all == 1;
+}
+
+SnapshotDatabase generate_snapshots_distributed(const fom::Problem& problem, const std::vector<fom::Param>& params,
+                                                const std::string& training_kind, int training_size,
+                                                const OfflineOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  for (const fom::Param& mu : params) problem.check_param(mu);  // same outcome on every rank
+  const int n = static_cast<int>(params.size());
+
+  std::vector<fom::Param> mine;
+  for (int j = rank; j < n; j += size) mine.push_back(params[j]);
+  OfflineOptions local_options = options;
+  if (rank != 0) local_options.progress = nullptr;
+  SnapshotDatabase local;
+  std::string error;
+  try {
+    local = generate_snapshots(problem, mine, training_kind, training_size, local_options);
+  } catch (const std::exception& e) {
+    error = e.what();
+  } catch (...) {
+    error = "unknown error";
+  }
+  // Every rank learns whether (and where) a computation failed before any gather,
+  // so that no rank waits for data that will never come.
+  int failed_rank = error.empty() ? size : rank, first_failed = size;
+  MPI_Allreduce(&failed_rank, &first_failed, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (first_failed < size)
+    throw RankFailure("rank " + std::to_string(first_failed) + " of " + std::to_string(size) +
+                      " failed: " + broadcast_message(error, first_failed));
+
+  const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
+  const int stride = nd + nc + kScalarsPerSnapshot;
+  const std::vector<double> buffer = pack(local);
+  std::vector<int> counts(size), displs(size);
+  for (int r = 0, offset = 0; r < size; ++r) {
+    counts[r] = share(n, r, size) * stride;
+    displs[r] = offset;
+    offset += counts[r];
+  }
+  std::vector<double> all(rank == 0 ? static_cast<size_t>(n) * stride : 0);
+  MPI_Gatherv(buffer.data(), static_cast<int>(buffer.size()), MPI_DOUBLE, all.data(), counts.data(), displs.data(),
+              MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  int local_threads = local.threads, threads = 0;
+  MPI_Reduce(&local_threads, &threads, 1, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD);
+  if (rank != 0) return SnapshotDatabase{};
+
+  // Rank r's k-th snapshot is parameter j = r + k·size.
+  SnapshotDatabase db = local;  // metadata (problem, fingerprint, names, ...) of rank 0
+  db.parameters.resize(problem.num_params(), n);
+  db.primal.resize(nd, n);
+  db.dual.resize(nc, n);
+  db.status.assign(n, Status::Success);
+  db.iterations.assign(n, 0);
+  db.pairing_iterations.assign(n, 0);
+  db.time_s.assign(n, 0.0);
+  for (int r = 0; r < size; ++r)
+    for (int k = 0; k < share(n, r, size); ++k) {
+      const int j = r + k * size;
+      const double* p = all.data() + displs[r] + static_cast<size_t>(stride) * k;
+      db.parameters.col(j) = params[j];
+      db.primal.col(j) = Eigen::Map<const Eigen::VectorXd>(p, nd);
+      db.dual.col(j) = Eigen::Map<const Eigen::VectorXd>(p + nd, nc);
+      db.status[j] = static_cast<Status>(static_cast<int>(p[nd + nc]));
+      db.iterations[j] = static_cast<int>(p[nd + nc + 1]);
+      db.pairing_iterations[j] = static_cast<int>(p[nd + nc + 2]);
+      db.time_s[j] = p[nd + nc + 3];
+    }
+  db.threads = threads;
+  db.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return db;
+}
+
+}  // namespace contactrom::rom::mpi

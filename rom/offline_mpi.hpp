@@ -1,0 +1,66 @@
+#pragma once
+/// \file offline_mpi.hpp
+/// \brief Offline stage distributed over MPI ranks (built with CONTACTROM_MPI).
+///
+/// \code
+///   mpirun -np 4 contactrom offline --problem hertz --train 120 --out hertz120.h5 --threads 1
+/// \endcode
+///
+/// Rank r of R computes the training parameters j ≡ r (mod R) with
+/// generate_snapshots() (its own factorisation, `threads` worker threads), so every
+/// rank gets the same number of snapshots up to one and a share of each part of
+/// the parameter range (the cost of a FOM query grows with the contact zone). The
+/// snapshots are gathered on rank 0 into the columns of the serial order: each
+/// snapshot is computed from scratch exactly as in a serial run, so the database's
+/// arrays are bit-identical to the serial ones; only timing fields differ.
+#include <string>
+#include <vector>
+
+#include "rom/offline.hpp"
+
+namespace contactrom::rom::mpi {
+
+/// \brief Whether this process was started by an MPI launcher (mpirun/mpiexec set
+/// the rank in the environment), without initialising MPI.
+bool launched_by_mpi();
+
+/// \brief Rank of this process as the launcher announced it (0 when not launched by MPI).
+int launcher_rank();
+
+/// \brief Scoped MPI session: MPI_Init on construction, MPI_Finalize on destruction.
+class Session {
+ public:
+  Session();
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+  int rank() const { return m_rank; }
+  int size() const { return m_size; }
+
+ private:
+  int m_rank = 0, m_size = 1;
+};
+
+/// \brief A failure on some rank, reported on every rank (rank 0 carries the
+/// failing rank's message) so that all ranks stop together.
+class RankFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// \brief The distributed offline stage (see the file comment); collective over
+/// MPI_COMM_WORLD. `options.progress` is called on rank 0 only, with rank 0's share.
+/// \returns on rank 0 the whole database (threads = worker threads over all ranks,
+///   setup_time_s = rank 0's factorisation, wall_time_s = until the gather ended);
+///   on the other ranks an empty database.
+/// \throws InputError (on every rank) for a parameter outside the range;
+///   RankFailure (on every rank) if a rank's computation threw.
+SnapshotDatabase generate_snapshots_distributed(const fom::Problem& problem, const std::vector<fom::Param>& params,
+                                                const std::string& training_kind, int training_size,
+                                                const OfflineOptions& options = {});
+
+/// \brief Whether `ok` holds on every rank (collective; an agreement step, e.g.
+/// after rank 0 wrote the file, so that every rank exits with the same outcome).
+bool all_ranks_ok(bool ok);
+
+}  // namespace contactrom::rom::mpi

@@ -1,0 +1,106 @@
+// Tests of the MPI offline stage (built with CONTACTROM_MPI): mpirun -np 2 and 3
+// write a database whose arrays are bit-identical to the serial run's; bad input
+// and I/O errors end every rank with a non-zero code, one message and no file.
+#define BOOST_TEST_MODULE rom_offline_mpi
+#include <boost/test/unit_test.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <string>
+
+#include "common/run_command.hpp"
+#include "rom/snapshot_database.hpp"
+
+namespace fs = std::filesystem;
+using contactrom::rom::read_database;
+using contactrom::rom::SnapshotDatabase;
+using contactrom::test::run_command;
+
+namespace {
+
+const std::string exe = CONTACTROM_EXE;
+
+/// mpirun with N ranks, allowed as root (as in CI) and on more ranks than cores.
+std::string mpirun(int ranks) {
+  return std::string("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 ") + CONTACTROM_MPIEXEC +
+         " --oversubscribe -np " + std::to_string(ranks) + " ";
+}
+
+/// A temporary folder for this test run, removed when the program ends.
+struct WorkDir {
+  std::string path = contactrom::test::temp_dir();
+  ~WorkDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+const std::string& work_dir() {
+  static const WorkDir dir;
+  return dir.path;
+}
+
+bool bitwise_equal(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0;
+}
+
+/// Lines of `text` that carry a contactrom message (mpirun adds its own summary).
+int contactrom_lines(const std::string& text) {
+  int n = 0;
+  for (size_t pos = 0; (pos = text.find("contactrom: ", pos)) != std::string::npos; ++pos) ++n;
+  return n;
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(mpi_offline_is_bit_identical_to_serial) {
+  const std::string serial = work_dir() + "/serial.h5";
+  auto r = run_command(exe + " offline --problem hertz --train 13 --threads 1 --out " + serial);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  const SnapshotDatabase a = read_database(serial);
+  for (int ranks : {2, 3}) {
+    const std::string path = work_dir() + "/mpi" + std::to_string(ranks) + ".h5";
+    r = run_command(mpirun(ranks) + exe + " offline --problem hertz --train 13 --threads 1 --json --out " + path);
+    BOOST_TEST_CONTEXT(ranks << " ranks") {
+      BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+      BOOST_TEST(std::count(r.out.begin(), r.out.end(), '\n') == 1);  // one JSON object, from rank 0
+      BOOST_TEST(r.out.find("\"ranks\":" + std::to_string(ranks)) != std::string::npos, r.out);
+      const SnapshotDatabase b = read_database(path);
+      BOOST_TEST(b.problem == a.problem);
+      BOOST_TEST(b.mesh_fingerprint == a.mesh_fingerprint);
+      BOOST_TEST(b.training_kind == a.training_kind);
+      BOOST_TEST(b.training_size == a.training_size);
+      BOOST_TEST(b.param_names == a.param_names);
+      BOOST_TEST(bitwise_equal(b.parameters, a.parameters));
+      BOOST_TEST(bitwise_equal(b.primal, a.primal));
+      BOOST_TEST(bitwise_equal(b.dual, a.dual));
+      BOOST_TEST(b.status == a.status);
+      BOOST_TEST(b.iterations == a.iterations);
+      BOOST_TEST(b.pairing_iterations == a.pairing_iterations);
+      BOOST_TEST(b.threads == ranks);
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(mpi_offline_bad_argument_fails_on_every_rank_with_one_message) {
+  const std::string db = work_dir() + "/bad.h5";
+  for (const std::string args : {"--problem cylinder --train 3", "--problem hertz --train 0", "--problem hertz"}) {
+    const auto r = run_command(mpirun(2) + exe + " offline " + args + " --out " + db);
+    BOOST_TEST_CONTEXT(args) {
+      BOOST_TEST(r.exit_code != 0);
+      BOOST_TEST(contactrom_lines(r.err) == 1, r.err);
+      BOOST_TEST(!fs::exists(db));
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(mpi_offline_unwritable_target_fails_with_one_message_and_no_file) {
+  const std::string target = work_dir() + "/no/such/dir/x.h5";
+  const auto r = run_command(mpirun(2) + exe + " offline --problem hertz --train 3 --threads 1 --out " + target);
+  BOOST_TEST(r.exit_code != 0);
+  BOOST_TEST(contactrom_lines(r.err) == 1, r.err);
+  BOOST_TEST(r.err.find("no/such/dir/x.h5") != std::string::npos, r.err);
+  BOOST_TEST(!fs::exists(target));
+}
