@@ -13,8 +13,18 @@ namespace contactrom::baselines {
 
 ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options) {
   // The greedy's translation validates the shared fields; reuse it, not a copy.
-  const rom::GreedyOptions g = rom::greedy_options(options);
+  rom::OnlineSolverOptions shared = options;
+  shared.extra.erase("init");  // read below: the baselines know fewer starting points
+  const rom::GreedyOptions g = rom::greedy_options(shared);
   ReducedActiveSetOptions o;
+  if (const auto it = options.extra.find("init"); it != options.extra.end()) {
+    if (it->second == "empty")
+      o.init = rom::WarmStart::Empty;
+    else if (it->second == "primal")
+      o.init = rom::WarmStart::Primal;
+    else
+      throw InputError("option init = '" + it->second + "' unknown; expected empty or primal");
+  }
   o.tau = g.tau;
   o.tau_scaling = g.tau_scaling;
   o.max_iterations = g.max_iterations;
@@ -34,6 +44,8 @@ ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOption
 ReducedActiveSet::ReducedActiveSet(std::string name, const rom::ReducedModel& model, std::vector<int> dual_columns,
                                    const Options& options)
     : m_name(std::move(name)), m_model(model), m_columns(std::move(dual_columns)), m_options(options) {
+  if (options.init != rom::WarmStart::Empty && options.init != rom::WarmStart::Primal)
+    throw InputError(m_name + ": init must be empty or primal (the active set follows from the violation)");
   const int m = model.dictionary_size();
   std::vector<char> seen(m, 0);
   for (int p : m_columns) {
@@ -85,7 +97,12 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   const Eigen::VectorXd u_free = k_inv.solve(f_hat);
 
   const rom::RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
-  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, u_s, v, violation, rhs;
+  // Starting point: u_free (paper), or the interpolated reduced coordinates of the
+  // training snapshots around μ (init = primal); the first active set is then the
+  // set of columns violated there.
+  Eigen::VectorXd u_hat, u_prev, lambda_i, u_s, v, violation, rhs;
+  std::vector<int> unused;
+  rom::warm_start_point(m_model, m_options.init, mu, u_free, unused, u_hat);
   rom::RowMajorMatrix c_hat_i;
   Eigen::MatrixXd z, schur;
   rom::SupportOperators ops;  // pairing, C_R and g_R at the current û
@@ -93,7 +110,7 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   std::vector<char> in_active(mw, 0);
   rom::NnlsQp nnls(m_options.nnls);
   const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
-  bool small_step = true;  // û = u_free is exact for I = ∅
+  bool small_step = m_options.init == rom::WarmStart::Empty;  // û = u_free is exact for I = ∅
   rom::OperatorClock operators(m_options.time_operators);
 
   for (int k = 0;; ++k) {

@@ -16,7 +16,9 @@
 ///     \begin{bmatrix} \hat u \\ \hat\lambda_I \end{bmatrix} =
 ///     \begin{bmatrix} \hat f \\ \hat g_I \end{bmatrix}. \f]
 /// The loop (Hintermüller–Ito–Kunisch primal–dual active set, as in Benaceur, Ern,
-/// Ehrlacher 2020) reads, starting from I = ∅ and the unconstrained û = K̂⁻¹f̂:
+/// Ehrlacher 2020) reads, starting from I = ∅ and the unconstrained û = K̂⁻¹f̂ (or,
+/// with ReducedActiveSetOptions::init = Primal, from the interpolated reduced
+/// coordinates of the training snapshots around μ):
 ///  1. rebuild the contact operators at the current û from the surface rows only,
 ///     exactly as rom::GreedyActiveSet does (pairing = search(Φ_s û + u_lift,s),
 ///     C_s, g = assemble(pairing)), and evaluate the reduced violation of every
@@ -90,11 +92,16 @@ struct ReducedActiveSetOptions {
   /// Measure OnlineResult::operator_time_s (see rom::OnlineSolverOptions::time_operators).
   /// Default false.
   bool time_operators = false;
+  /// Starting point: rom::WarmStart::Empty (default; û = K̂⁻¹f̂, as the paper ran the
+  /// baselines) or rom::WarmStart::Primal (û interpolated from the training snapshots
+  /// around μ; the first active set is the set of columns violated there).
+  rom::WarmStart init = rom::WarmStart::Empty;
 };
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
-/// step_tolerance, time_operators; validated as for the greedy) and `extra["inner_solve"]`
-/// ("nonnegative" or "equality"). \throws InputError on bad values.
+/// step_tolerance, time_operators; validated as for the greedy), `extra["inner_solve"]`
+/// ("nonnegative" or "equality") and `extra["init"]` ("empty" or "primal").
+/// \throws InputError on bad values.
 ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options);
 
 /// \brief Primal–dual active-set online solver with dual basis W = D_d[:, columns];
