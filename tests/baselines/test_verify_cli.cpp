@@ -147,11 +147,14 @@ BOOST_AUTO_TEST_CASE(bench_reports_every_method_and_consistent_ratios) {
   // (no assertion on the times themselves: they are benchmarks, not tests).
   const json j = run_json("bench --problem rope --repeats 1 --queries 3 --ipopt-queries 1");
   for (const char* k : {"fom_active_set", "fom_ipopt", "rom_greedy", "rom_greedy_nested", "rom_cpg",
-                        "rom_full_dictionary", "rom_convex_hull"})
+                        "rom_full_dictionary", "rom_convex_hull", "rom_cpg_warm", "rom_greedy_init_empty",
+                        "rom_greedy_nested_init_empty"})
     BOOST_TEST((j.contains(k) && j[k].get<double>() > 0.0), k);
   const json& ratios = j["ratios"];
   for (const char* k : {"fom_active_set/rom_greedy", "fom_active_set/rom_greedy_nested", "rom_cpg/rom_greedy",
                         "rom_cpg/rom_greedy_nested", "rom_greedy_nested/rom_greedy", "fom_ipopt/fom_active_set",
+                        "rom_cpg_warm/rom_greedy", "rom_greedy_init_empty/rom_greedy",
+                        "rom_greedy_nested_init_empty/rom_greedy_nested", "fom_active_set/rom_cpg_warm",
                         "rom_cpg_without_operators/rom_greedy_without_operators",
                         "rom_full_dictionary_without_operators/rom_greedy_nested_without_operators"})
     BOOST_TEST(ratios.contains(k), k);
