@@ -361,7 +361,8 @@ BOOST_AUTO_TEST_CASE(warm_start_reaches_the_fixed_points_of_the_empty_start) {
   // empty set (same schedule):
   //  - where the selections are equal, both runs are fixed points of the same
   //    reduced system reached from different sides, so they agree to the step
-  //    tolerance (1e-5, relative), not to rounding: û within 1e-4 relatively;
+  //    tolerance, not to rounding: û within the step tolerance (1e-5) relatively
+  //    (measured: 1.6e-6 at worst for init=cell, interleaved);
   //  - where the warm start ends on a different sparse solution (the sparse
   //    representation is not unique: e.g. the two bracketing columns where Alg. 1
   //    picked one column and a farther one), it is held to the reduced KKT
@@ -392,7 +393,7 @@ BOOST_AUTO_TEST_CASE(warm_start_reaches_the_fixed_points_of_the_empty_start) {
           std::sort(sb.begin(), sb.end());
           if (sa == sb) {
             ++equal;
-            BOOST_TEST((b.u_hat - a.u_hat).norm() <= 1e-4 * a.u_hat.norm(), "d = " << mu(0));
+            BOOST_TEST((b.u_hat - a.u_hat).norm() <= 1e-5 * a.u_hat.norm(), "d = " << mu(0));
           } else {
             BOOST_TEST(b.coefficients.minCoeff() >= 0.0, "d = " << mu(0));
             BOOST_TEST(own_pairing_violation(model, b.u) <= warm.threshold() + 1e-10, "d = " << mu(0));
