@@ -13,8 +13,20 @@ namespace contactrom::baselines {
 
 ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options) {
   // The greedy's translation validates the shared fields; reuse it, not a copy.
-  const rom::GreedyOptions g = rom::greedy_options(options);
+  rom::OnlineSolverOptions shared = options;
+  shared.extra.erase("init");  // read below: the baselines know fewer starting points
+  const rom::GreedyOptions g = rom::greedy_options(shared);
   ReducedActiveSetOptions o;
+  if (const auto it = options.extra.find("init"); it != options.extra.end()) {
+    if (it->second == "empty")
+      o.init = rom::WarmStart::Empty;
+    else if (it->second == "primal")
+      o.init = rom::WarmStart::Primal;
+    else if (it->second == "cell")
+      o.init = rom::WarmStart::Cell;
+    else
+      throw InputError("option init = '" + it->second + "' unknown; expected empty, primal or cell");
+  }
   o.tau = g.tau;
   o.tau_scaling = g.tau_scaling;
   o.max_iterations = g.max_iterations;
@@ -34,6 +46,8 @@ ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOption
 ReducedActiveSet::ReducedActiveSet(std::string name, const rom::ReducedModel& model, std::vector<int> dual_columns,
                                    const Options& options)
     : m_name(std::move(name)), m_model(model), m_columns(std::move(dual_columns)), m_options(options) {
+  if (options.init == rom::WarmStart::Nearest)
+    throw InputError(m_name + ": init must be empty, primal or cell");
   const int m = model.dictionary_size();
   std::vector<char> seen(m, 0);
   for (int p : m_columns) {
@@ -55,9 +69,24 @@ ReducedActiveSet::ReducedActiveSet(std::string name, const rom::ReducedModel& mo
   g.tau = options.tau;
   g.tau_scaling = options.tau_scaling;
   m_threshold = rom::greedy_threshold(model, g);
+  if (options.init == rom::WarmStart::Cell) {
+    // Offline: this method's own (cold) solution at every training parameter, the
+    // starting points of init = cell.
+    std::vector<int> position(static_cast<size_t>(m), -1);
+    for (size_t i = 0; i < m_columns.size(); ++i) position[static_cast<size_t>(m_columns[i])] = static_cast<int>(i);
+    m_starts.resize(static_cast<size_t>(m));
+    for (int c = 0; c < m; ++c) {
+      const rom::OnlineResult res = solve_from(model.dictionary_parameters()[static_cast<size_t>(c)], rom::WarmStart::Empty);
+      Start& t = m_starts[static_cast<size_t>(c)];
+      t.u_hat = res.u_hat;
+      for (int p : res.selected) t.active.push_back(position[static_cast<size_t>(p)]);
+    }
+  }
 }
 
-rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
+rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const { return solve_from(mu, m_options.init); }
+
+rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmStart init) const {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   const fom::Problem& problem = m_model.problem();
@@ -85,7 +114,26 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   const Eigen::VectorXd u_free = k_inv.solve(f_hat);
 
   const rom::RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
-  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, u_s, v, violation, rhs;
+  // Starting point: u_free (paper); the interpolated reduced coordinates of the
+  // training snapshots around μ (init = primal), the first active set then being the
+  // set of columns violated there; or (init = cell) this method's own solutions at
+  // those training parameters: their interpolated û and the union of their active sets.
+  Eigen::VectorXd u_hat, u_prev, lambda_i, u_s, v, violation, rhs;
+  std::vector<int> start;  // positions in W
+  if (init == rom::WarmStart::Cell && !m_starts.empty()) {
+    u_hat.setZero(r);
+    for (const auto& s : m_model.interpolation_stencil(mu)) {
+      const Start& t = m_starts[static_cast<size_t>(s.column)];
+      u_hat.noalias() += s.weight * t.u_hat;
+      start.insert(start.end(), t.active.begin(), t.active.end());
+    }
+    std::sort(start.begin(), start.end());
+    start.erase(std::unique(start.begin(), start.end()), start.end());
+  } else {
+    std::vector<int> unused;
+    rom::warm_start_point(m_model, init == rom::WarmStart::Primal ? init : rom::WarmStart::Empty, mu, u_free,
+                          unused, u_hat);
+  }
   rom::RowMajorMatrix c_hat_i;
   Eigen::MatrixXd z, schur;
   rom::SupportOperators ops;  // pairing, C_R and g_R at the current û
@@ -93,7 +141,7 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
   std::vector<char> in_active(mw, 0);
   rom::NnlsQp nnls(m_options.nnls);
   const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
-  bool small_step = true;  // û = u_free is exact for I = ∅
+  bool small_step = init == rom::WarmStart::Empty;  // û = u_free is exact for I = ∅
   rom::OperatorClock operators(m_options.time_operators);
 
   for (int k = 0;; ++k) {
@@ -110,13 +158,15 @@ rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const {
     //    violated column. With the non-negative inner solve a zero multiplier on a
     //    still-violated column keeps it (dropping and re-adding it would cycle).
     next.clear();
+    if (k == 0) next = start;  // the warm start's set (empty otherwise)
     for (size_t i = 0; i < active.size(); ++i) {
       const double l = lambda_i(static_cast<Eigen::Index>(i));
       const bool keep = nonnegative ? (l > 0.0 || violation(active[i]) > m_threshold) : l >= 0.0;
       if (keep) next.push_back(active[i]);
     }
-    for (int p = 0; p < mw; ++p)
-      if (!in_active[p] && violation(p) > m_threshold) next.push_back(p);
+    if (k > 0 || start.empty())
+      for (int p = 0; p < mw; ++p)
+        if (!in_active[p] && violation(p) > m_threshold) next.push_back(p);
     const bool changed = next != active;
     const double worst = mw ? violation.maxCoeff() : -std::numeric_limits<double>::infinity();
 

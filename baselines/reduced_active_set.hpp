@@ -16,7 +16,8 @@
 ///     \begin{bmatrix} \hat u \\ \hat\lambda_I \end{bmatrix} =
 ///     \begin{bmatrix} \hat f \\ \hat g_I \end{bmatrix}. \f]
 /// The loop (Hintermüller–Ito–Kunisch primal–dual active set, as in Benaceur, Ern,
-/// Ehrlacher 2020) reads, starting from I = ∅ and the unconstrained û = K̂⁻¹f̂:
+/// Ehrlacher 2020) reads, starting from I = ∅ and the unconstrained û = K̂⁻¹f̂ (or
+/// from a warm start, ReducedActiveSetOptions::init):
 ///  1. rebuild the contact operators at the current û from the surface rows only,
 ///     exactly as rom::GreedyActiveSet does (pairing = search(Φ_s û + u_lift,s),
 ///     C_s, g = assemble(pairing)), and evaluate the reduced violation of every
@@ -90,11 +91,19 @@ struct ReducedActiveSetOptions {
   /// Measure OnlineResult::operator_time_s (see rom::OnlineSolverOptions::time_operators).
   /// Default false.
   bool time_operators = false;
+  /// Starting point: rom::WarmStart::Empty (default; û = K̂⁻¹f̂, as the paper ran the
+  /// baselines); rom::WarmStart::Primal (û interpolated from the training snapshots
+  /// around μ; the first active set is the set of columns violated there); or
+  /// rom::WarmStart::Cell (the method's own solutions at the training parameters
+  /// around μ, computed once in the constructor: their interpolated û and the union of
+  /// their active sets). Nearest is refused.
+  rom::WarmStart init = rom::WarmStart::Empty;
 };
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
-/// step_tolerance, time_operators; validated as for the greedy) and `extra["inner_solve"]`
-/// ("nonnegative" or "equality"). \throws InputError on bad values.
+/// step_tolerance, time_operators; validated as for the greedy), `extra["inner_solve"]`
+/// ("nonnegative" or "equality") and `extra["init"]` ("empty", "primal" or "cell").
+/// \throws InputError on bad values.
 ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options);
 
 /// \brief Primal–dual active-set online solver with dual basis W = D_d[:, columns];
@@ -131,6 +140,14 @@ class ReducedActiveSet : public rom::OnlineSolver {
   rom::SupportRows m_support;  // contact rows where W is not zero, W on them
   Options m_options;
   double m_threshold = 0.0;
+  /// Per dictionary column (training parameter): the cold solution's û and active
+  /// set (positions in W), for init = cell; empty otherwise.
+  struct Start {
+    Eigen::VectorXd u_hat;
+    std::vector<int> active;
+  };
+  std::vector<Start> m_starts;
+  rom::OnlineResult solve_from(const fom::Param& mu, rom::WarmStart init) const;
 };
 
 /// \brief Reduced-level penetration \f$ \max_p D_d[:,p]^T (C(u)\,u - g(u)) \f$ over the

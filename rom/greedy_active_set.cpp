@@ -44,6 +44,37 @@ int most_violated(const Eigen::VectorXd& violation, const std::vector<char>& in_
 
 }  // namespace
 
+WarmStart parse_warm_start(const std::string& method, const std::string& text) {
+  if (text == "empty") return WarmStart::Empty;
+  if (text == "cell") return WarmStart::Cell;
+  if (text == "nearest") return WarmStart::Nearest;
+  if (text == "primal") return WarmStart::Primal;
+  throw InputError(method + " option init = '" + text + "' unknown; expected empty, cell, nearest or primal");
+}
+
+void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Param& mu,
+                      const Eigen::VectorXd& u_free, std::vector<int>& columns, Eigen::VectorXd& u_hat) {
+  columns.clear();
+  if (init == WarmStart::Empty || model.dictionary_size() == 0) {
+    u_hat = u_free;
+    return;
+  }
+  std::vector<ReducedModel::StencilPoint> stencil = model.interpolation_stencil(mu);
+  if (init == WarmStart::Nearest) {
+    const auto heaviest = std::max_element(stencil.begin(), stencil.end(), [](const auto& a, const auto& b) {
+      return a.weight < b.weight;
+    });
+    stencil = {{heaviest->column, 1.0}};
+  }
+  // (A quadratic stencil for û, tried on hertz 30, needed more pairing updates on
+  // average: the solutions are not smooth in μ where nodes enter contact.)
+  if (init != WarmStart::Primal)
+    for (const auto& s : stencil) columns.push_back(s.column);
+  const Eigen::MatrixXd& coords = model.snapshot_coordinates();
+  u_hat.setZero(model.primal_rank());
+  for (const auto& s : stencil) u_hat.noalias() += s.weight * coords.col(s.column);
+}
+
 GreedyOptions greedy_options(const OnlineSolverOptions& options) {
   GreedyOptions g;
   g.tau = options.tau;
@@ -72,6 +103,8 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
       g.anderson_depth = greedy_int_option(key, value, 0);
     } else if (key == "max_solves") {
       g.max_solves = greedy_int_option(key, value, 1);
+    } else if (key == "init") {
+      g.init = parse_warm_start("greedy", value);
     }
   }
   return g;
@@ -101,6 +134,8 @@ struct GreedyActiveSet::Query {
   OperatorClock operators;  // time spent building the contact operators (optional)
   Eigen::VectorXd lift_s;  // surface lifting u_off,s(μ)
   Eigen::VectorXd u_free;  // unconstrained reduced solution K̂⁻¹ f̂
+  Eigen::VectorXd u_start;  // starting û (GreedyOptions::init)
+  std::vector<int> start_columns;  // starting selection
   // Outcome, filled by the schedule: final û, the selection and its multipliers.
   Eigen::VectorXd u_hat, lambda_i;
   std::vector<int> selected;
@@ -157,6 +192,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   }
   q.lift_s = m_model.surface_lifting(mu);
   q.u_free = q.k_inv.solve(m_model.reduced_rhs(mu));
+  warm_start_point(m_model, m_options.init, mu, q.u_free, q.start_columns, q.u_start);
 
   if (m_options.schedule == GreedySchedule::Nested)
     solve_nested(q, res);
@@ -210,13 +246,14 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
   const int r = m_model.primal_rank(), m = m_model.dictionary_size();
   const Eigen::VectorXd &u_free = q.u_free, &lift_s = q.lift_s;
 
-  Eigen::VectorXd u_hat = u_free, u_prev, lambda_i, v, violation, rhs;
+  Eigen::VectorXd u_hat = q.u_start, u_prev, lambda_i, v, violation, rhs;
   // Ĉ_I, K̂⁻¹Ĉ_Iᵀ and S in storage that only grows: the leading |I| rows/columns are used.
   RowMajorMatrix c_hat_i;
   Eigen::MatrixXd w, schur;
   SupportOperators ops;  // pairing, C_R and g_R at the previous iterate
-  std::vector<int> active, solved;
+  std::vector<int> active = q.start_columns, solved;
   std::vector<char> in_active(m, 0);
+  for (int p : active) in_active[p] = 1;
   // Surface displacement of the current iterate, u_s = Φ_s û + u_off,s: the only
   // place the primal enters the contact operators.
   Eigen::VectorXd u_s = phi_s * u_hat + lift_s;
@@ -341,7 +378,7 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
   RowMajorMatrix a;  // A = C_R Φ_s (|R| × r)
   Eigen::VectorXd b;       // C_R u_off,s − g_R: A û + b is the gap on R
   Eigen::VectorXd v_free;  // every column's violation at u_free, D_Rᵀ (A u_free + b)
-  Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x = u_free, u_hat = u_free;
+  Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x = q.u_start, u_hat = q.u_start;
   Eigen::MatrixXd schur;
   SupportOperators ops;  // pairing, C_R and g_R at the rebuild point x
   Eigen::VectorXd u_s;
@@ -349,6 +386,11 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
   std::vector<int> solved, key;
   std::vector<int> seen, seen_start;  // selections met on the current operators, one after the other
   fom::AndersonMixer mixer(m_options.anderson_depth);
+  for (int p : q.start_columns) {  // filled by make_column once the operators exist
+    in_active[p] = 1;
+    cols.emplace_back();
+    cols.back().p = p;
+  }
 
   // Fills `col` for dictionary column p on the current operators (its vectors keep
   // their storage from one rebuild to the next).

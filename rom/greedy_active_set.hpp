@@ -5,7 +5,9 @@
 ///
 /// Unknowns: reduced displacement û (u = Φû + u_lift(μ)) and sparse dictionary
 /// coefficients λ̂_I (λ = D_d[:, I] λ̂_I). Starting from I = ∅ and the
-/// unconstrained û = K̂⁻¹ f̂, each iteration k:
+/// unconstrained û = K̂⁻¹ f̂ (GreedyOptions::init = WarmStart::Empty, the paper's
+/// Alg. 1) — or, by default, from the columns of the training parameters around μ
+/// and their interpolated reduced coordinates (WarmStart) — each iteration k:
 ///  1. rebuilds the contact operators at the previous iterate from the surface
 ///     rows only: \f$ u_s = \Phi_s \hat u^{k-1} + u_{lift,s} \f$, pairing =
 ///     search(u_s), (C_s, g) = assemble(pairing),
@@ -71,6 +73,31 @@ enum class GreedySchedule {
   Nested
 };
 
+/// \brief Where an online active-set iteration starts (see docs/rom.md, "Warm start").
+/// The stencil is ReducedModel::interpolation_stencil(μ): the training parameters
+/// bracketing μ (1D) or the corners of its enclosing grid cell, with multilinear weights.
+enum class WarmStart {
+  /// Paper Alg. 1: no column selected, û = K̂⁻¹ f̂ (the unconstrained solution).
+  Empty,
+  /// The stencil's columns selected, û = Σ w_j û_j (interpolated reduced
+  /// coordinates of their snapshots), operators first built there.
+  Cell,
+  /// The heaviest stencil point alone: its column selected, û = its û_j.
+  Nearest,
+  /// No column selected, û = Σ w_j û_j: a primal guess only (what a primal–dual
+  /// active set such as CPG can use, its first set being the violated columns there).
+  Primal
+};
+
+/// \brief WarmStart from its option text ("empty", "cell", "nearest", "primal").
+/// \throws InputError "<method> option init = '<text>' unknown; expected ..." otherwise.
+WarmStart parse_warm_start(const std::string& method, const std::string& text);
+
+/// \brief The starting point of `init` at μ: the selected dictionary columns (empty
+/// for Empty and Primal) and the reduced displacement (u_free for Empty).
+void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Param& mu,
+                      const Eigen::VectorXd& u_free, std::vector<int>& columns, Eigen::VectorXd& u_hat);
+
 /// \brief Settings of GreedyActiveSet (documented defaults).
 struct GreedyOptions {
   /// Threshold τ; < 0: τ = δ of the reduced model (paper). Default −1.
@@ -90,6 +117,9 @@ struct GreedyOptions {
   /// instead of the last one (which may carry negative multipliers). The result is
   /// still flagged converged = false. Default true.
   bool best_iterate_on_failure = true;
+  /// Starting point of the iteration. Default WarmStart::Cell (measured best, see
+  /// docs/rom.md); WarmStart::Empty is the paper's Alg. 1.
+  WarmStart init = WarmStart::Cell;
   /// Operator-rebuild schedule. Default Interleaved (paper Alg. 1).
   GreedySchedule schedule = GreedySchedule::Interleaved;
   /// Nested schedule: Anderson depth of the rebuild point (0: plain). Default 5.
@@ -149,8 +179,8 @@ Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
 /// step_tolerance, and the extra keys schedule = interleaved|nested, anderson_depth,
-/// max_solves) into GreedyOptions. \throws InputError for an unknown tau_scaling or
-/// schedule, or a malformed number.
+/// max_solves, init = empty|cell|nearest|primal) into GreedyOptions. \throws InputError
+/// for an unknown tau_scaling, schedule or init, or a malformed number.
 GreedyOptions greedy_options(const OnlineSolverOptions& options);
 
 }  // namespace contactrom::rom

@@ -24,12 +24,12 @@ Registry& registry() {
   static Registry* r = [] {
     auto* reg = new Registry;  // never destroyed: registrars may outlive static destruction order
     reg->factories["greedy"] = [](const ReducedModel& model, const OnlineSolverOptions& options) {
-      check_extra_options(options, "greedy", {"schedule", "anderson_depth", "max_solves"});
+      check_extra_options(options, "greedy", {"schedule", "anderson_depth", "max_solves", "init"});
       return std::unique_ptr<OnlineSolver>(std::make_unique<GreedyActiveSet>(model, greedy_options(options)));
     };
     // The same solver with the nested operator-rebuild schedule (GreedySchedule::Nested).
     reg->factories["greedy-nested"] = [](const ReducedModel& model, const OnlineSolverOptions& options) {
-      check_extra_options(options, "greedy-nested", {"anderson_depth", "max_solves"});
+      check_extra_options(options, "greedy-nested", {"anderson_depth", "max_solves", "init"});
       GreedyOptions g = greedy_options(options);
       g.schedule = GreedySchedule::Nested;
       return std::unique_ptr<OnlineSolver>(std::make_unique<GreedyActiveSet>(model, g));

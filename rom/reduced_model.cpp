@@ -1,8 +1,10 @@
 #include "rom/reduced_model.hpp"
 
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "rom/pod.hpp"
 
@@ -88,6 +90,8 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
 
   const std::vector<int>& surf = problem.contact().surface_dofs();
   const int ns = static_cast<int>(surf.size()), r = primal_rank();
+  m_snapshot_coords = m_phi.transpose() * primal;
+  build_parameter_grid();
   m_phi_s.resize(ns, r);
   for (int a = 0; a < ns; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
   m_phi_s_rows = m_phi_s;
@@ -116,6 +120,83 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
     }
   }
   m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void ReducedModel::build_parameter_grid() {
+  const int m = dictionary_size(), d = m > 0 ? static_cast<int>(m_dict_params[0].size()) : 0;
+  m_grid_values.assign(static_cast<size_t>(d), {});
+  for (int k = 0; k < d; ++k) {
+    std::vector<double>& v = m_grid_values[static_cast<size_t>(k)];
+    for (const fom::Param& p : m_dict_params) v.push_back(p(k));
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+  }
+  // A grid far larger than the dictionary is no tensor grid: interpolation_stencil
+  // then falls back to the nearest training parameter.
+  double nodes = 1.0;
+  for (const auto& v : m_grid_values) nodes *= static_cast<double>(v.size());
+  m_grid_columns.clear();
+  if (m == 0 || nodes > 64.0 * m) return;
+  m_grid_columns.assign(static_cast<size_t>(nodes), -1);
+  for (int c = m - 1; c >= 0; --c) {  // the first column wins on duplicates
+    size_t index = 0, stride = 1;
+    for (int k = 0; k < d; ++k) {
+      const auto& v = m_grid_values[static_cast<size_t>(k)];
+      index += stride * static_cast<size_t>(std::lower_bound(v.begin(), v.end(), m_dict_params[c](k)) - v.begin());
+      stride *= v.size();
+    }
+    m_grid_columns[index] = c;
+  }
+}
+
+std::vector<ReducedModel::StencilPoint> ReducedModel::interpolation_stencil(const fom::Param& mu) const {
+  const int m = dictionary_size(), d = static_cast<int>(m_grid_values.size());
+  std::vector<StencilPoint> out;
+  if (m == 0) return out;
+  if (!m_grid_columns.empty() && mu.size() == d) {
+    // Per dimension: lower grid index and the weight t of the upper one.
+    std::vector<size_t> lower(static_cast<size_t>(d));
+    std::vector<double> t(static_cast<size_t>(d));
+    for (int k = 0; k < d; ++k) {
+      const auto& v = m_grid_values[static_cast<size_t>(k)];
+      const double x = std::clamp(mu(k), v.front(), v.back());
+      size_t i = static_cast<size_t>(std::upper_bound(v.begin(), v.end(), x) - v.begin());
+      i = i == 0 ? 0 : i - 1;
+      if (i + 1 >= v.size()) i = v.size() - 1;
+      lower[static_cast<size_t>(k)] = i;
+      t[static_cast<size_t>(k)] = i + 1 < v.size() ? (x - v[i]) / (v[i + 1] - v[i]) : 0.0;
+    }
+    bool complete = true;
+    for (int corner = 0; corner < (1 << d) && complete; ++corner) {
+      double weight = 1.0;
+      size_t index = 0, stride = 1;
+      for (int k = 0; k < d; ++k) {
+        const bool up = (corner >> k) & 1;
+        const double tk = t[static_cast<size_t>(k)];
+        weight *= up ? tk : 1.0 - tk;
+        index += stride * (lower[static_cast<size_t>(k)] + (up ? 1 : 0));
+        stride *= m_grid_values[static_cast<size_t>(k)].size();
+      }
+      if (weight <= 0.0) continue;
+      const int c = index < m_grid_columns.size() ? m_grid_columns[index] : -1;
+      if (c < 0) complete = false;
+      else out.push_back({c, weight});
+    }
+    if (complete && !out.empty()) return out;
+    out.clear();
+  }
+  // Not a tensor grid around μ: the nearest training parameter, distances scaled by
+  // the parameter range.
+  const Eigen::VectorXd range = (m_problem.param_upper() - m_problem.param_lower()).cwiseMax(1e-300);
+  int best = 0;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < m; ++c) {
+    if (m_dict_params[c].size() != mu.size()) continue;
+    const double dist = (m_dict_params[c] - mu).cwiseQuotient(range).squaredNorm();
+    if (dist < best_distance) best_distance = dist, best = c;
+  }
+  out.push_back({best, 1.0});
+  return out;
 }
 
 Eigen::MatrixXd ReducedModel::reduced_stiffness(const fom::Param& mu) const {

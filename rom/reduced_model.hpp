@@ -89,6 +89,24 @@ class ReducedModel {
   /// Primal snapshots u − u_lift of the dictionary columns (n_dofs × m), for methods
   /// that need them (e.g. monolithic dictionaries).
   const Eigen::MatrixXd& primal_snapshots() const { return m_primal; }
+  /// \brief Reduced coordinates of the dictionary columns' primal snapshots,
+  /// \f$ \hat u_p = \Phi^T (u_p - u_{off}(\mu_p)) \f$ (r × m): the best reduced
+  /// approximation of each training solution, used to warm-start the online methods.
+  const Eigen::MatrixXd& snapshot_coordinates() const { return m_snapshot_coords; }
+
+  /// \brief One training parameter of an interpolation stencil and its weight.
+  struct StencilPoint {
+    int column;     ///< dictionary column (index into dictionary_parameters())
+    double weight;  ///< interpolation weight (> 0; the weights of a stencil sum to 1)
+  };
+  /// \brief The training parameters around μ with multilinear interpolation weights:
+  /// the two bracketing training parameters in 1D, the corners of the enclosing cell
+  /// of a tensor grid in several dimensions (a coordinate outside the training range
+  /// is clamped to it; corners of zero weight are left out, so a training parameter
+  /// gets itself alone). When the training parameters do not form a tensor grid
+  /// around μ, the nearest one (distance scaled by the parameter range) with weight 1.
+  /// O(d · log m + 2^d); allocates only the returned vector.
+  std::vector<StencilPoint> interpolation_stencil(const fom::Param& mu) const;
 
   /// Reduced stiffness terms \f$ \Phi^T K_q \Phi \f$ (r × r each).
   const std::vector<Eigen::MatrixXd>& reduced_stiffness_terms() const { return m_k_hat; }
@@ -129,6 +147,12 @@ class ReducedModel {
   Eigen::VectorXd m_sigma;
   std::vector<int> m_dict_snapshots;
   std::vector<fom::Param> m_dict_params;
+  Eigen::MatrixXd m_snapshot_coords;  // Φᵀ primal, r × m
+  // Training parameters as a tensor grid: sorted distinct values per dimension and
+  // the dictionary column at each grid node (−1: none), first dimension fastest.
+  std::vector<std::vector<double>> m_grid_values;
+  std::vector<int> m_grid_columns;
+  void build_parameter_grid();
   std::vector<Eigen::VectorXd> m_offset;  // L̃_k
   std::vector<Eigen::MatrixXd> m_k_hat;   // Φᵀ K_q Φ
   Eigen::MatrixXd m_f_hat;                // column k: Φᵀ f_ext,k

@@ -61,7 +61,7 @@ const rom::OnlineSolverRegistrar full_dictionary_registrar("full-dictionary", ba
 constexpr double kReducedPenetrationSlack = 1e-10;
 
 struct VerifyArgs {
-  std::string db, methods, reference = "ipopt", out, tau_scaling = "absolute", inner_solve;
+  std::string db, methods, reference = "ipopt", out, tau_scaling = "absolute", inner_solve, init;
   double delta = 1e-8, tau = -1.0, cpg_tolerance = -1.0;
   int threads = 0, max_iterations = 50, limit = 0, repeats = 3;
   bool json = false, progress = false, bench = false;
@@ -251,6 +251,9 @@ void run_verify(const VerifyArgs& a) {
     rom::OnlineSolverOptions o = options;
     if (m == "cpg" && a.cpg_tolerance >= 0.0) o.extra["cpg_tolerance"] = format_double(a.cpg_tolerance);
     if ((m == "cpg" || m == "full-dictionary") && !a.inner_solve.empty()) o.extra["inner_solve"] = a.inner_solve;
+    // --init concerns the methods with a warm start; each checks the value itself.
+    if ((m == "greedy" || m == "greedy-nested" || m == "cpg" || m == "full-dictionary") && !a.init.empty())
+      o.extra["init"] = a.init;
     solvers.push_back(rom::make_online_solver(m, model, o));
     solver_options.push_back(o);
   }
@@ -430,6 +433,9 @@ CommandRegistrar reg("verify", [](CLI::App& app) {
   sub->add_option("--inner-solve", args->inner_solve,
                   "cpg/full-dictionary saddle-point solve: nonnegative (default) | equality (textbook PDAS)")
       ->check(CLI::IsMember({"nonnegative", "equality"}));
+  sub->add_option("--init", args->init,
+                  "starting point of greedy/greedy-nested (empty|cell|nearest|primal; default cell) and of "
+                  "cpg/full-dictionary (empty|primal|cell; default empty)");
   sub->add_option("--reference", args->reference, "reference solver: ipopt (default) | fom (custom active set)");
   sub->add_option("--threads", args->threads, "threads for the reference solves (default: hardware concurrency)")
       ->check(CLI::Range(1, 1024));

@@ -310,4 +310,58 @@ BOOST_AUTO_TEST_CASE(hertz_basis_and_online_solver) {
     BOOST_TEST((a.selected == b.selected));
     BOOST_TEST((a.u_hat - b.u_hat).norm() == 0.0);
   }
+
+  // Warm starts: from the interpolated training coordinates (init=primal) or from
+  // CPG's own solutions at the training parameters around μ (init=cell, their û
+  // interpolated and their active sets joined). On every validation query both
+  // converge to the cold start's solution — for a fixed pairing the reduced QP on the
+  // CPG cone has one minimiser, so they agree to a few step tolerances (each stops
+  // when its last solve moved û by ≤ 1e-5; measured up to 2.5e-5 apart: 1e-4) — and
+  // init=cell needs fewer solves than the cold start.
+  for (const char* init : {"primal", "cell"}) {
+    rom::OnlineSolverOptions warm_options;
+    warm_options.extra["init"] = init;
+    const auto warm = rom::make_online_solver("cpg", model, warm_options);
+    double cold_iterations = 0.0, warm_iterations = 0.0;
+    for (const fom::Param& mu : validation) {
+      const rom::OnlineResult a = plain->solve(mu), b = warm->solve(mu);
+      BOOST_TEST_CONTEXT("init " << init << ", d = " << mu(0)) {
+        BOOST_REQUIRE(b.converged);
+        BOOST_TEST(b.coefficients.minCoeff() > 0.0);
+        BOOST_TEST((b.u_hat - a.u_hat).norm() <= 1e-4 * a.u_hat.norm());
+        BOOST_TEST(baselines::reduced_penetration(model, cpg.dual_columns(), b.u) <= cpg.threshold() + 1e-10);
+      }
+      cold_iterations += a.iterations;
+      warm_iterations += b.iterations;
+    }
+    BOOST_TEST_MESSAGE("CPG mean solves: cold " << cold_iterations / validation.size() << ", init=" << init << " "
+                                                << warm_iterations / validation.size());
+    if (std::string(init) == "cell") BOOST_TEST(warm_iterations < cold_iterations);
+  }
+  // At a training parameter init=cell starts from the solution there: one solve
+  // confirms it.
+  {
+    rom::OnlineSolverOptions warm_options;
+    warm_options.extra["init"] = "cell";
+    const auto warm = rom::make_online_solver("cpg", model, warm_options);
+    for (int c = 0; c < model.dictionary_size(); c += 7) {
+      const fom::Param& mu = model.dictionary_parameters()[static_cast<size_t>(c)];
+      const rom::OnlineResult a = plain->solve(mu), b = warm->solve(mu);
+      BOOST_TEST(b.converged);
+      BOOST_TEST(b.iterations <= 2, "column " << c);
+      BOOST_TEST((b.u_hat - a.u_hat).norm() <= 1e-4 * a.u_hat.norm(), "column " << c);
+    }
+  }
+  // init=nearest (a greedy setting) and nonsense are refused.
+  for (const char* bad : {"nearest", "lukewarm"}) {
+    rom::OnlineSolverOptions o;
+    o.extra["init"] = bad;
+    try {
+      rom::make_online_solver("cpg", model, o);
+      BOOST_ERROR("init=" << bad << " accepted");
+    } catch (const InputError& e) {
+      BOOST_TEST(std::string(e.what()).find(std::string("'") + bad + "'") != std::string::npos, e.what());
+      BOOST_TEST(std::string(e.what()).find("expected empty, primal or cell") != std::string::npos, e.what());
+    }
+  }
 }

@@ -148,11 +148,14 @@ BOOST_AUTO_TEST_CASE(bench_reports_every_method_and_consistent_ratios) {
   // (no assertion on the times themselves: they are benchmarks, not tests).
   const json j = run_json("bench --problem rope --repeats 1 --queries 3 --ipopt-queries 1");
   for (const char* k : {"fom_active_set", "fom_ipopt", "rom_greedy", "rom_greedy_nested", "rom_cpg",
-                        "rom_full_dictionary", "rom_convex_hull"})
+                        "rom_full_dictionary", "rom_convex_hull", "rom_cpg_warm", "rom_greedy_init_empty",
+                        "rom_greedy_nested_init_empty"})
     BOOST_TEST((j.contains(k) && j[k].get<double>() > 0.0), k);
   const json& ratios = j["ratios"];
   for (const char* k : {"fom_active_set/rom_greedy", "fom_active_set/rom_greedy_nested", "rom_cpg/rom_greedy",
                         "rom_cpg/rom_greedy_nested", "rom_greedy_nested/rom_greedy", "fom_ipopt/fom_active_set",
+                        "rom_cpg_warm/rom_greedy", "rom_greedy_init_empty/rom_greedy",
+                        "rom_greedy_nested_init_empty/rom_greedy_nested", "fom_active_set/rom_cpg_warm",
                         "rom_cpg_without_operators/rom_greedy_without_operators",
                         "rom_full_dictionary_without_operators/rom_greedy_nested_without_operators"})
     BOOST_TEST(ratios.contains(k), k);
@@ -207,6 +210,21 @@ BOOST_AUTO_TEST_CASE(online_option_reaches_the_method) {
   BOOST_TEST(capped["dual_basis_size"] == 2);
 }
 
+BOOST_AUTO_TEST_CASE(init_option_reaches_the_methods) {
+  // The warm start (default) needs fewer solves than the paper's empty start, for the
+  // greedy through `online --option` and for CPG through `verify --init`.
+  const std::string base = "online --db " + dbs().hertz + " --validation --threads 2 --method ";
+  const json warm = run_json(base + "greedy");
+  const json cold = run_json(base + "greedy --option init=empty");
+  BOOST_TEST(warm["mean_iterations"].get<double>() < cold["mean_iterations"].get<double>());
+  BOOST_TEST(warm["nonconverged"] == 0);
+  const std::string verify = "verify --db " + dbs().hertz + " --method cpg --reference fom --threads 2 --limit 9";
+  const json cpg_cold = run_json(verify);
+  const json cpg_warm = run_json(verify + " --init cell");
+  BOOST_TEST(cpg_warm["methods"]["cpg"]["mean_iterations"].get<double>() <
+             cpg_cold["methods"]["cpg"]["mean_iterations"].get<double>());
+}
+
 BOOST_AUTO_TEST_CASE(bad_input_is_one_line_exit_2_and_no_file) {
   const std::string csv = dbs().dir + "/bad.csv";
   const std::string cases[] = {
@@ -219,6 +237,9 @@ BOOST_AUTO_TEST_CASE(bad_input_is_one_line_exit_2_and_no_file) {
       "online --db " + dbs().hertz + " --method greedy --option foo=1 --out " + csv,
       "online --db " + dbs().hertz + " --method cpg --option cpg_tolerance --out " + csv,
       "online --db " + dbs().hertz + " --method cpg --option cpg_tolerance=x --out " + csv,
+      "online --db " + dbs().hertz + " --method greedy --option init=warm --out " + csv,
+      "online --db " + dbs().hertz + " --method cpg --option init=nearest --out " + csv,
+      "verify --db " + dbs().hertz + " --method greedy-nested --init hot --out " + csv,
   };
   for (const std::string& c : cases) {
     const auto r = run_command(exe + " " + c);
