@@ -52,7 +52,7 @@
 ///
 /// Exact command lines (docs/convex_hull.md):
 /// \code
-///   contactrom offline --problem rope --train 9 --out rope.h5
+///   contactrom offline --problem rope --out rope.h5
 ///   contactrom online --db rope.h5 --method convex-hull --delta 1e-7 --validation
 ///   contactrom hull-report --db rope.h5 --set validation --delta 1e-7 --out rope_val.csv --json
 /// \endcode

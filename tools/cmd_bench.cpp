@@ -1,4 +1,4 @@
-// contactrom bench --problem P [--train N | --level n] [--delta D] [--repeats R] [--json]
+// contactrom bench (--problem P [--train N | --level n] [--refine k] | --db DB.h5) [--delta D] [--repeats R] [--json]
 // Median per-query times of every solver, all measured in the same run so that
 // their ratios are meaningful on a noisy machine:
 //   fom_active_set  custom active-set FOM, factorisation reused (built before timing)
@@ -30,13 +30,15 @@
 #include "rom/offline.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
+#include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"
 
 namespace contactrom::cli {
 namespace {
 
 struct BenchArgs {
-  std::string problem;
+  std::string problem, db;
+  int refine = 0;
   int train = 0, level = 0, repeats = 3, queries = 30, ipopt_queries = 5, threads = 0;
   double delta = 1e-8;
   bool json = false;
@@ -58,8 +60,24 @@ std::string key_of(const std::string& method) {
 void run_bench(const BenchArgs& a) {
   if (a.repeats < 1) throw InputError("--repeats " + std::to_string(a.repeats) + " invalid; expected >= 1");
   if (a.queries < 1) throw InputError("--queries " + std::to_string(a.queries) + " invalid; expected >= 1");
-  auto problem = fom::make_problem(a.problem);
-  const int n = fom::resolve_training_size(problem->definition().training, problem->name(), a.train, a.level, true);
+  // The problem and its snapshots: from --db (no meshing, no offline stage), or
+  // built from --problem with an offline stage of its own.
+  if (a.db.empty() == a.problem.empty()) throw InputError("bench needs exactly one of --problem and --db");
+  rom::SnapshotDatabase db;
+  std::unique_ptr<fom::Problem> problem;
+  double offline_s = 0.0;
+  if (!a.db.empty()) {
+    if (a.train || a.level || a.refine) throw InputError("--train, --level and --refine go with --problem, not --db");
+    db = rom::read_database(a.db);
+    problem = rom::problem_from_database(db, a.db);
+  } else {
+    fom::ProblemOptions popt;
+    popt.refine = a.refine;
+    problem = fom::make_problem(a.problem, popt);
+  }
+  const int n = a.db.empty()
+                    ? fom::resolve_training_size(problem->definition().training, problem->name(), a.train, a.level, true)
+                    : db.training_size;
 
   nlohmann::json j;
   j["problem"] = problem->name();
@@ -73,9 +91,11 @@ void run_bench(const BenchArgs& a) {
   fom::ActiveSetSolver fom_solver(*problem);
   rom::OfflineOptions off;
   off.threads = a.threads;
-  const auto t0 = std::chrono::steady_clock::now();
-  const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, n, off);
-  const double offline_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (a.db.empty()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    db = rom::generate_snapshots(*problem, n, off);
+    offline_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   const std::vector<fom::Param> queries = thin(rom::database_validation_set(db, *problem), a.queries);
   j["queries"] = queries.size();
   j["offline_s"] = offline_s;
@@ -185,9 +205,12 @@ void run_bench(const BenchArgs& a) {
 CommandRegistrar reg("bench", [](CLI::App& app) {
   auto a = std::make_shared<BenchArgs>();
   auto* sub = app.add_subcommand("bench", "Median per-query times of the FOM solvers and every ROM, in one run");
-  sub->add_option("--problem", a->problem, "a shipped problem (contactrom problems) or a problem file path")->required();
-  sub->add_option("--train", a->train, "training size (hertz; default 30)");
-  sub->add_option("--level", a->level, "training level (ironing default 7, ironing2 default 3)");
+  sub->add_option("--problem", a->problem, "a shipped problem (contactrom problems) or a problem file path");
+  sub->add_option("--db", a->db, "a snapshot database instead of --problem (no offline stage)");
+  sub->add_option("--train", a->train, "training size (default: the problem file's [training] default_size; hertz 30)");
+  sub->add_option("--level", a->level, "training level (default: the problem file's default_size; ironing 7, ironing2 3)");
+  sub->add_option("--refine", a->refine, "extra uniform mesh refinements (each splits every quad in four)")
+      ->check(CLI::Range(0, 6));
   sub->add_option("--delta", a->delta, "POD energy tolerance (default 1e-8)");
   sub->add_option("--repeats", a->repeats, "timing passes over the queries (default 3)");
   sub->add_option("--queries", a->queries, "number of validation parameters timed (default 30)");

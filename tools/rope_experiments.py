@@ -10,7 +10,7 @@ The executable is --exe, else $CONTACTROM_EXE, else build/tools/contactrom under
 repository root. Run with /usr/bin/python3 (Debian's matplotlib; see TOOLCHAIN.md).
 
 Writes into RESULTS_DIR:
-    rope.h5                         snapshot database (contactrom offline --train 9)
+    rope.h5                         snapshot database (contactrom offline --problem rope)
     rope_chls.csv, rope_chls.png    leave-one-out CHLS errors vs gamma (contactrom chls)
     rope_hull_{training,validation}[_nopolish].csv
                                     per-query results of contactrom hull-report: errors,
@@ -139,7 +139,7 @@ def main():
     summary = {"delta": a.delta}
 
     db = out("rope.h5")
-    run(a.exe, ["offline", "--problem", "rope", "--train", 9, "--out", db, "--threads", a.threads], commands)
+    run(a.exe, ["offline", "--problem", "rope", "--out", db, "--threads", a.threads], commands)
 
     summary["chls"] = run_json(a.exe, ["chls", "--db", db, "--out", out("rope_chls.csv")], commands)
     plot_chls(read_csv(out("rope_chls.csv")), out("rope_chls.png"))
