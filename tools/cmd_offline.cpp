@@ -51,18 +51,16 @@ struct Ranks {
 /// Writes the database on rank 0; every rank then agrees on the outcome, so that
 /// all of them exit with an error if the write failed.
 void write_on_root(const std::string& path, const rom::SnapshotDatabase& db, const Ranks& ranks) {
-  bool ok = true;
   try {
     if (ranks.root()) rom::write_database(path, db);
   } catch (...) {
-    ok = false;
 #ifdef CONTACTROM_HAVE_MPI
     if (ranks.size > 1) rom::mpi::all_ranks_ok(false);
 #endif
     throw;
   }
 #ifdef CONTACTROM_HAVE_MPI
-  if (ranks.size > 1 && !rom::mpi::all_ranks_ok(ok))
+  if (ranks.size > 1 && !rom::mpi::all_ranks_ok(true))
     throw rom::mpi::RankFailure("rank 0 could not write the database");
 #endif
 }
