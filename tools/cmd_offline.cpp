@@ -1,4 +1,4 @@
-// contactrom offline --problem P (--train N | --level n) --out DB.h5 [--threads T] [--progress] [--json]
+// contactrom offline --problem P (--train N | --level n) --out DB.h5 [--threads T] [--part k/K] [--progress] [--json]
 // Computes the FOM snapshots at the training parameters in parallel (one shared
 // factorisation, no warm start, deterministic) and writes them to an HDF5
 // database (docs/database_format.md). A progress bar is drawn on stderr when it
@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fom/errors.hpp"
+#include "rom/database_merge.hpp"
 #include "rom/offline.hpp"
 #ifdef CONTACTROM_HAVE_MPI
 #include "rom/offline_mpi.hpp"
@@ -29,6 +30,7 @@ namespace {
 struct OfflineArgs {
   std::string problem, out;
   int train = 0, level = 0, threads = 0;
+  std::string part;  // "k/K": only the k-th of K contiguous parts of the training set
   bool progress = false, json = false;
 };
 
@@ -40,6 +42,16 @@ std::string param_text(const fom::Problem& problem, const fom::Param& mu) {
     out += buf;
   }
   return out;
+}
+
+/// The part "k/K" of the training set (rom::part_range), for splitting a run over jobs.
+std::vector<fom::Param> training_part(const std::vector<fom::Param>& params, const std::string& text) {
+  int k = 0, parts = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%d/%d%c", &k, &parts, &tail) != 2)
+    throw InputError("--part '" + text + "' invalid; expected k/K, e.g. 1/4");
+  const auto [begin, end] = rom::part_range(static_cast<int>(params.size()), k, parts);
+  return std::vector<fom::Param>(params.begin() + begin, params.begin() + end);
 }
 
 /// Rank and size of the MPI run this process belongs to ({0, 1} when serial).
@@ -87,7 +99,8 @@ void run_offline(const OfflineArgs& a) {
     n = a.train ? a.train : static_cast<int>(problem->training_set(1).size());
   }
   if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
-  const std::vector<fom::Param> params = problem->training_set(n);
+  std::vector<fom::Param> params = problem->training_set(n);
+  if (!a.part.empty()) params = training_part(params, a.part);
 
   const std::string label =
       "offline " + problem->name() + (ranks.size > 1 ? " (rank 0 of " + std::to_string(ranks.size) + ")" : "");
@@ -154,6 +167,8 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
   sub->add_option("--out", args->out, "output database (.h5)")->required();
   sub->add_option("--threads", args->threads, "worker threads (default: hardware concurrency)")
       ->check(CLI::Range(1, 1024));
+  sub->add_option("--part", args->part,
+                  "k/K: only the k-th of K contiguous parts of the training set (join the parts with merge)");
   sub->add_flag("--progress", args->progress, "draw the progress bar even when stderr is not a terminal");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_offline(*args); });

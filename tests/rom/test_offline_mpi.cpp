@@ -27,9 +27,18 @@ std::string mpirun(int ranks) {
          " --oversubscribe -np " + std::to_string(ranks) + " ";
 }
 
+/// A temporary folder for this test run, removed when the program ends.
+struct WorkDir {
+  std::string path = contactrom::test::temp_dir();
+  ~WorkDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
 const std::string& work_dir() {
-  static const std::string dir = contactrom::test::temp_dir();
-  return dir;
+  static const WorkDir dir;
+  return dir.path;
 }
 
 bool bitwise_equal(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {

@@ -1,0 +1,145 @@
+// Splitting and merging databases (rom/database_merge.hpp, `offline --part`,
+// `merge`): parts cover the training set contiguously and in balance, the merge of
+// the parts equals the whole run bitwise, and incompatible databases are refused.
+#define BOOST_TEST_MODULE rom_database_merge
+#include <boost/test/unit_test.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+
+#include "common/run_command.hpp"
+#include "fom/problem.hpp"
+#include "rom/database_merge.hpp"
+#include "rom/offline.hpp"
+
+namespace fs = std::filesystem;
+using contactrom::InputError;
+using contactrom::rom::merge_databases;
+using contactrom::rom::part_range;
+using contactrom::rom::SnapshotDatabase;
+using contactrom::test::run_command;
+
+namespace {
+
+const std::string exe = CONTACTROM_EXE;
+
+int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+bool bitwise_equal(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0;
+}
+
+void check_same_snapshots(const SnapshotDatabase& a, const SnapshotDatabase& b) {
+  BOOST_TEST(a.problem == b.problem);
+  BOOST_TEST(a.mesh_fingerprint == b.mesh_fingerprint);
+  BOOST_TEST(a.training_kind == b.training_kind);
+  BOOST_TEST(a.training_size == b.training_size);
+  BOOST_TEST(bitwise_equal(a.parameters, b.parameters));
+  BOOST_TEST(bitwise_equal(a.primal, b.primal));
+  BOOST_TEST(bitwise_equal(a.dual, b.dual));
+  BOOST_TEST(a.status == b.status);
+  BOOST_TEST(a.iterations == b.iterations);
+  BOOST_TEST(a.pairing_iterations == b.pairing_iterations);
+}
+
+const contactrom::fom::Problem& hertz() {
+  static auto p = contactrom::fom::make_problem("hertz");
+  return *p;
+}
+
+struct WorkDir {
+  std::string path = contactrom::test::temp_dir();
+  ~WorkDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+const std::string& work_dir() {
+  static const WorkDir dir;
+  return dir.path;
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(parts_are_contiguous_balanced_and_cover_everything) {
+  for (int n : {0, 1, 7, 30, 121})
+    for (int parts : {1, 2, 3, 8}) {
+      int expected_begin = 0;
+      for (int k = 1; k <= parts; ++k) {
+        const auto [begin, end] = part_range(n, k, parts);
+        BOOST_TEST(begin == expected_begin);
+        BOOST_TEST(end - begin >= n / parts);
+        BOOST_TEST(end - begin <= n / parts + 1);
+        expected_begin = end;
+      }
+      BOOST_TEST(expected_begin == n);
+    }
+  BOOST_CHECK_THROW(part_range(10, 0, 2), InputError);
+  BOOST_CHECK_THROW(part_range(10, 3, 2), InputError);
+  BOOST_CHECK_THROW(part_range(10, 1, 0), InputError);
+}
+
+BOOST_AUTO_TEST_CASE(merge_of_the_parts_equals_the_whole) {
+  const auto params = hertz().training_set(7);
+  const SnapshotDatabase whole = contactrom::rom::generate_snapshots(hertz(), params, "train", 7);
+  std::vector<SnapshotDatabase> parts;
+  for (int k = 1; k <= 3; ++k) {
+    const auto [begin, end] = part_range(7, k, 3);
+    parts.push_back(contactrom::rom::generate_snapshots(
+        hertz(), std::vector<contactrom::fom::Param>(params.begin() + begin, params.begin() + end), "train", 7));
+  }
+  check_same_snapshots(merge_databases(parts, {"a", "b", "c"}), whole);
+}
+
+BOOST_AUTO_TEST_CASE(incompatible_databases_and_repeated_parameters_are_refused) {
+  const SnapshotDatabase a = contactrom::rom::generate_snapshots(hertz(), 2);
+  auto refused = [&](const SnapshotDatabase& b, const std::string& what) {
+    try {
+      merge_databases({a, b}, {"a.h5", "b.h5"});
+      BOOST_ERROR(what << " accepted");
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      BOOST_TEST((msg.find("a.h5") != std::string::npos && msg.find("b.h5") != std::string::npos), msg);
+      BOOST_TEST(msg.find(what) != std::string::npos, msg);
+    }
+  };
+  SnapshotDatabase b = a;
+  b.mesh_fingerprint = "00000000deadbeef";
+  refused(b, "fingerprint");
+  b = a;
+  b.training_size = 3;
+  refused(b, "training set");
+  b = a;
+  b.problem = "ironing";
+  refused(b, "problem");
+  BOOST_CHECK_THROW(merge_databases({a, a}, {"a.h5", "a2.h5"}), InputError);  // same parameters twice
+}
+
+BOOST_AUTO_TEST_CASE(cli_offline_parts_merge_into_the_whole_run) {
+  const std::string dir = work_dir();
+  auto r = run_command(exe + " offline --problem hertz --train 9 --threads 1 --out " + dir + "/whole.h5");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  for (int k : {1, 2}) {
+    r = run_command(exe + " offline --problem hertz --train 9 --threads 1 --part " + std::to_string(k) + "/2 --out " +
+                    dir + "/part" + std::to_string(k) + ".h5");
+    BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  }
+  r = run_command(exe + " merge " + dir + "/part1.h5 " + dir + "/part2.h5 --out " + dir + "/merged.h5 --json");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  BOOST_TEST(lines(r.out) == 1);
+  check_same_snapshots(contactrom::rom::read_database(dir + "/merged.h5"),
+                       contactrom::rom::read_database(dir + "/whole.h5"));
+
+  // A part twice: one line, exit code 2, no output file.
+  r = run_command(exe + " merge " + dir + "/part1.h5 " + dir + "/part1.h5 --out " + dir + "/twice.h5");
+  BOOST_TEST(r.exit_code == 2);
+  BOOST_TEST(lines(r.err) == 1, r.err);
+  BOOST_TEST(!fs::exists(dir + "/twice.h5"));
+  r = run_command(exe + " offline --problem hertz --train 9 --part 3/2 --out " + dir + "/bad.h5");
+  BOOST_TEST(r.exit_code == 2);
+  BOOST_TEST(r.err.find("3/2") != std::string::npos, r.err);
+  BOOST_TEST(!fs::exists(dir + "/bad.h5"));
+}
