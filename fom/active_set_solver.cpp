@@ -55,7 +55,7 @@ bool pairing_settled(const ConstraintMatrix& c, const Eigen::VectorXd& g, const 
 
 }  // namespace
 
-bool condense(const Problem& problem, const Param& mu, Condensation& out) {
+bool condense(const Problem& problem, const Param& mu, Condensation& out, const std::vector<int>* order) {
   const std::vector<int>& free = problem.free_dofs();
   const int n = problem.num_dofs(), nf = static_cast<int>(free.size());
   std::vector<int> free_index(n, -1);
@@ -77,7 +77,10 @@ bool condense(const Problem& problem, const Param& mu, Condensation& out) {
     cond.surface_position[j] = last_of_free[f];
   }
   cond.factor = std::make_unique<SparseCholesky>();
-  if (cond.factor->compute(free_block(k, free_index, nf), last).info() != Status::Success) return false;
+  const SparseMatrix kff = free_block(k, free_index, nf);
+  if (order) cond.factor->compute(kff, last, *order);
+  if (!order || cond.factor->info() == Status::InvalidInput) cond.factor->compute(kff, last);  // order of another size
+  if (cond.factor->info() != Status::Success) return false;
   const Eigen::MatrixXd s_free = cond.factor->inverse_block();
   const std::vector<int>& pos = cond.surface_position;
   cond.s = Eigen::MatrixXd::Zero(ns, ns);
@@ -112,8 +115,17 @@ Eigen::VectorXd Condensation::surface_response(const Eigen::VectorXd& surface_fo
 
 ActiveSetSolver::ActiveSetSolver(const Problem& problem, ActiveSetOptions options)
     : m_problem(problem), m_options(options) {
-  if (!problem.stiffness_is_constant()) return;
   const auto t0 = std::chrono::steady_clock::now();
+  if (!problem.stiffness_is_constant()) {
+    // K(μ) changes with μ, its sparsity pattern does not: order the dofs once, here,
+    // and let every query's factorisation reuse the order (it redoes the symbolic
+    // analysis on its own matrix, so the order only affects the cost).
+    Condensation probe;
+    if (condense(problem, 0.5 * (problem.param_lower() + problem.param_upper()), probe))
+      m_order = probe.factor->permutation();
+    m_setup_time = seconds_since(t0);
+    return;
+  }
   m_constant = std::make_unique<Condensation>();
   Param mid = 0.5 * (problem.param_lower() + problem.param_upper());
   m_constant_ok = condense(problem, mid, *m_constant);
@@ -134,7 +146,7 @@ FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) con
   }
   const auto t0 = std::chrono::steady_clock::now();
   Condensation cond;
-  if (!condense(m_problem, mu, cond)) {
+  if (!condense(m_problem, mu, cond, m_order.empty() ? nullptr : &m_order)) {
     FomSolution s;
     s.mu = mu;
     s.status = Status::NumericalIssue;

@@ -77,8 +77,11 @@ struct Condensation {
 };
 
 /// \brief Factorises K(μ) (CHOLMOD) and builds the condensation for `problem`.
+/// \param order elimination order of the free dofs to reuse (SparseCholesky::
+///   permutation() of an earlier condensation of the same problem), or nullptr to
+///   compute a fill-reducing one.
 /// Returns false (and leaves `out` untouched) if the factorisation fails.
-bool condense(const Problem& problem, const Param& mu, Condensation& out);
+bool condense(const Problem& problem, const Param& mu, Condensation& out, const std::vector<int>* order = nullptr);
 
 /// \brief Custom active-set FOM solver; see the file comment.
 class ActiveSetSolver {
@@ -89,7 +92,8 @@ class ActiveSetSolver {
   /// \param warm optional previous solution: its multipliers and pairing seed the iteration.
   FomSolution solve(const Param& mu, const FomSolution* warm = nullptr) const;
 
-  /// Time spent factorising and condensing in the constructor (0 for rope).
+  /// Time spent in the constructor: factorising and condensing when K is constant,
+  /// ordering the dofs for the per-query factorisations otherwise (rope).
   double setup_time() const { return m_setup_time; }
   const Problem& problem() const { return m_problem; }
 
@@ -99,6 +103,7 @@ class ActiveSetSolver {
   const Problem& m_problem;
   ActiveSetOptions m_options;
   std::unique_ptr<Condensation> m_constant;  // set when K does not depend on μ
+  std::vector<int> m_order;  // otherwise: elimination order reused by every query's factorisation
   bool m_constant_ok = true;
   double m_setup_time = 0.0;
 };

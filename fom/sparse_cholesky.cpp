@@ -66,6 +66,16 @@ Eigen::SparseMatrix<double> sub_block(const Eigen::SparseMatrix<double>& a, cons
   return b;
 }
 
+/// Whether `set` holds distinct indices in [0, n).
+bool valid_set(const std::vector<int>& set, int n) {
+  std::vector<char> seen(static_cast<size_t>(n), 0);
+  for (int i : set) {
+    if (i < 0 || i >= n || seen[i]) return false;
+    seen[i] = 1;
+  }
+  return true;
+}
+
 /// Fill-reducing permutation: CHOLMOD's default choice (AMD, or METIS/NESDIS when
 /// AMD fills in badly) for the unknowns not in `last`, then `last` in its order.
 bool ordering_with_last(const Eigen::SparseMatrix<double>& a, const std::vector<int>& last, std::vector<int>& perm) {
@@ -136,18 +146,26 @@ SparseCholesky::SparseCholesky() = default;
 SparseCholesky::~SparseCholesky() = default;
 
 SparseCholesky& SparseCholesky::compute(const Eigen::SparseMatrix<double>& a, const std::vector<int>& last) {
+  std::vector<int> order;
+  if (a.rows() != a.cols() || !valid_set(last, static_cast<int>(a.rows())) || !ordering_with_last(a, last, order)) {
+    m_impl = std::make_unique<Impl>();
+    m_info = Status::InvalidInput;
+    return *this;
+  }
+  return compute(a, last, order);
+}
+
+SparseCholesky& SparseCholesky::compute(const Eigen::SparseMatrix<double>& a, const std::vector<int>& last,
+                                        const std::vector<int>& order) {
   m_impl = std::make_unique<Impl>();
   m_n = static_cast<int>(a.rows());
   m_trailing = 0;
+  m_order.clear();
   m_info = Status::InvalidInput;
-  if (a.rows() != a.cols()) return *this;
-  std::vector<char> seen(m_n, 0);
-  for (int i : last) {
-    if (i < 0 || i >= m_n || seen[i]) return *this;
-    seen[i] = 1;
-  }
-  std::vector<int> perm;
-  if (!ordering_with_last(a, last, perm)) return *this;
+  if (a.rows() != a.cols() || order.size() != static_cast<size_t>(m_n) || !valid_set(order, m_n) ||
+      last.size() > order.size() || !std::equal(last.begin(), last.end(), order.end() - last.size()))
+    return *this;
+  std::vector<int> perm = order;
 
   Eigen::SparseMatrix<double> compressed = a;
   compressed.makeCompressed();
@@ -169,6 +187,7 @@ SparseCholesky& SparseCholesky::compute(const Eigen::SparseMatrix<double>& a, co
     return *this;
   }
   m_impl->extract_l22(m_n);
+  m_order = order;
   m_info = Status::Success;
   return *this;
 }

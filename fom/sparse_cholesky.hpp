@@ -40,6 +40,18 @@ class SparseCholesky {
   ///   InvalidInput if the sizes or indices are inconsistent.
   SparseCholesky& compute(const Eigen::SparseMatrix<double>& a, const std::vector<int>& last);
 
+  /// \brief Same with a given elimination order (e.g. permutation() of an earlier
+  /// factor of a matrix with the same pattern), which skips the ordering step: the
+  /// factor of a parameter-dependent matrix then costs symbolic analysis and
+  /// numeric factorisation only. InvalidInput unless `order` is a permutation of
+  /// 0..n−1 ending with `last`.
+  SparseCholesky& compute(const Eigen::SparseMatrix<double>& a, const std::vector<int>& last,
+                          const std::vector<int>& order);
+
+  /// The elimination order of the last successful compute() (new position k holds
+  /// unknown order[k]); it ends with `last`.
+  const std::vector<int>& permutation() const { return m_order; }
+
   /// Status of the last compute().
   Status info() const { return m_info; }
   /// Number of unknowns n of the factorised matrix.
@@ -67,6 +79,7 @@ class SparseCholesky {
   Status m_info = Status::InvalidInput;
   int m_n = 0;
   int m_trailing = 0;
+  std::vector<int> m_order;
 };
 
 }  // namespace contactrom::fom

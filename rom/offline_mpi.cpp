@@ -50,12 +50,6 @@ bool launched_by_mpi() {
   return false;
 }
 
-int launcher_rank() {
-  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"})
-    if (const char* value = std::getenv(name)) return std::atoi(value);
-  return 0;
-}
-
 Session::Session() {
   int initialised = 0;
   MPI_Initialized(&initialised);
@@ -67,7 +61,28 @@ Session::Session() {
 Session::~Session() {
   int finalised = 0;
   MPI_Finalized(&finalised);
-  if (!finalised) MPI_Finalize();
+  if (finalised) return;
+  MPI_Barrier(MPI_COMM_WORLD);
+  MPI_Finalize();
+}
+
+bool active() {
+  int initialised = 0, finalised = 0;
+  MPI_Initialized(&initialised);
+  MPI_Finalized(&finalised);
+  return initialised && !finalised;
+}
+
+int world_rank() {
+  int rank = 0;
+  if (active()) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  return rank;
+}
+
+int world_size() {
+  int size = 1;
+  if (active()) MPI_Comm_size(MPI_COMM_WORLD, &size);
+  return size;
 }
 
 bool all_ranks_ok(bool ok) {

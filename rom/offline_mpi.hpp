@@ -24,10 +24,11 @@ namespace contactrom::rom::mpi {
 /// the rank in the environment), without initialising MPI.
 bool launched_by_mpi();
 
-/// \brief Rank of this process as the launcher announced it (0 when not launched by MPI).
-int launcher_rank();
-
-/// \brief Scoped MPI session: MPI_Init on construction, MPI_Finalize on destruction.
+/// \brief Scoped MPI session: MPI_Init on construction; on destruction a barrier,
+/// then MPI_Finalize. Create it first thing in main() and let it end after the
+/// error messages are printed: the barrier keeps every rank alive until rank 0 has
+/// reported (a launcher aborts the whole job as soon as one rank exits with an
+/// error, which could otherwise cut rank 0 short).
 class Session {
  public:
   Session();
@@ -40,6 +41,13 @@ class Session {
  private:
   int m_rank = 0, m_size = 1;
 };
+
+/// \brief Whether MPI is initialised and not yet finalised (a Session is alive).
+bool active();
+/// \brief Rank of this process in MPI_COMM_WORLD (0 when MPI is not active).
+int world_rank();
+/// \brief Number of ranks in MPI_COMM_WORLD (1 when MPI is not active).
+int world_size();
 
 /// \brief A failure on some rank, reported on every rank (rank 0 carries the
 /// failing rank's message) so that all ranks stop together.

@@ -79,10 +79,10 @@ void write_on_root(const std::string& path, const rom::SnapshotDatabase& db, con
 
 void run_offline(const OfflineArgs& a) {
 #ifdef CONTACTROM_HAVE_MPI
-  // Under mpirun, the snapshots are distributed over the ranks (rom/offline_mpi.hpp).
-  std::unique_ptr<rom::mpi::Session> session;
-  if (rom::mpi::launched_by_mpi()) session = std::make_unique<rom::mpi::Session>();
-  const Ranks ranks = session ? Ranks{session->rank(), session->size()} : Ranks{};
+  // Under mpirun (main() started MPI), the snapshots are distributed over the ranks
+  // (rom/offline_mpi.hpp).
+  const bool distributed = rom::mpi::active();
+  const Ranks ranks{rom::mpi::world_rank(), rom::mpi::world_size()};
 #else
   const Ranks ranks;
 #endif
@@ -103,8 +103,9 @@ void run_offline(const OfflineArgs& a) {
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
   const std::string kind = plan.selector();
 #ifdef CONTACTROM_HAVE_MPI
-  const rom::SnapshotDatabase db = session ? rom::mpi::generate_snapshots_distributed(*problem, params, kind, n, options)
-                                           : rom::generate_snapshots(*problem, params, kind, n, options);
+  const rom::SnapshotDatabase db = distributed
+                                       ? rom::mpi::generate_snapshots_distributed(*problem, params, kind, n, options)
+                                       : rom::generate_snapshots(*problem, params, kind, n, options);
 #else
   const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, params, kind, n, options);
 #endif

@@ -9,6 +9,7 @@
 // numerical non-convergence is reported in the output with a status instead.
 #include <algorithm>
 #include <iostream>
+#include <memory>
 
 #include "fom/errors.hpp"
 #include "tools/cli.hpp"
@@ -32,9 +33,12 @@ int main(int argc, char** argv) {
   std::sort(table.begin(), table.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   for (auto& entry : table) entry.setup(app);
 #ifdef CONTACTROM_HAVE_MPI
-  // Under mpirun every rank runs this program; only rank 0 reports errors, so a
-  // bad argument gives one message (every rank still exits with the error code).
-  if (rom::mpi::launcher_rank() != 0) std::cerr.setstate(std::ios::badbit);
+  // Under mpirun every rank runs this program (MPI starts before the arguments are
+  // parsed and ends after the error message); only rank 0 reports errors, so a bad
+  // argument gives one message, and every rank exits with the error code.
+  std::unique_ptr<rom::mpi::Session> mpi_session;
+  if (rom::mpi::launched_by_mpi()) mpi_session = std::make_unique<rom::mpi::Session>();
+  if (rom::mpi::world_rank() != 0) std::cerr.setstate(std::ios::badbit);
 #endif
   try {
     app.parse(argc, argv);

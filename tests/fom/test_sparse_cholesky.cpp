@@ -136,3 +136,29 @@ BOOST_AUTO_TEST_CASE(concurrent_solves_agree_with_a_serial_solve) {
   for (auto& th : pool) th.join();
   for (int t = 0; t < threads; ++t) BOOST_TEST((got[t] - expected[t]).norm() == 0.0);
 }
+
+BOOST_AUTO_TEST_CASE(a_reused_order_gives_the_same_factor_for_another_matrix) {
+  // The order of one matrix reused for another of the same pattern gives exactly
+  // the factor a fresh compute() with that order gives, and the right inverse block.
+  const Eigen::SparseMatrix<double> a = grid_matrix(9, 2, 21u), b = grid_matrix(9, 2, 22u);
+  const std::vector<int> last = boundary_set(9, 2, 6u);
+  SparseCholesky first;
+  BOOST_REQUIRE(first.compute(a, last).info() == Status::Success);
+  const std::vector<int>& order = first.permutation();
+  BOOST_REQUIRE(order.size() == static_cast<size_t>(a.rows()));
+  BOOST_TEST(std::equal(last.begin(), last.end(), order.end() - last.size()));
+  SparseCholesky reused;
+  BOOST_REQUIRE(reused.compute(b, last, order).info() == Status::Success);
+  const Eigen::MatrixXd inv = Eigen::MatrixXd(b).inverse();
+  Eigen::MatrixXd expected(last.size(), last.size());
+  for (size_t i = 0; i < last.size(); ++i)
+    for (size_t j = 0; j < last.size(); ++j) expected(i, j) = inv(last[i], last[j]);
+  BOOST_TEST(rel_diff(reused.inverse_block(), expected) <= 1e-12);
+  // An order that does not end with `last`, or is not a permutation, is refused.
+  std::vector<int> shuffled = order;
+  std::swap(shuffled.front(), shuffled.back());
+  BOOST_TEST(SparseCholesky().compute(b, last, shuffled).info() == Status::InvalidInput);
+  std::vector<int> repeated = order;
+  repeated[0] = repeated[1];
+  BOOST_TEST(SparseCholesky().compute(b, last, repeated).info() == Status::InvalidInput);
+}
