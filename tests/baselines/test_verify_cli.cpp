@@ -142,6 +142,19 @@ BOOST_AUTO_TEST_CASE(bench_with_the_fom_reference) {
   BOOST_TEST(j["methods"]["cpg"]["basis_time_s"].get<double>() >= 0.0);
 }
 
+BOOST_AUTO_TEST_CASE(bench_on_a_database_skips_the_offline_stage) {
+  // bench --db rebuilds the problem from the database and times on its snapshots.
+  const json j = run_json("bench --db " + dbs().ironing + " --repeats 1 --queries 2 --ipopt-queries 1");
+  BOOST_TEST(j["problem"] == "ironing");
+  BOOST_TEST(j["training"] == 4);
+  BOOST_TEST(j["snapshots"] == 17);
+  BOOST_TEST(j["offline_s"].get<double>() == 0.0);
+  BOOST_TEST(j["rom_greedy"].get<double>() > 0.0);
+  const auto r = run_command(exe + " bench --db " + dbs().ironing + " --level 4");
+  BOOST_TEST(r.exit_code == 2);
+  BOOST_TEST(r.err.find("--problem, not --db") != std::string::npos, r.err);
+}
+
 BOOST_AUTO_TEST_CASE(bench_reports_every_method_and_consistent_ratios) {
   // `contactrom bench` on rope (tiny): every registered ROM and both FOM solvers are
   // timed in the one run, and every ratio is the quotient of the two medians it names
