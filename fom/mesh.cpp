@@ -334,6 +334,25 @@ Mesh read_current_model(const std::string& where) {
     }
     order_chain(where, g.name, mesh.nodes, mesh.quads, segs, mesh.segments[g.name], mesh.curve_nodes[g.name]);
   }
+  // Physical points: a node group without segments (Dirichlet data on a point).
+  for (const auto& g : physical_groups(0)) {
+    if (mesh.curve_nodes.count(g.name))
+      throw InputError(where + ": the physical point '" + g.name + "' has the name of another group");
+    std::vector<int>& nodes = mesh.curve_nodes[g.name];
+    mesh.segments[g.name];  // no segments
+    for (int entity : g.entities) {
+      std::vector<std::size_t> tags;
+      std::vector<double> coord, param;
+      gmsh::model::mesh::getNodes(tags, coord, param, 0, entity);
+      for (std::size_t t : tags) {
+        auto it = id_of.find(t);
+        if (it == id_of.end())
+          throw InputError(where + ": physical point '" + g.name + "' is not a node of a physical surface");
+        nodes.push_back(it->second);
+      }
+    }
+    if (nodes.empty()) throw InputError(where + ": physical point '" + g.name + "' has no mesh node");
+  }
   return mesh;
 }
 

@@ -87,7 +87,7 @@ class Builder {
     std::vector<int> owner(is_dirichlet.size(), -1);
     for (size_t s = 0; s < m_def.dirichlet.size(); ++s) {
       const DirichletSpec& d = m_def.dirichlet[s];
-      for (int node : group_nodes(d.group, d.where, "physical curve")) {
+      for (int node : group_nodes(d.group, d.where, "physical curve or point")) {
         for (int c = 0; c < 2; ++c) {
           const auto& value = d.displacement[static_cast<size_t>(c)];
           if (!value) continue;
@@ -112,6 +112,8 @@ class Builder {
   void tractions(AffineVectors& fext) const {
     for (const TractionSpec& t : m_def.traction) {
       group_nodes(t.group, t.where, "physical curve");
+      if (m_mesh.group_segments(t.group).empty())
+        throw InputError(m_def.where(t.where) + ": '" + t.group + "' is a physical point; expected a physical curve");
       for (const auto& seg : m_mesh.group_segments(t.group)) {
         const double half = 0.5 * (m_mesh.nodes.col(seg[1]) - m_mesh.nodes.col(seg[0])).norm();
         for (int node : seg)

@@ -315,6 +315,29 @@ Physical Curve("base_bottom", 14) = {8};
   fs::remove_all(dir);
 }
 
+BOOST_AUTO_TEST_CASE(dirichlet_on_a_physical_point) {
+  // hertz with the top body's load face free in x except at one physical point:
+  // the same solution as the file that fixes the whole face in x would not hold,
+  // but the problem must be well posed and the point's x displacement exactly 0.
+  const std::string dir = contactrom::test::temp_dir();
+  std::string geo = read_text(kSource + "/meshes/hertz.geo");
+  geo += "\nPhysical Point(\"top_corner\", 21) = {12};\n";
+  write_temp(dir, "hertz.geo", geo);
+  std::string text = hertz_text();
+  text = std::regex_replace(text, std::regex(kSource + "/meshes/hertz.geo"), "hertz.geo");
+  text = replace_once(text, "displacement = [0.0, \"-d\"]", "displacement = [\"free\", \"-d\"]");
+  text += "\n[[dirichlet]]\ngroup = \"top_corner\"\ndisplacement = [0.0, \"free\"]\n";
+  const auto p = fom::make_problem(write_temp(dir, "point.toml", text));
+  const auto& corner = p->mesh()->group_nodes("top_corner");
+  BOOST_TEST_REQUIRE(corner.size() == 1u);
+  const auto s = solve(*p, fom::Param::Constant(1, 0.1));
+  BOOST_TEST(s.status == Status::Success);
+  BOOST_TEST(s.u(2 * corner[0]) == 0.0);
+  BOOST_TEST(p->is_dirichlet()[2 * corner[0]] == 1);
+  BOOST_TEST(fom::kkt_residuals(*p, fom::Param::Constant(1, 0.1), s.u, s.lambda).stationarity <= 1e-10);
+  fs::remove_all(dir);
+}
+
 BOOST_AUTO_TEST_CASE(database_rebuilds_the_problem_without_its_files) {
   // offline on a copy of the problem file and mesh; delete both; online still runs.
   const std::string dir = contactrom::test::temp_dir();
