@@ -4,6 +4,8 @@
 #include <chrono>
 
 #include "fom/anderson.hpp"
+#include "fom/errors.hpp"
+#include "fom/rigid_bodies.hpp"
 
 namespace contactrom::fom {
 namespace {
@@ -61,7 +63,12 @@ bool condense(const Problem& problem, const Param& mu, Condensation& out) {
   std::vector<int> free_index(n, -1);
   for (int i = 0; i < nf; ++i) free_index[free[i]] = i;
   const SparseMatrix k = problem.stiffness(mu);
-  Eigen::CholmodSupernodalLLT<SparseMatrix> llt(free_block(k, free_index, nf));
+  Eigen::CholmodSupernodalLLT<SparseMatrix> llt;
+  // CHOLMOD prints its warnings on stdout (breaking --json); failure is reported
+  // through info() and explained by the caller instead.
+  llt.cholmod().print = 0;
+  llt.cholmod().error_handler = nullptr;
+  llt.compute(free_block(k, free_index, nf));
   if (llt.info() != Eigen::Success) return false;
 
   const std::vector<int>& surf = problem.contact().surface_dofs();
@@ -95,6 +102,9 @@ ActiveSetSolver::ActiveSetSolver(const Problem& problem, ActiveSetOptions option
   m_constant = std::make_unique<Condensation>();
   Param mid = 0.5 * (problem.param_lower() + problem.param_upper());
   m_constant_ok = condense(problem, mid, *m_constant);
+  // A stiffness that cannot be factorised is a problem definition error (a body
+  // held by nothing), not a numerical accident of one query.
+  if (!m_constant_ok) throw InputError(singular_stiffness_message(problem));
   m_setup_time = seconds_since(t0);
 }
 
@@ -116,7 +126,7 @@ FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) con
     FomSolution s;
     s.mu = mu;
     s.status = Status::NumericalIssue;
-    s.message = "Cholesky factorisation of the stiffness failed (matrix not positive definite)";
+    s.message = singular_stiffness_message(m_problem);
     return s;
   }
   FomSolution s = solve_with(cond, mu, warm);

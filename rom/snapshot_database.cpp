@@ -6,158 +6,54 @@
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <type_traits>
 
 #include "fom/atomic_file.hpp"
+#include "rom/hdf5_io.hpp"
 
 namespace contactrom::rom {
 namespace {
 
 // The HDF5 C API reports failure through negative return values and prints an
-// error stack on stderr by default; we turn the printing off (the user gets our
-// one-line message instead) and translate failures into exceptions.
+// error stack on stderr by default; rom/hdf5_io turns the printing off (the user
+// gets our one-line message instead), checks shapes, types and sizes before
+// reading, and translates failures into exceptions.
+using hdf5::Handle;
+using hdf5::check;
+using hdf5::write_dataset;
+using hdf5::write_scalar_attribute;
+using hdf5::write_string_attribute;
+using hdf5::read_string_attribute;
+using hdf5::has_attribute;
+using Hdf5Failure = hdf5::Failure;
 
-/// Failure inside an HDF5 call sequence; `what()` names the object involved.
-struct Hdf5Failure : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-void silence_hdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
-
-/// Owns one HDF5 identifier and closes it with the matching H5*close.
-class Handle {
- public:
-  using Closer = herr_t (*)(hid_t);
-  Handle(hid_t id, Closer closer, const std::string& what) : m_id(id), m_closer(closer) {
-    if (id < 0) throw Hdf5Failure(what);
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  ~Handle() {
-    if (m_id >= 0) m_closer(m_id);
-  }
-  /// Closes now and reports failure (closing a file flushes it).
-  void close(const std::string& what) {
-    const herr_t rc = m_closer(m_id);
-    m_id = -1;
-    if (rc < 0) throw Hdf5Failure(what);
-  }
-  hid_t id() const { return m_id; }
-
- private:
-  hid_t m_id;
-  Closer m_closer;
-};
-
-void check(herr_t rc, const std::string& what) {
-  if (rc < 0) throw Hdf5Failure(what);
-}
-
-// ---------------------------------------------------------------- writing
-
-void write_string_attribute(hid_t loc, const char* name, const std::string& value) {
-  // Variable-length UTF-8 string: h5py returns it as a Python str.
-  Handle type(H5Tcopy(H5T_C_S1), H5Tclose, std::string("attribute ") + name);
-  check(H5Tset_size(type.id(), H5T_VARIABLE), std::string("attribute ") + name);
-  check(H5Tset_cset(type.id(), H5T_CSET_UTF8), std::string("attribute ") + name);
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose, std::string("attribute ") + name);
-  Handle attr(H5Acreate2(loc, name, type.id(), space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-              std::string("attribute ") + name);
-  const char* data = value.c_str();
-  check(H5Awrite(attr.id(), type.id(), &data), std::string("attribute ") + name);
-}
-
-void write_scalar_attribute(hid_t loc, const char* name, hid_t file_type, hid_t mem_type, const void* value) {
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose, std::string("attribute ") + name);
-  Handle attr(H5Acreate2(loc, name, file_type, space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-              std::string("attribute ") + name);
-  check(H5Awrite(attr.id(), mem_type, value), std::string("attribute ") + name);
-}
-
-/// Writes a dataset of rank 1 (length rows) or rank 2 (rows × cols, row-major).
-void write_dataset(hid_t file, hid_t dcpl, const char* name, hid_t file_type, hid_t mem_type, int rank, hsize_t rows,
-                   hsize_t cols, const void* data) {
-  const std::string what = std::string("dataset /") + name;
-  const hsize_t dims[2] = {rows, cols};
-  Handle space(H5Screate_simple(rank, dims, nullptr), H5Sclose, what);
-  Handle set(H5Dcreate2(file, name, file_type, space.id(), H5P_DEFAULT, dcpl, H5P_DEFAULT), H5Dclose, what);
-  const hsize_t count = rank == 2 ? rows * cols : rows;
-  if (count > 0) check(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), what);
-}
-
-// ---------------------------------------------------------------- reading
-
-std::string read_string_attribute(hid_t loc, const char* name) {
-  const std::string what = std::string("attribute ") + name;
-  Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose, what);
-  Handle type(H5Aget_type(attr.id()), H5Tclose, what);
-  if (H5Tget_class(type.id()) != H5T_STRING) throw Hdf5Failure(what + " is not a string");
-  if (H5Tis_variable_str(type.id()) > 0) {
-    Handle mem(H5Tcopy(H5T_C_S1), H5Tclose, what);
-    check(H5Tset_size(mem.id(), H5T_VARIABLE), what);
-    check(H5Tset_cset(mem.id(), H5Tget_cset(type.id())), what);
-    char* data = nullptr;
-    check(H5Aread(attr.id(), mem.id(), &data), what);
-    std::string out = data ? data : "";
-    H5free_memory(data);
-    return out;
-  }
-  const size_t size = H5Tget_size(type.id());
-  if (size == 0) throw Hdf5Failure(what);
-  std::string buf(size, '\0');
-  check(H5Aread(attr.id(), type.id(), buf.data()), what);
-  const size_t end = buf.find('\0');
-  return end == std::string::npos ? buf : buf.substr(0, end);
-}
-
-template <typename T>
-T read_scalar_attribute(hid_t loc, const char* name, hid_t mem_type) {
-  const std::string what = std::string("attribute ") + name;
-  Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose, what);
-  Handle space(H5Aget_space(attr.id()), H5Sclose, what);
-  if (H5Sget_simple_extent_npoints(space.id()) != 1) throw Hdf5Failure(what + " is not a scalar");
-  T value{};
-  check(H5Aread(attr.id(), mem_type, &value), what);
-  return value;
-}
-
-bool has_attribute(hid_t loc, const char* name) { return H5Aexists(loc, name) > 0; }
-
-/// Reads a dataset of rank 1 or 2 into `out` (resized to its number of
-/// elements); returns its dimensions (cols = 1 for rank 1).
-template <typename T>
-void read_dataset(hid_t file, const char* name, hid_t mem_type, std::vector<T>& out, hsize_t& rows, hsize_t& cols) {
-  const std::string what = std::string("dataset /") + name;
-  Handle set(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, what);
-  Handle space(H5Dget_space(set.id()), H5Sclose, what);
-  const int rank = H5Sget_simple_extent_ndims(space.id());
-  if (rank < 1 || rank > 2) throw Hdf5Failure(what + " has rank " + std::to_string(rank) + ", expected 1 or 2");
-  hsize_t dims[2] = {0, 1};
-  if (H5Sget_simple_extent_dims(space.id(), dims, nullptr) < 0) throw Hdf5Failure(what);
-  rows = dims[0];
-  cols = rank == 2 ? dims[1] : 1;
-  out.assign(static_cast<size_t>(rows * cols), T{});
-  if (!out.empty()) check(H5Dread(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), what);
-}
+void silence_hdf5() { hdf5::silence(); }
 
 /// Reads an n_snap × width dataset into the columns of a width × n_snap matrix.
 Eigen::MatrixXd read_matrix(hid_t file, const char* name, hsize_t expected_rows) {
   std::vector<double> buf;
   hsize_t rows = 0, cols = 0;
-  read_dataset(file, name, H5T_NATIVE_DOUBLE, buf, rows, cols);
-  if (rows != expected_rows)
-    throw Hdf5Failure(std::string("dataset /") + name + " has " + std::to_string(rows) + " rows, expected " +
-                      std::to_string(expected_rows) + " (one per snapshot)");
+  const std::vector<hsize_t> dims = hdf5::dataset_shape(file, name);
+  if (dims[0] != expected_rows || dims.size() != 2)
+    throw Hdf5Failure(std::string("dataset /") + name + " has " + std::to_string(dims[0]) + " rows" +
+                      (dims.size() != 2 ? " and rank 1" : "") + ", expected " + std::to_string(expected_rows) +
+                      " (one per snapshot) and rank 2");
+  hdf5::read_double_dataset(file, name, buf, rows, cols);
   return Eigen::Map<Eigen::MatrixXd>(buf.data(), static_cast<Eigen::Index>(cols), static_cast<Eigen::Index>(rows));
 }
 
 template <typename T>
-std::vector<T> read_vector(hid_t file, const char* name, hid_t mem_type, hsize_t expected) {
+std::vector<T> read_vector(hid_t file, const char* name, hsize_t expected) {
   std::vector<T> out;
   hsize_t rows = 0, cols = 0;
-  read_dataset(file, name, mem_type, out, rows, cols);
-  if (rows != expected || cols != 1)
-    throw Hdf5Failure(std::string("dataset /") + name + " has " + std::to_string(rows * cols) + " entries, expected " +
-                      std::to_string(expected));
+  // Shape first: the size of /status bounds every other dataset before any allocation.
+  const std::vector<hsize_t> dims = hdf5::dataset_shape(file, name);
+  if (dims.size() != 1 || dims[0] != expected)
+    throw Hdf5Failure(std::string("dataset /") + name + " has shape (" + std::to_string(dims[0]) +
+                      (dims.size() == 2 ? ", " + std::to_string(dims[1]) : std::string()) + "), expected (" +
+                      std::to_string(expected) + ")");
+  if constexpr (std::is_same_v<T, int>) hdf5::read_int_dataset(file, name, out, rows, cols);
+  else hdf5::read_double_dataset(file, name, out, rows, cols);
   return out;
 }
 
@@ -233,7 +129,7 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
     write_dataset(f, dcpl.id(), "pairing_iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0,
                   db.pairing_iterations.data());
     write_dataset(f, dcpl.id(), "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, n, 0, db.time_s.data());
-    file.close("file close");
+    hdf5::close_file(file, "file close");
   } catch (const Hdf5Failure& e) {
     std::remove(tmp.c_str());
     throw InputError("cannot write database '" + path + "': HDF5 failed on " + e.what() +
@@ -257,7 +153,7 @@ SnapshotDatabase read_database(const std::string& path) {
     const hid_t f = file.id();
     if (!has_attribute(f, "format_version"))
       throw InputError("database '" + path + "' has no format_version attribute; not a contactrom database");
-    const int version = read_scalar_attribute<int>(f, "format_version", H5T_NATIVE_INT);
+    const int version = hdf5::read_int_attribute(f, "format_version");
     if (version != kDatabaseFormatVersion)
       throw InputError("database '" + path + "' has format_version " + std::to_string(version) +
                        ", but this contactrom reads version " + std::to_string(kDatabaseFormatVersion));
@@ -265,24 +161,24 @@ SnapshotDatabase read_database(const std::string& path) {
     db.mesh_fingerprint = read_string_attribute(f, "mesh_fingerprint");
     db.created_by = read_string_attribute(f, "created_by");
     db.training_kind = read_string_attribute(f, "training_kind");
-    db.training_size = read_scalar_attribute<int>(f, "training_size", H5T_NATIVE_INT);
+    db.training_size = hdf5::read_int_attribute(f, "training_size");
     db.param_names = split(read_string_attribute(f, "param_names"), ',');
     if (has_attribute(f, "setup_time_s"))
-      db.setup_time_s = read_scalar_attribute<double>(f, "setup_time_s", H5T_NATIVE_DOUBLE);
+      db.setup_time_s = hdf5::read_double_attribute(f, "setup_time_s");
     if (has_attribute(f, "wall_time_s"))
-      db.wall_time_s = read_scalar_attribute<double>(f, "wall_time_s", H5T_NATIVE_DOUBLE);
-    if (has_attribute(f, "threads")) db.threads = read_scalar_attribute<int>(f, "threads", H5T_NATIVE_INT);
+      db.wall_time_s = hdf5::read_double_attribute(f, "wall_time_s");
+    if (has_attribute(f, "threads")) db.threads = hdf5::read_int_attribute(f, "threads");
 
     std::vector<int> status;
     hsize_t n = 0, cols = 0;
-    read_dataset(f, "status", H5T_NATIVE_INT, status, n, cols);
-    if (cols != 1) throw Hdf5Failure("dataset /status is not one-dimensional");
+    if (hdf5::dataset_shape(f, "status").size() != 1) throw Hdf5Failure("dataset /status is not one-dimensional");
+    hdf5::read_int_dataset(f, "status", status, n, cols);
     db.parameters = read_matrix(f, "parameters", n);
     db.primal = read_matrix(f, "primal", n);
     db.dual = read_matrix(f, "dual", n);
-    db.iterations = read_vector<int>(f, "iterations", H5T_NATIVE_INT, n);
-    db.pairing_iterations = read_vector<int>(f, "pairing_iterations", H5T_NATIVE_INT, n);
-    db.time_s = read_vector<double>(f, "time_s", H5T_NATIVE_DOUBLE, n);
+    db.iterations = read_vector<int>(f, "iterations", n);
+    db.pairing_iterations = read_vector<int>(f, "pairing_iterations", n);
+    db.time_s = read_vector<double>(f, "time_s", n);
     for (int s : status) {
       if (s < 0 || s > static_cast<int>(Status::InvalidInput))
         throw Hdf5Failure("dataset /status holds the unknown status code " + std::to_string(s));

@@ -96,14 +96,11 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
   auto args = std::make_shared<OfflineArgs>();
   auto* sub = app.add_subcommand("offline", "Compute FOM snapshots at the training parameters into an HDF5 database");
   sub->add_option("--problem", args->problem, "rope | hertz | ironing | ironing2")->required();
-  auto* train = sub->add_option("--train", args->train, "training size N (hertz: d_i = 0.3 i/N)")
-                    ->check(CLI::Range(1, 100000));
-  auto* level = sub->add_option("--level", args->level, "nested training level n (ironing, ironing2)")
-                    ->check(CLI::Range(1, 12));
+  auto* train = add_integer(sub, "--train", args->train, "training size N (hertz: d_i = 0.3 i/N)", 1, 100000);
+  auto* level = add_integer(sub, "--level", args->level, "nested training level n (ironing, ironing2)", 1, 12);
   train->excludes(level);
   sub->add_option("--out", args->out, "output database (.h5)")->required();
-  sub->add_option("--threads", args->threads, "worker threads (default: hardware concurrency)")
-      ->check(CLI::Range(1, 1024));
+  add_integer(sub, "--threads", args->threads, "worker threads (default: hardware concurrency)", 1, 1024);
   sub->add_flag("--progress", args->progress, "draw the progress bar even when stderr is not a terminal");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_offline(*args); });

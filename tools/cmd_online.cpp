@@ -39,7 +39,7 @@ nlohmann::json selected_json(const std::vector<int>& selected) { return selected
 
 void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::ReducedModel& model,
                 const rom::OnlineSolver& solver) {
-  const fom::Param mu = fom::parse_param(problem, a.param);
+  const fom::Param mu = parse_problem_param(problem, a.param);
   const rom::OnlineResult res = solver.solve(mu);
   const fom::ActiveSetSolver fom_solver(problem);
   const fom::FomSolution ref = fom_solver.solve(mu);
@@ -49,10 +49,7 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
   std::vector<int> snapshots;
   for (int c : res.selected) snapshots.push_back(model.dictionary_snapshots()[c]);
   if (!a.out.empty()) {
-    fom::ensure_directory(a.out);
-    const std::string stem = a.out + "/" + problem.name() + "_" + solver.name();
-    fom::write_vtu(stem + ".vtu", problem, res.u, res.lambda);
-    fom::write_surface_csv(stem + "_surface.csv", problem, res.u, res.lambda);
+    fom::write_fields(a.out, problem.name() + "_" + solver.name(), problem, res.u, res.lambda);
   }
   nlohmann::json j;
   j["problem"] = problem.name();
@@ -184,25 +181,21 @@ CommandRegistrar reg("online", [](CLI::App& app) {
   auto* sub = app.add_subcommand("online", "Evaluate a reduced model built from a snapshot database");
   sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
   sub->add_option("--method", args->method, "online method (default greedy; see the error text for all)");
-  sub->add_option("--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--tau", args->tau, "greedy penetration threshold (default: tau = delta)")
-      ->check(CLI::NonNegativeNumber);
+  add_number(sub, "--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
+  add_number(sub, "--tau", args->tau, "greedy penetration threshold (default: tau = delta)", Interval::at_least(0));
   sub->add_option("--tau-scaling", args->tau_scaling, "absolute (default, paper) | relative")
       ->check(CLI::IsMember({"absolute", "relative"}));
   sub->add_option("--lifting", args->lifting,
                   "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet")
       ->check(CLI::IsMember({"harmonic", "dirichlet"}));
-  sub->add_option("--max-iterations", args->max_iterations, "iteration cap k_max (default 50)")
-      ->check(CLI::Range(1, 100000));
+  add_integer(sub, "--max-iterations", args->max_iterations, "iteration cap k_max (default 50)", 1, 100000);
   sub->add_option("--option", args->options,
                   "method setting KEY=VALUE, repeatable: cpg_tolerance, cpg_max_size, inner_solve (cpg); "
                   "inner_solve (full-dictionary); basis, rank_l, seed, ... (convex-hull; see docs/convex_hull.md)");
   sub->add_flag("--validation", args->validation, "evaluate on the validation set (default without --param)");
   sub->add_option("--param", args->param, "one query V or V1,V2");
   sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)");
-  sub->add_option("--threads", args->threads, "threads for the FOM references (default: hardware concurrency)")
-      ->check(CLI::Range(1, 1024));
+  add_integer(sub, "--threads", args->threads, "threads for the FOM references (default: hardware concurrency)", 1, 1024);
   sub->add_flag("--kkt", args->kkt, "also compute the FOM KKT residuals of every ROM solution");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_online(*args); });

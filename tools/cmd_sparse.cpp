@@ -26,6 +26,7 @@
 #include "rom/nnls.hpp"
 #include "rom/omp.hpp"
 #include "tools/cli.hpp"
+#include "tools/cli_common.hpp"
 
 namespace {
 
@@ -171,11 +172,17 @@ const contactrom::cli::CommandRegistrar registrar("sparse", [](CLI::App& app) {
   sub->add_option("--method", args->method, "nnls | omp | focuss | nnfocuss")->required();
   sub->add_option("--dictionary", args->dictionary, "CSV file of D (one row per line)")->required();
   sub->add_option("--signal", args->signal, "CSV file of x (one column or one row)")->required();
-  auto* atoms = sub->add_option("--atoms", args->atoms, "OMP: largest number of atoms (default min(rows, cols))");
-  auto* tol = sub->add_option("--tol", args->tolerance,
-                              "tolerance: NNLS KKT (1e-12), OMP relative residual (1e-8), FOCUSS change (1e-10)");
-  auto* max_iter = sub->add_option("--max-iter", args->max_iterations,
-                                   "iteration cap: NNLS active-set changes (3n), FOCUSS solves (100), OMP atoms");
+  using contactrom::Interval;
+  using contactrom::cli::add_integer;
+  using contactrom::cli::add_number;
+  auto* atoms = add_integer(sub, "--atoms", args->atoms, "OMP: largest number of atoms (default min(rows, cols))", 0,
+                            100000000);
+  auto* tol = add_number(sub, "--tol", args->tolerance,
+                         "tolerance: NNLS KKT (1e-12), OMP relative residual (1e-8), FOCUSS change (1e-10)",
+                         Interval::at_least(0));
+  auto* max_iter = add_integer(sub, "--max-iter", args->max_iterations,
+                               "iteration cap: NNLS active-set changes (3n), FOCUSS solves (100), OMP atoms", 1,
+                               100000000);
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args, atoms, tol, max_iter] {
     run_sparse(*args, tol->count() > 0, max_iter->count() > 0, atoms->count() > 0);

@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "fom/errors.hpp"
+#include "fom/input_values.hpp"
 #include "tools/cli.hpp"
 
 namespace contactrom::cli {
@@ -28,6 +29,17 @@ int main(int argc, char** argv) {
   auto& table = cli::command_table();
   std::sort(table.begin(), table.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   for (auto& entry : table) entry.setup(app);
+  // CLI11 would only say that a subcommand is required; name the unknown one.
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string name = argv[1];
+    const bool known = std::any_of(table.begin(), table.end(), [&](const auto& e) { return e.name == name; });
+    if (!known) {
+      std::string names;
+      for (const auto& e : table) names += (names.empty() ? "" : ", ") + e.name;
+      std::cerr << "contactrom: error: unknown command " << quoted(name) << "; expected one of: " << names << "\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
