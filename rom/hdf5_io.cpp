@@ -1,5 +1,6 @@
 #include "rom/hdf5_io.hpp"
 
+#include <cstdio>
 #include <limits>
 
 namespace contactrom::rom::hdf5 {
@@ -12,7 +13,7 @@ std::string dataset_what(const char* name) { return std::string("dataset /") + n
 hssize_t attribute_elements(hid_t attr, const std::string& what) {
   Handle space(H5Aget_space(attr), H5Sclose, what);
   const hssize_t n = H5Sget_simple_extent_npoints(space.id());
-  if (n < 0) throw Failure(what + " has an unreadable dataspace");
+  if (n < 0) throw Refused(what + " has an unreadable dataspace");
   return n;
 }
 
@@ -22,9 +23,9 @@ T read_numeric_attribute(hid_t loc, const char* name, H5T_class_t cls, hid_t mem
   const std::string what = attribute_what(name);
   Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose, what);
   Handle type(H5Aget_type(attr.id()), H5Tclose, what);
-  if (H5Tget_class(type.id()) != cls) throw Failure(what + " is not " + expected);
+  if (H5Tget_class(type.id()) != cls) throw Refused(what + " is not " + expected);
   const hssize_t n = attribute_elements(attr.id(), what);
-  if (n != 1) throw Failure(what + " has " + std::to_string(n) + " elements, expected a single " + expected);
+  if (n != 1) throw Refused(what + " has " + std::to_string(n) + " elements, expected a single " + expected);
   T value{};
   check(H5Aread(attr.id(), mem_type, &value), what);
   return value;
@@ -38,9 +39,9 @@ void read_numeric_dataset(hid_t file, const char* name, H5T_class_t cls, hid_t m
   const std::string what = dataset_what(name);
   Handle set(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, what);
   Handle type(H5Dget_type(set.id()), H5Tclose, what);
-  if (H5Tget_class(type.id()) != cls) throw Failure(what + " does not hold " + expected);
+  if (H5Tget_class(type.id()) != cls) throw Refused(what + " does not hold " + expected);
   const size_t element = H5Tget_size(type.id());
-  if (element == 0 || element > 16) throw Failure(what + " has elements of " + std::to_string(element) + " bytes");
+  if (element == 0 || element > 16) throw Refused(what + " has elements of " + std::to_string(element) + " bytes");
   const std::vector<hsize_t> dims = dataset_shape(file, name);
   rows = dims[0];
   cols = dims.size() == 2 ? dims[1] : 1;
@@ -49,10 +50,12 @@ void read_numeric_dataset(hid_t file, const char* name, H5T_class_t cls, hid_t m
   const std::uint64_t limit = file_size(file);
   const long double declared = static_cast<long double>(rows) * static_cast<long double>(cols) * element;
   if (declared > static_cast<long double>(limit))
-    throw Failure(what + " declares " + std::to_string(rows) + " x " + std::to_string(cols) + " elements (" +
-                  std::to_string(static_cast<unsigned long long>(std::min<long double>(
-                      declared, static_cast<long double>(std::numeric_limits<unsigned long long>::max())))) +
+  {
+    char bytes[32];
+    std::snprintf(bytes, sizeof bytes, "%.3Lg", declared);
+    throw Refused(what + " declares " + std::to_string(rows) + " x " + std::to_string(cols) + " elements (" + bytes +
                   " bytes), more than the file's " + std::to_string(limit) + " bytes");
+  }
   out.assign(static_cast<size_t>(rows * cols), T{});
   if (!out.empty()) check(H5Dread(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), what);
 }
@@ -81,7 +84,7 @@ void check(herr_t rc, const std::string& what) {
 
 void write_string_attribute(hid_t loc, const char* name, const std::string& value) {
   const std::string what = attribute_what(name);
-  if (value.size() > kMaxStringAttribute) throw Failure(what + " is too long");
+  if (value.size() > kMaxStringAttribute) throw Refused(what + " is too long");
   // Fixed length, padded with NULs: never a variable-length heap reference.
   Handle type(H5Tcopy(H5T_C_S1), H5Tclose, what);
   check(H5Tset_size(type.id(), value.empty() ? 1 : value.size()), what);
@@ -97,18 +100,21 @@ std::string read_string_attribute(hid_t loc, const char* name) {
   const std::string what = attribute_what(name);
   Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose, what);
   Handle type(H5Aget_type(attr.id()), H5Tclose, what);
-  if (H5Tget_class(type.id()) != H5T_STRING) throw Failure(what + " is not a string");
+  if (H5Tget_class(type.id()) != H5T_STRING) throw Refused(what + " is not a string");
   if (H5Tis_variable_str(type.id()) != 0)
-    throw Failure(what + " is a variable-length string, expected a fixed-length one (not read)");
+    throw Refused(what + " is a variable-length string, expected a fixed-length one (not read)");
   const hssize_t n = attribute_elements(attr.id(), what);
-  if (n != 1) throw Failure(what + " has " + std::to_string(n) + " elements, expected a single string");
+  if (n != 1) throw Refused(what + " has " + std::to_string(n) + " elements, expected a single string");
   const size_t size = H5Tget_size(type.id());
   if (size == 0 || size > kMaxStringAttribute)
-    throw Failure(what + " has a string size of " + std::to_string(size) + " bytes");
+    throw Refused(what + " has a string size of " + std::to_string(size) + " bytes");
   // Read through a memory type of the same size, so the buffer always matches.
   Handle mem(H5Tcopy(H5T_C_S1), H5Tclose, what);
   check(H5Tset_size(mem.id(), size), what);
   check(H5Tset_strpad(mem.id(), H5T_STR_NULLPAD), what);
+  const H5T_cset_t cset = H5Tget_cset(type.id());
+  if (cset != H5T_CSET_ASCII && cset != H5T_CSET_UTF8) throw Refused(what + " has an unknown character set");
+  check(H5Tset_cset(mem.id(), cset), what);
   std::string buffer(size, '\0');
   check(H5Aread(attr.id(), mem.id(), buffer.data()), what);
   const size_t end = buffer.find('\0');
@@ -143,7 +149,7 @@ std::vector<hsize_t> dataset_shape(hid_t file, const char* name) {
   Handle set(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, what);
   Handle space(H5Dget_space(set.id()), H5Sclose, what);
   const int rank = H5Sget_simple_extent_ndims(space.id());
-  if (rank < 1 || rank > 2) throw Failure(what + " has rank " + std::to_string(rank) + ", expected 1 or 2");
+  if (rank < 1 || rank > 2) throw Refused(what + " has rank " + std::to_string(rank) + ", expected 1 or 2");
   std::vector<hsize_t> dims(static_cast<size_t>(rank), 0);
   if (H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr) < 0) throw Failure(what);
   return dims;
@@ -167,26 +173,19 @@ void write_dataset(hid_t file, hid_t dcpl, const char* name, hid_t file_type, hi
   if (count > 0) check(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), what);
 }
 
-void close_file(Handle& file, const std::string& what) {
-  const hid_t id = file.id();
-  // Objects left open would keep the file open after H5Fclose; close them first.
-  const ssize_t open = H5Fget_obj_count(id, H5F_OBJ_ALL & ~H5F_OBJ_FILE);
-  if (open > 0) {
-    std::vector<hid_t> ids(static_cast<size_t>(open));
-    const ssize_t got = H5Fget_obj_ids(id, H5F_OBJ_ALL & ~H5F_OBJ_FILE, ids.size(), ids.data());
-    for (ssize_t i = 0; i < got; ++i) H5Oclose(ids[static_cast<size_t>(i)]);
-  }
-  try {
-    file.close(what);
-  } catch (const Failure&) {
-    // The final flush failed (e.g. disk full). HDF5 keeps the file open and would
-    // flush it again, and fail harder, when the process exits; drop it now:
-    // close it once more and, if it is still open, shut the library down so
-    // nothing of this file survives.
-    if (H5Iis_valid(id) > 0) H5Fclose(id);
-    if (H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL) > 0) H5close();
-    throw;
-  }
+hid_t create_memory_file(const std::string& label, hid_t fcpl) {
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "file access properties");
+  check(H5Pset_fapl_core(fapl.id(), std::size_t{1} << 20, false), "file access properties");
+  return H5Fcreate(label.c_str(), H5F_ACC_TRUNC, fcpl, fapl.id());
+}
+
+std::string file_image(hid_t file) {
+  check(H5Fflush(file, H5F_SCOPE_GLOBAL), "file flush");
+  const ssize_t size = H5Fget_file_image(file, nullptr, 0);
+  if (size < 0) throw Failure("file image");
+  std::string image(static_cast<size_t>(size), '\0');
+  if (H5Fget_file_image(file, image.data(), image.size()) != size) throw Failure("file image");
+  return image;
 }
 
 }  // namespace contactrom::rom::hdf5

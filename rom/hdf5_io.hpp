@@ -34,6 +34,12 @@ struct Failure : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// \brief A file refused by a check (wrong shape, type or size) rather than a
+/// failed HDF5 call; `what()` is a whole sentence naming the object.
+struct Refused : Failure {
+  using Failure::Failure;
+};
+
 /// \brief Turns off HDF5's own error printing (the caller reports one line instead).
 void silence();
 
@@ -103,10 +109,14 @@ void read_double_dataset(hid_t file, const char* name, std::vector<double>& out,
 void write_dataset(hid_t file, hid_t dcpl, const char* name, hid_t file_type, hid_t mem_type, int rank, hsize_t rows,
                    hsize_t cols, const void* data);
 
-/// \brief Closes a file, and if closing fails (full disk: the final flush
-/// failed), closes every object still open in it and the file again, so that
-/// HDF5 does not retry the flush at process exit.
-/// \throws Failure(`what`) if the first close failed.
-void close_file(Handle& file, const std::string& what);
+/// \brief Creates an HDF5 file in memory (core driver, no backing store) with the
+/// file-creation properties `fcpl`: HDF5 never touches the disk, so a full disk
+/// or a failing device cannot leave a half-closed file inside the library.
+/// Write it out with file_image() and fom/atomic_file.
+/// \param label name of the file in HDF5's error messages
+hid_t create_memory_file(const std::string& label, hid_t fcpl);
+
+/// \brief The bytes of an open file (flushed first), as they would be on disk.
+std::string file_image(hid_t file);
 
 }  // namespace contactrom::rom::hdf5

@@ -2,6 +2,8 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -13,6 +15,12 @@
 
 namespace contactrom::rom {
 namespace {
+
+/// Negative pressures down to this fraction of the largest |pressure| (at least 1)
+/// are rounding; below it a database is refused.
+constexpr double kNegativePressureTolerance = 1e-9;
+/// Relative distance within which a stored parameter equals its training-set value.
+constexpr double kParameterMatchTolerance = 1e-12;
 
 // The HDF5 C API reports failure through negative return values and prints an
 // error stack on stderr by default; rom/hdf5_io turns the printing off (the user
@@ -35,7 +43,7 @@ Eigen::MatrixXd read_matrix(hid_t file, const char* name, hsize_t expected_rows)
   hsize_t rows = 0, cols = 0;
   const std::vector<hsize_t> dims = hdf5::dataset_shape(file, name);
   if (dims[0] != expected_rows || dims.size() != 2)
-    throw Hdf5Failure(std::string("dataset /") + name + " has " + std::to_string(dims[0]) + " rows" +
+    throw hdf5::Refused(std::string("dataset /") + name + " has " + std::to_string(dims[0]) + " rows" +
                       (dims.size() != 2 ? " and rank 1" : "") + ", expected " + std::to_string(expected_rows) +
                       " (one per snapshot) and rank 2");
   hdf5::read_double_dataset(file, name, buf, rows, cols);
@@ -49,12 +57,45 @@ std::vector<T> read_vector(hid_t file, const char* name, hsize_t expected) {
   // Shape first: the size of /status bounds every other dataset before any allocation.
   const std::vector<hsize_t> dims = hdf5::dataset_shape(file, name);
   if (dims.size() != 1 || dims[0] != expected)
-    throw Hdf5Failure(std::string("dataset /") + name + " has shape (" + std::to_string(dims[0]) +
+    throw hdf5::Refused(std::string("dataset /") + name + " has shape (" + std::to_string(dims[0]) +
                       (dims.size() == 2 ? ", " + std::to_string(dims[1]) : std::string()) + "), expected (" +
                       std::to_string(expected) + ")");
   if constexpr (std::is_same_v<T, int>) hdf5::read_int_dataset(file, name, out, rows, cols);
   else hdf5::read_double_dataset(file, name, out, rows, cols);
   return out;
+}
+
+std::string format_value(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+/// Refuses values that no offline run writes: non-finite numbers, negative
+/// pressures (beyond rounding), negative counts or times, a training size < 1.
+void validate_values(const SnapshotDatabase& db) {
+  const auto first_bad = [](const Eigen::MatrixXd& m, const auto& bad) -> std::string {
+    for (Eigen::Index j = 0; j < m.cols(); ++j)
+      for (Eigen::Index i = 0; i < m.rows(); ++i)
+        if (bad(m(i, j)))
+          return "row " + std::to_string(j) + ", column " + std::to_string(i) + " holds " + format_value(m(i, j));
+    return "";
+  };
+  const auto not_finite = [](double v) { return !std::isfinite(v); };
+  for (const auto& [name, m] : {std::pair<const char*, const Eigen::MatrixXd*>{"parameters", &db.parameters},
+                                {"primal", &db.primal}, {"dual", &db.dual}})
+    if (const std::string where = first_bad(*m, not_finite); !where.empty())
+      throw hdf5::Refused(std::string("dataset /") + name + " " + where + ", expected finite numbers");
+  // Contact pressures are >= 0; the FOM's dual QP may leave rounding-level negatives.
+  const double scale = std::max(1.0, db.dual.size() ? db.dual.cwiseAbs().maxCoeff() : 0.0);
+  if (const std::string where = first_bad(db.dual, [&](double v) { return v < -kNegativePressureTolerance * scale; });
+      !where.empty())
+    throw hdf5::Refused("dataset /dual " + where + ", expected contact pressures >= 0");
+  for (size_t j = 0; j < db.time_s.size(); ++j)
+    if (!(db.time_s[j] >= 0.0) || !std::isfinite(db.time_s[j]) || db.iterations[j] < 0 || db.pairing_iterations[j] < 0)
+      throw hdf5::Refused("snapshot " + std::to_string(j) + " has a negative or non-finite time or iteration count");
+  if (db.training_size < 1)
+    throw hdf5::Refused("attribute training_size is " + std::to_string(db.training_size) + ", expected >= 1");
 }
 
 std::string join(const std::vector<std::string>& items, const char* sep) {
@@ -91,7 +132,11 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
       db.iterations.size() != n || db.pairing_iterations.size() != n || db.time_s.size() != n)
     throw std::invalid_argument("write_database: inconsistent snapshot counts");
   silence_hdf5();
-  const std::string tmp = temporary_path_for(path);
+  check_output_path(path);
+  // The file is built in memory and written by write_file_atomically: HDF5 never
+  // writes to the disk, so a full disk is our error to report, not a half-closed
+  // file left inside libhdf5.
+  std::string image;
   try {
     // Object modification times are not stored, so that two runs on the same
     // data give the same bytes (except the timing datasets).
@@ -99,7 +144,7 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
     check(H5Pset_obj_track_times(fcpl.id(), false), "file creation properties");
     Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "dataset creation properties");
     check(H5Pset_obj_track_times(dcpl.id(), false), "dataset creation properties");
-    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, fcpl.id(), H5P_DEFAULT), H5Fclose, "file creation");
+    Handle file(hdf5::create_memory_file(path, fcpl.id()), H5Fclose, "file creation");
     const hid_t f = file.id();
 
     const int version = kDatabaseFormatVersion;
@@ -129,13 +174,12 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
     write_dataset(f, dcpl.id(), "pairing_iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0,
                   db.pairing_iterations.data());
     write_dataset(f, dcpl.id(), "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, n, 0, db.time_s.data());
-    hdf5::close_file(file, "file close");
+    image = hdf5::file_image(f);
+    file.close("file close");
   } catch (const Hdf5Failure& e) {
-    std::remove(tmp.c_str());
-    throw InputError("cannot write database '" + path + "': HDF5 failed on " + e.what() +
-                     " (folder missing, not writable or disk full?)");
+    throw InputError("cannot write database '" + path + "': HDF5 failed on " + e.what());
   }
-  commit_temporary(tmp, path);
+  write_file_atomically(path, [&image](std::ostream& out) { out.write(image.data(), static_cast<std::streamsize>(image.size())); });
 }
 
 SnapshotDatabase read_database(const std::string& path) {
@@ -171,7 +215,7 @@ SnapshotDatabase read_database(const std::string& path) {
 
     std::vector<int> status;
     hsize_t n = 0, cols = 0;
-    if (hdf5::dataset_shape(f, "status").size() != 1) throw Hdf5Failure("dataset /status is not one-dimensional");
+    if (hdf5::dataset_shape(f, "status").size() != 1) throw hdf5::Refused("dataset /status is not one-dimensional");
     hdf5::read_int_dataset(f, "status", status, n, cols);
     db.parameters = read_matrix(f, "parameters", n);
     db.primal = read_matrix(f, "primal", n);
@@ -181,15 +225,18 @@ SnapshotDatabase read_database(const std::string& path) {
     db.time_s = read_vector<double>(f, "time_s", n);
     for (int s : status) {
       if (s < 0 || s > static_cast<int>(Status::InvalidInput))
-        throw Hdf5Failure("dataset /status holds the unknown status code " + std::to_string(s));
+        throw hdf5::Refused("dataset /status holds the unknown status code " + std::to_string(s));
       db.status.push_back(static_cast<Status>(s));
     }
     if (db.parameters.rows() != static_cast<Eigen::Index>(db.param_names.size()))
-      throw Hdf5Failure("dataset /parameters has " + std::to_string(db.parameters.rows()) +
+      throw hdf5::Refused("dataset /parameters has " + std::to_string(db.parameters.rows()) +
                         " columns but param_names lists " + std::to_string(db.param_names.size()));
     if (db.training_kind != "train" && db.training_kind != "level")
-      throw Hdf5Failure("attribute training_kind is '" + db.training_kind + "', expected 'train' or 'level'");
+      throw hdf5::Refused("attribute training_kind is '" + db.training_kind + "', expected 'train' or 'level'");
+    validate_values(db);
     file.close("file close");
+  } catch (const hdf5::Refused& e) {
+    throw InputError("database '" + path + "' is not a valid contactrom database: " + e.what());
   } catch (const Hdf5Failure& e) {
     throw InputError("database '" + path + "' is truncated or corrupt (HDF5 cannot read " + e.what() + ")");
   }
@@ -213,6 +260,36 @@ void check_database(const SnapshotDatabase& db, const fom::Problem& problem, con
   if ((db.training_kind == "level") != problem.uses_levels())
     throw InputError("database '" + path + "' selects its training set by '" + db.training_kind + "', but " +
                      problem.name() + " uses " + (problem.uses_levels() ? "'level'" : "'train'"));
+  check_training_set(db, problem, path);
+}
+
+void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path) {
+  for (int j = 0; j < db.num_snapshots(); ++j) {
+    try {
+      problem.check_param(db.parameter(j));
+    } catch (const InputError& e) {
+      throw InputError("database '" + path + "' dataset /parameters row " + std::to_string(j) + ": " + e.what());
+    }
+  }
+  const std::string option = db.training_kind == "level" ? "level " : "training size ";
+  std::vector<fom::Param> expected;
+  try {
+    expected = problem.training_set(db.training_size);
+  } catch (const InputError& e) {
+    throw InputError("database '" + path + "' attribute training_size: " + e.what());
+  }
+  const auto mismatch = [&](const std::string& why) {
+    return InputError("database '" + path + "' claims " + option + std::to_string(db.training_size) + " of " +
+                      problem.name() + ", but " + why + "; expected the snapshots of that training set");
+  };
+  if (static_cast<int>(expected.size()) != db.num_snapshots())
+    throw mismatch("it holds " + std::to_string(db.num_snapshots()) + " snapshots instead of " +
+                   std::to_string(expected.size()));
+  for (int j = 0; j < db.num_snapshots(); ++j) {
+    const double scale = std::max(1.0, expected[j].cwiseAbs().maxCoeff());
+    if ((db.parameter(j) - expected[j]).cwiseAbs().maxCoeff() > kParameterMatchTolerance * scale)
+      throw mismatch("its snapshot " + std::to_string(j) + " is not at the training parameter of that set");
+  }
 }
 
 std::vector<fom::Param> database_training_set(const SnapshotDatabase& db, const fom::Problem& problem) {

@@ -60,6 +60,7 @@ struct ChlsArgs {
 };
 
 void run_chls(const ChlsArgs& a) {
+  if (!a.out.empty()) check_output_path(a.out);
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = fom::make_problem(db.problem);
   rom::check_database(db, *problem, a.db);
@@ -145,6 +146,7 @@ struct HullRow {
 };
 
 void run_hull_report(const HullArgs& a) {
+  if (!a.out.empty()) check_output_path(a.out);
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = fom::make_problem(db.problem);
   rom::check_database(db, *problem, a.db);

@@ -14,6 +14,7 @@
 #include "fom/errors.hpp"
 #include "rom/offline.hpp"
 #include "rom/snapshot_database.hpp"
+#include "fom/atomic_file.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 
@@ -37,6 +38,7 @@ std::string param_text(const fom::Problem& problem, const fom::Param& mu) {
 }
 
 void run_offline(const OfflineArgs& a) {
+  check_output_path(a.out);  // before the snapshots are computed
   auto problem = fom::make_problem(a.problem);
   int n = 0;
   if (problem->uses_levels()) {

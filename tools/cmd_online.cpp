@@ -21,6 +21,7 @@
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
+#include "fom/atomic_file.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 
@@ -142,6 +143,7 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
 }
 
 void run_online(const OnlineArgs& a) {
+  if (!a.out.empty() && a.param.empty()) check_output_path(a.out);
   if (!a.param.empty() && a.validation)
     throw InputError("--param and --validation exclude each other; give one");
   const rom::SnapshotDatabase db = rom::read_database(a.db);

@@ -222,6 +222,7 @@ void write_csv(const std::string& path, const fom::Problem& problem, const std::
 }
 
 void run_verify(const VerifyArgs& a) {
+  if (!a.out.empty()) check_output_path(a.out);
   const std::vector<std::string> methods = split_methods(a.methods);
   const std::vector<std::string> names = rom::online_solver_names();
   for (const std::string& m : methods)

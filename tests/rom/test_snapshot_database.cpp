@@ -129,15 +129,15 @@ BOOST_AUTO_TEST_CASE(layout_as_seen_from_h5py) {
   const SnapshotDatabase db = synthetic(5, 40, 9);
   const std::string path = temp().file("layout.h5");
   contactrom::rom::write_database(path, db);
-  // /primal is n_snap × n_dofs, row j = snapshot j; attributes are Python str/int.
+  // /primal is n_snap × n_dofs, row j = snapshot j; string attributes are fixed-length (bytes in h5py).
   char script[2048];
   std::snprintf(script, sizeof script,
                 "/usr/bin/python3 -c \"import h5py, numpy as np; f = h5py.File('%s', 'r'); "
                 "assert f['primal'].shape == (5, 40), f['primal'].shape; "
                 "assert f['dual'].shape == (5, 9); assert f['parameters'].shape == (5, 1); "
                 "assert f['status'].shape == (5,); assert list(f['status'][:]) == [0, 0, 1, 0, 0]; "
-                "assert int(f.attrs['format_version']) == 1; assert f.attrs['problem'] == 'hertz'; "
-                "assert f.attrs['mesh_fingerprint'] == '0123456789abcdef'; "
+                "assert int(f.attrs['format_version']) == 1; assert f.attrs['problem'] == b'hertz'; "
+                "assert f.attrs['mesh_fingerprint'] == b'0123456789abcdef'; "
                 "assert abs(f['primal'][3, 17] - (%.17g)) == 0; assert abs(f['dual'][4, 8] - (%.17g)) == 0; "
                 "assert abs(f['parameters'][1, 0] - (%.17g)) == 0\"",
                 path.c_str(), db.primal(17, 3), db.dual(8, 4), db.parameters(0, 1));
