@@ -114,6 +114,14 @@ struct ConvexHullOptions {
   /// \f$ u_s \f$, whereas α can drift along nearly dependent columns without
   /// changing u. Default 1e-8.
   double pairing_tolerance = 1e-8;
+  /// Largest relative projected residual \f$ \|B^T r(\alpha)\| / \|B^T f(\mu)\| \f$ of
+  /// a solve reported as success. A query outside the convex hull of the training
+  /// snapshots (e.g. below the training range) has no convex combination that
+  /// balances its load: its residual is of order 1, and it is reported as
+  /// no_convergence with the residual in the message, never as success. Inside
+  /// the hull the residual is at the level of the dictionary's truncation
+  /// (about 1e-6 on hertz). Default 1e-2.
+  double residual_tolerance = 1e-2;
   /// nnFOCUSS settings (rom/focuss.hpp); defaults: 100 iterations, tolerance 1e-10,
   /// pruning 1e-8.
   FocussOptions focuss;

@@ -11,7 +11,10 @@
 // --max-iter: NNLS active-set changes, FOCUSS/nnFOCUSS re-weighted solves, OMP atoms.
 // --json prints one object {method, status, iterations, residual, coefficients, ...};
 // a numerical failure is reported as a status (exit 0), bad input exits 2.
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <limits>
@@ -103,6 +106,26 @@ SparseRun run_method(const SparseArgs& args, bool has_tol, bool has_max_iter, bo
   return run;
 }
 
+/// NNLS, OMP and nnFOCUSS work with the n x n Gram matrix of the dictionary's
+/// columns: refuse, naming the size, a dictionary whose Gram matrix cannot fit in
+/// this machine's memory instead of failing inside the allocator.
+void check_gram_fits(const SparseArgs& args, const MatrixXd& d) {
+  if (args.method == "focuss") return;
+  const double n = static_cast<double>(d.cols());
+  const double bytes = n * n * sizeof(double);
+  const double memory = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  if (memory > 0.0 && bytes > 0.5 * memory) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "dictionary '%s' has %lld columns: %s works with their %lld x %lld Gram matrix (%.3g GB), more than "
+                  "half of this machine's %.3g GB of memory; expected at most %lld columns",
+                  args.dictionary.c_str(), static_cast<long long>(d.cols()), args.method.c_str(),
+                  static_cast<long long>(d.cols()), static_cast<long long>(d.cols()), bytes / 1e9, memory / 1e9,
+                  static_cast<long long>(std::sqrt(0.5 * memory / sizeof(double))));
+    throw InputError(text);
+  }
+}
+
 void run_sparse(const SparseArgs& args, bool has_tol, bool has_max_iter, bool has_atoms) {
   if (args.method != "nnls" && args.method != "omp" && args.method != "focuss" && args.method != "nnfocuss") {
     throw InputError("unknown --method '" + args.method + "': expected nnls, omp, focuss or nnfocuss");
@@ -127,6 +150,7 @@ void run_sparse(const SparseArgs& args, bool has_tol, bool has_max_iter, bool ha
                      std::to_string(d.rows()) + " (the rows of dictionary '" + args.dictionary + "')");
   }
 
+  check_gram_fits(args, d);
   const SparseRun run = run_method(args, has_tol, has_max_iter, has_atoms, d, x);
   const double residual = (d * run.coefficients - x).norm();
   const double x_norm = x.norm();

@@ -9,6 +9,8 @@
 // numerical non-convergence is reported in the output with a status instead.
 #include <algorithm>
 #include <iostream>
+#include <new>
+#include <stdexcept>
 
 #include "fom/errors.hpp"
 #include "fom/input_values.hpp"
@@ -49,6 +51,14 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::cerr << "contactrom: error: " << e.what() << "\n";
     return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "contactrom: error: out of memory: a size given in the input (mesh, database, dictionary or option)"
+                 " is too large for this machine\n";
+    return 1;
+  } catch (const std::length_error&) {
+    std::cerr << "contactrom: error: a size given in the input (mesh, database, dictionary or option) is too large to"
+                 " allocate\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "contactrom: error: " << e.what() << "\n";
     return 1;
