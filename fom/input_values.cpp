@@ -143,8 +143,9 @@ fom::Param parse_problem_param(const fom::Problem& problem, const std::string& t
     throw InputError(std::string(e.what()) + " (" + problem.range_text() + ")");
   }
   if (static_cast<int>(items.size()) != problem.num_params())
-    throw InputError("--param " + quoted(text) + " has " + std::to_string(items.size()) + " value(s), but problem '" +
-                     problem.name() + "' takes " + std::to_string(problem.num_params()) + expected);
+    throw InputError("problem '" + problem.name() + "' takes " + std::to_string(problem.num_params()) +
+                     " parameter value(s), but --param " + quoted(text) + " has " + std::to_string(items.size()) +
+                     expected);
   fom::Param mu(problem.num_params());
   for (int i = 0; i < problem.num_params(); ++i) {
     const std::string what = "parameter " + problem.param_names()[i] + " =";

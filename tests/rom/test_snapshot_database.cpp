@@ -207,7 +207,8 @@ BOOST_AUTO_TEST_CASE(database_of_another_mesh_or_problem_is_refused) {
   db.problem = "hertz";
   db.mesh_fingerprint = hertz->fingerprint();
   db.param_names = {"d"};
-  db.parameters = Eigen::MatrixXd::Zero(1, 1);
+  db.training_size = 1;                               // hertz --train 1: d = 0.3
+  db.parameters = Eigen::MatrixXd::Constant(1, 1, 0.3);
   db.primal = Eigen::MatrixXd::Zero(hertz->num_dofs(), 1);
   db.dual = Eigen::MatrixXd::Zero(hertz->contact().num_constraints(), 1);
   BOOST_CHECK_NO_THROW(contactrom::rom::check_database(db, *hertz, "ok.h5"));
