@@ -16,9 +16,11 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
   CC=${CC:-clang} CXX=${CXX:-clang++} cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DCONTACTROM_FUZZ=ON -DCONTACTROM_BUILD_TESTS=OFF >/dev/null || exit 100
 fi
-cmake --build "$build" --target fuzz_csv fuzz_database >/dev/null || exit 100
+targets="fuzz_csv fuzz_database"
+[ -f "$root/fom/problem_file.hpp" ] && targets="$targets fuzz_problem_file"
+cmake --build "$build" --target $targets >/dev/null || exit 100
 failures=0
-for target in fuzz_csv fuzz_database; do
+for target in $targets; do
   name=${target#fuzz_}
   work="$build/fuzz-work/$name"
   findings="$build/fuzz-findings/$name"
