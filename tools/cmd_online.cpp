@@ -62,6 +62,7 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
   j["primal_rank"] = model.primal_rank();
   j["status"] = to_string(res.status);
   j["converged"] = res.converged;
+  if (!res.message.empty()) j["message"] = res.message;
   j["iterations"] = res.iterations;
   j["sparsity"] = res.selected.size();
   j["selected"] = selected_json(snapshots);
@@ -78,7 +79,8 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
     return;
   }
   std::cout << "online " << solver.name() << " on " << problem.name() << " at " << j["param"].dump() << ": "
-            << to_string(res.status) << ", " << res.iterations << " iterations\n"
+            << to_string(res.status) << (res.message.empty() ? "" : " (" + res.message + ")") << ", "
+            << res.iterations << " iterations\n"
             << "dictionary " << model.dictionary_size() << " columns, primal rank " << model.primal_rank()
             << " (delta " << model.delta() << ")\n"
             << "selected snapshots " << j["selected"].dump() << " coefficients " << j["coefficients"].dump() << "\n"
