@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "fom/atomic_file.hpp"
 #include "fom/errors.hpp"
 #include "fom/input_values.hpp"
 #include "fom/problem.hpp"
@@ -84,4 +85,12 @@ BOOST_AUTO_TEST_CASE(problem_parameters_are_checked_per_component) {
   BOOST_TEST(message_of([&] { contactrom::parse_problem_param(*rope, "12,13"); }).find("takes 1 parameter") !=
              std::string::npos);
   BOOST_TEST(message_of([&] { contactrom::parse_problem_param(*rope, "nan"); }).find("'nan'") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(device_targets_are_refused_without_writing) {
+  // check_output_path only inspects the target; nothing is written to /dev/null.
+  const std::string m = message_of([] { contactrom::check_output_path("/dev/null"); });
+  BOOST_TEST(m.find("'/dev/null': it is a device, pipe or socket") != std::string::npos, m);
+  BOOST_TEST(message_of([] { contactrom::check_output_path(""); }) == "output file name is empty; expected a file name");
+  BOOST_TEST(message_of([] { contactrom::check_output_path("/tmp"); }).find("is a folder") != std::string::npos);
 }
