@@ -36,6 +36,16 @@ CLI::Option* add_integer(CLI::App* sub, const std::string& name, Int& target, co
       ->type_name("INT");
 }
 
+/// Validator of a file or folder option: an empty value ("--out ''") is refused
+/// rather than read as "not given".
+inline CLI::Validator non_empty_path() {
+  return CLI::Validator(
+      [](std::string& value) {
+        return value.empty() ? std::string("'' is empty; expected a path") : std::string();
+      },
+      "PATH");
+}
+
 /// A parameter as a JSON number (one value) or array (several).
 inline nlohmann::json param_json(const fom::Param& mu) {
   if (mu.size() == 1) return mu(0);

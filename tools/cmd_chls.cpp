@@ -120,8 +120,10 @@ void run_chls(const ChlsArgs& a) {
 CommandRegistrar reg_chls("chls", [](CLI::App& app) {
   auto args = std::make_shared<ChlsArgs>();
   auto* sub = app.add_subcommand("chls", "Leave-one-out convex hull least squares of the primal snapshots");
-  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
-  sub->add_option("--out", args->out, "CSV file: parameter columns, chls_error, status, iterations, support");
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
+      ->check(non_empty_path())->required();
+  sub->add_option("--out", args->out, "CSV file: parameter columns, chls_error, status, iterations, support")
+      ->check(non_empty_path());
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_chls(*args); });
 });
@@ -301,7 +303,8 @@ void run_hull_report(const HullArgs& a) {
 CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
   auto args = std::make_shared<HullArgs>();
   auto* sub = app.add_subcommand("hull-report", "Convex-hull ROM errors, sparsity and KKT compliance per query");
-  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
+      ->check(non_empty_path())->required();
   sub->add_option("--set", args->set, "training | validation (default)")
       ->check(CLI::IsMember({"training", "validation"}));
   add_number(sub, "--delta", args->delta, "POD/SVD energy tolerance (default 1e-8; paper rope: 1e-7)", Interval::closed(0, 1));
@@ -317,7 +320,8 @@ CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
   add_integer(sub, "--max-pairing-iterations", args->max_pairing_iterations, "pairing fixed-point cap (default 20)", 1, 100000);
   sub->add_option("--option", args->options,
                   "further convex-hull setting KEY=VALUE (repeatable; keys: see rom/convex_hull.hpp)");
-  sub->add_option("--out", args->out, "CSV file, one row per query");
+  sub->add_option("--out", args->out, "CSV file, one row per query")
+      ->check(non_empty_path());
   add_integer(sub, "--threads", args->threads, "threads for the FOM references (default: hardware concurrency)", 1, 1024);
   sub->add_flag("--time", args->time, "also time the online solve (rom::time_online)");
   add_integer(sub, "--repeats", args->repeats, "passes over the set for --time (default 3)", 1, 1000);

@@ -81,7 +81,8 @@ CommandRegistrar reg("fom", [](CLI::App& app) {
   sub->add_option("--param", args->param, "parameter value, V or V1,V2 (ironing2)")->required();
   sub->add_option("--solver", args->solver, "active-set (default) | ipopt")
       ->check(CLI::IsMember({"active-set", "ipopt"}));
-  sub->add_option("--out", args->out, "folder for <problem>.vtu and <problem>_surface.csv");
+  sub->add_option("--out", args->out, "folder for <problem>.vtu and <problem>_surface.csv")
+      ->check(non_empty_path());
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_fom(*args); });
 });

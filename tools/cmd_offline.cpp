@@ -101,7 +101,8 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
   auto* train = add_integer(sub, "--train", args->train, "training size N (hertz: d_i = 0.3 i/N)", 1, 100000);
   auto* level = add_integer(sub, "--level", args->level, "nested training level n (ironing, ironing2)", 1, 12);
   train->excludes(level);
-  sub->add_option("--out", args->out, "output database (.h5)")->required();
+  sub->add_option("--out", args->out, "output database (.h5)")
+      ->check(non_empty_path())->required();
   add_integer(sub, "--threads", args->threads, "worker threads (default: hardware concurrency)", 1, 1024);
   sub->add_flag("--progress", args->progress, "draw the progress bar even when stderr is not a terminal");
   sub->add_flag("--json", args->json, "print one JSON object");

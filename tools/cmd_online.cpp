@@ -183,7 +183,8 @@ void run_online(const OnlineArgs& a) {
 CommandRegistrar reg("online", [](CLI::App& app) {
   auto args = std::make_shared<OnlineArgs>();
   auto* sub = app.add_subcommand("online", "Evaluate a reduced model built from a snapshot database");
-  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
+      ->check(non_empty_path())->required();
   sub->add_option("--method", args->method, "online method (default greedy; see the error text for all)");
   add_number(sub, "--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
   add_number(sub, "--tau", args->tau, "greedy penetration threshold (default: tau = delta)", Interval::at_least(0));
@@ -198,7 +199,8 @@ CommandRegistrar reg("online", [](CLI::App& app) {
                   "inner_solve (full-dictionary); basis, rank_l, seed, ... (convex-hull; see docs/convex_hull.md)");
   sub->add_flag("--validation", args->validation, "evaluate on the validation set (default without --param)");
   sub->add_option("--param", args->param, "one query V or V1,V2");
-  sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)");
+  sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)")
+      ->check(non_empty_path());
   add_integer(sub, "--threads", args->threads, "threads for the FOM references (default: hardware concurrency)", 1, 1024);
   sub->add_flag("--kkt", args->kkt, "also compute the FOM KKT residuals of every ROM solution");
   sub->add_flag("--json", args->json, "print one JSON object");

@@ -194,8 +194,10 @@ const contactrom::cli::CommandRegistrar registrar("sparse", [](CLI::App& app) {
   auto args = std::make_shared<SparseArgs>();
   auto* sub = app.add_subcommand("sparse", "Sparse regression of a signal on a dictionary (NNLS, OMP, FOCUSS, nnFOCUSS)");
   sub->add_option("--method", args->method, "nnls | omp | focuss | nnfocuss")->required();
-  sub->add_option("--dictionary", args->dictionary, "CSV file of D (one row per line)")->required();
-  sub->add_option("--signal", args->signal, "CSV file of x (one column or one row)")->required();
+  sub->add_option("--dictionary", args->dictionary, "CSV file of D (one row per line)")
+      ->check(contactrom::cli::non_empty_path())->required();
+  sub->add_option("--signal", args->signal, "CSV file of x (one column or one row)")
+      ->check(contactrom::cli::non_empty_path())->required();
   using contactrom::Interval;
   using contactrom::cli::add_integer;
   using contactrom::cli::add_number;

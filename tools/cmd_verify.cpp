@@ -415,7 +415,8 @@ void run_verify(const VerifyArgs& a) {
 CommandRegistrar reg("verify", [](CLI::App& app) {
   auto args = std::make_shared<VerifyArgs>();
   auto* sub = app.add_subcommand("verify", "KKT verification of reduced solutions against the Ipopt reference");
-  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
+      ->check(non_empty_path())->required();
   sub->add_option("--method", args->methods, "online method(s), comma-separated (e.g. greedy,cpg,full-dictionary)")
       ->required();
   add_number(sub, "--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
@@ -432,7 +433,8 @@ CommandRegistrar reg("verify", [](CLI::App& app) {
   add_integer(sub, "--limit", args->limit, "use N evenly spaced validation parameters (default: all)", 1, 1000000);
   sub->add_flag("--bench", args->bench, "also time each method and the FOM, in interleaved rounds (rom::time_interleaved)");
   add_integer(sub, "--repeats", args->repeats, "timing passes over the parameters with --bench (default 3)", 1, 1000);
-  sub->add_option("--out", args->out, "CSV file with one row per method and parameter");
+  sub->add_option("--out", args->out, "CSV file with one row per method and parameter")
+      ->check(non_empty_path());
   sub->add_flag("--progress", args->progress, "draw progress bars even when stderr is not a terminal");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_verify(*args); });

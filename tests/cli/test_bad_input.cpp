@@ -146,7 +146,9 @@ BOOST_FIXTURE_TEST_CASE(output_targets, Fixture) {
   BOOST_REQUIRE(::mkfifo(file("fifo").c_str(), 0600) == 0);
   const std::string offline = "offline --problem rope --out ";
   const std::vector<Case> cases = {
-      {offline + "''", "output file name is empty", "", ""},
+      {offline + "''", "--out: '' is empty; expected a path", "", ""},
+      {"fom --problem rope --param 20 --out ''", "--out: '' is empty; expected a path", "", ""},
+      {"online --db ''", "--db: '' is empty; expected a path", "", ""},
       {offline + file("folder"), "is a folder", "", ""},
       {offline + file("link.h5"), "is a symbolic link", "", ""},
       {offline + file("fifo"), "it is a device, pipe or socket", "", ""},
