@@ -233,3 +233,15 @@ BOOST_FIXTURE_TEST_CASE(unheld_body_is_named_and_stdout_stays_clean, Fixture) {
   check_case({"fom --problem hertz --param 0.1 --json", "body 'top' is held by no Dirichlet condition", "", env});
   check_case({"offline --problem hertz --train 3 --out " + file("s.h5"), "body 'top'", file("s.h5"), env});
 }
+
+BOOST_FIXTURE_TEST_CASE(geo_that_exits_is_an_error_not_a_silent_success, Fixture) {
+  // A .geo file is a gmsh program; `Exit;` ends the process from inside gmsh.
+  const std::string meshes = file("meshes");
+  fs::create_directories(meshes);
+  std::ifstream in(std::string(CONTACTROM_SOURCE_DIR) + "/meshes/hertz.geo");
+  std::ofstream geo(meshes + "/hertz.geo");
+  geo << "Exit;\n" << in.rdbuf();
+  geo.close();
+  check_case({"fom --problem hertz --param 0.1 --json", "/hertz.geo' ended the program while gmsh read it", "",
+              "CONTACTROM_MESH_DIR=" + meshes + " "});
+}
