@@ -18,6 +18,13 @@ struct IpoptOptions {
   /// (Search_Direction_Becomes_Too_Small: the round-off floor lies above `tol`, e.g. rope
   /// at large γ where \f$ \epsilon\,\|K\|\,\|u\| \approx 10^{-12} \f$) counts as success (default 1e-9).
   double acceptable_tol = 1e-9;
+  /// Largest FOM stationarity, penetration and negative-pressure residual
+  /// (fom/kkt.hpp, relative) of a solution reported as success. Ipopt's tolerances
+  /// are absolute in its scaled problem: for a load near zero (hertz d = 1e-300) it
+  /// reports success with a stationarity residual of 1e278 relative to the load; such
+  /// a solution is reported as no_convergence with its residuals. Normal queries stay
+  /// below 1e-12 (default 1e-6).
+  double kkt_tolerance = 1e-6;
   /// Ipopt `mu_min`, the smallest barrier parameter. Ipopt's 1e-11 leaves multipliers
   /// ≈ 1e-11 / slack on inactive rows, enough to flip the active set of nodes that barely
   /// separate; 1e-16 drives them to round-off (default 1e-16).

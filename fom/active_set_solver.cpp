@@ -4,6 +4,8 @@
 #include <chrono>
 
 #include "fom/anderson.hpp"
+#include "fom/errors.hpp"
+#include "fom/rigid_bodies.hpp"
 
 namespace contactrom::fom {
 namespace {
@@ -129,6 +131,9 @@ ActiveSetSolver::ActiveSetSolver(const Problem& problem, ActiveSetOptions option
   m_constant = std::make_unique<Condensation>();
   Param mid = 0.5 * (problem.param_lower() + problem.param_upper());
   m_constant_ok = condense(problem, mid, *m_constant);
+  // A stiffness that cannot be factorised is a problem definition error (a body
+  // held by nothing), not a numerical accident of one query.
+  if (!m_constant_ok) throw InputError(singular_stiffness_message(problem));
   m_setup_time = seconds_since(t0);
 }
 
@@ -150,7 +155,7 @@ FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) con
     FomSolution s;
     s.mu = mu;
     s.status = Status::NumericalIssue;
-    s.message = "Cholesky factorisation of the stiffness failed (matrix not positive definite)";
+    s.message = singular_stiffness_message(m_problem);
     return s;
   }
   FomSolution s = solve_with(cond, mu, warm);

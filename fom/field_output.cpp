@@ -6,6 +6,7 @@
 
 #include "fom/atomic_file.hpp"
 #include "fom/errors.hpp"
+#include "fom/input_values.hpp"
 #include "fom/kkt.hpp"
 
 namespace contactrom::fom {
@@ -23,20 +24,11 @@ void data_array(std::ostream& out, const char* name, int components, const Eigen
   out << "        </DataArray>\n";
 }
 
-}  // namespace
-
-void ensure_directory(const std::string& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir))
-    throw InputError("cannot create output folder '" + dir + "': " + (ec ? ec.message() : "not a folder"));
-}
-
-void write_vtu(const std::string& path, const Problem& problem, const Param& mu, const Eigen::VectorXd& u,
-               const Eigen::VectorXd& lambda) {
-  const Mesh* mesh = problem.mesh();
-  const ContactModel& contact = problem.contact();
-  write_file_atomically(path, [&](std::ostream& out) {
+/// The VTU content (see write_vtu); captures its arguments by reference.
+FileWriter vtu_writer(const Problem& problem, const Param& mu, const Eigen::VectorXd& u, const Eigen::VectorXd& lambda) {
+  return [&problem, &mu, &u, &lambda](std::ostream& out) {
+    const Mesh* mesh = problem.mesh();
+    const ContactModel& contact = problem.contact();
     out << std::setprecision(std::numeric_limits<double>::max_digits10);
     const int np = mesh ? mesh->num_nodes() : static_cast<int>(problem.rope_x().size());
     const int ncell = mesh ? mesh->num_quads() : np - 1;
@@ -83,14 +75,14 @@ void write_vtu(const std::string& path, const Problem& problem, const Param& mu,
       out << "      </CellData>\n";
     }
     out << "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
-  });
+  };
 }
 
-void write_surface_csv(const std::string& path, const Problem& problem, const Eigen::VectorXd& u,
-                       const Eigen::VectorXd& lambda) {
-  const ContactModel& contact = problem.contact();
-  const Eigen::VectorXd gap = normal_gaps(problem, u);
-  write_file_atomically(path, [&](std::ostream& out) {
+/// The contact surface CSV content (see write_surface_csv).
+FileWriter surface_csv_writer(const Problem& problem, const Eigen::VectorXd& u, const Eigen::VectorXd& lambda) {
+  return [&problem, &u, &lambda](std::ostream& out) {
+    const ContactModel& contact = problem.contact();
+    const Eigen::VectorXd gap = normal_gaps(problem, u);
     out << std::setprecision(std::numeric_limits<double>::max_digits10);
     out << "x,y,gap,pressure\n";
     for (int s = 0; s < contact.num_constraints(); ++s) {
@@ -100,7 +92,52 @@ void write_surface_csv(const std::string& path, const Problem& problem, const Ei
       else out << "inf";
       out << ',' << lambda(s) << '\n';
     }
-  });
+  };
+}
+
+}  // namespace
+
+void ensure_directory(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw InputError("cannot create output folder " + quoted(dir, 200) + ": " + (ec ? ec.message() : "not a folder"));
+}
+
+void write_vtu(const std::string& path, const Problem& problem, const Param& mu, const Eigen::VectorXd& u,
+               const Eigen::VectorXd& lambda) {
+  write_file_atomically(path, vtu_writer(problem, mu, u, lambda));
+}
+
+void write_surface_csv(const std::string& path, const Problem& problem, const Eigen::VectorXd& u,
+                       const Eigen::VectorXd& lambda) {
+  write_file_atomically(path, surface_csv_writer(problem, u, lambda));
+}
+
+void write_fields(const std::string& dir, const std::string& stem, const Problem& problem, const Param& mu,
+                  const Eigen::VectorXd& u,
+                  const Eigen::VectorXd& lambda) {
+  namespace fs = std::filesystem;
+  if (dir.empty()) throw InputError("output folder name is empty; expected a folder");
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(dir, ec);
+  bool created = false;
+  if (fs::exists(st)) {
+    if (!fs::is_directory(fs::status(dir, ec)))
+      throw InputError("cannot create output folder " + quoted(dir, 200) + ": a file of that name exists");
+  } else {
+    fs::create_directories(dir, ec);
+    if (ec) throw InputError("cannot create output folder " + quoted(dir, 200) + ": " + ec.message());
+    created = true;
+  }
+  const std::string base = dir + "/" + stem;
+  try {
+    write_files_atomically({{base + ".vtu", vtu_writer(problem, mu, u, lambda)},
+                            {base + "_surface.csv", surface_csv_writer(problem, u, lambda)}});
+  } catch (...) {
+    if (created) fs::remove(dir, ec);  // only if still empty
+    throw;
+  }
 }
 
 }  // namespace contactrom::fom

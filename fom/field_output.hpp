@@ -23,6 +23,14 @@ void write_vtu(const std::string& path, const Problem& problem, const Param& mu,
 void write_surface_csv(const std::string& path, const Problem& problem, const Eigen::VectorXd& u,
                        const Eigen::VectorXd& lambda);
 
+/// \brief Writes `dir`/`stem`.vtu and `dir`/`stem`_surface.csv as one set: both
+/// are complete before either is published, and a failure leaves neither (nor
+/// `dir`, if this call created it).
+/// \throws InputError naming the folder or file and the reason.
+void write_fields(const std::string& dir, const std::string& stem, const Problem& problem, const Param& mu,
+                  const Eigen::VectorXd& u,
+                  const Eigen::VectorXd& lambda);
+
 /// \brief Creates `dir` (and parents) if needed; throws InputError naming it on failure.
 void ensure_directory(const std::string& dir);
 

@@ -415,10 +415,46 @@ std::string Mesh::fingerprint() const {
   return buf;
 }
 
+namespace {
+
+/// The mesh file gmsh is reading (empty: none). A .geo file is a program: its
+/// `Exit;` command makes gmsh call exit(0) in the middle of the session. The exit
+/// handler below turns that into a one-line error and exit code 2 instead of a
+/// silent success with no output.
+/// A plain buffer, not a std::string: it must outlive static destructors, which
+/// exit() runs before the handler.
+char g_mesh_being_read[4096] = "";
+
+void refuse_exit_inside_gmsh() {
+  if (g_mesh_being_read[0] == '\0') return;
+  std::fprintf(stderr,
+               "contactrom: error: mesh '%s' ended the program while gmsh read it (an Exit command or a fatal gmsh "
+               "error); a .geo file is a program: expected one that only builds a mesh\n",
+               g_mesh_being_read);
+  std::fflush(stderr);
+  std::_Exit(2);
+}
+
+/// Marks `path` as being read for the lifetime of the guard.
+class MeshReadGuard {
+ public:
+  explicit MeshReadGuard(const std::string& path) {
+    static const bool registered = std::atexit(refuse_exit_inside_gmsh) == 0;
+    (void)registered;
+    std::snprintf(g_mesh_being_read, sizeof g_mesh_being_read, "%s", path.c_str());
+  }
+  ~MeshReadGuard() { g_mesh_being_read[0] = '\0'; }
+  MeshReadGuard(const MeshReadGuard&) = delete;
+  MeshReadGuard& operator=(const MeshReadGuard&) = delete;
+};
+
+}  // namespace
+
 Mesh load_mesh(const std::string& path, const MeshOptions& options) {
   if (options.refine < 0 || options.refine > MeshOptions::kMaxRefine)
     throw InputError("mesh refinement " + std::to_string(options.refine) + " invalid; expected an integer in 0.." +
                      std::to_string(MeshOptions::kMaxRefine));
+
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh file '" + path + "' not found");
   if (!std::ifstream(path)) throw InputError("mesh file '" + path + "' is not readable");
@@ -426,6 +462,7 @@ Mesh load_mesh(const std::string& path, const MeshOptions& options) {
   const std::string ext = lower_extension(path);
 
   GmshSession session;
+  const MeshReadGuard guard(path);
   try {
     gmsh::open(path);
     if (std::string err = session.take_first_error(); !err.empty())

@@ -72,6 +72,11 @@ struct MeshOptions {
 /// `gmsh::model::mesh::generate(2)` and the options set in the file; a `.msh`
 /// file is read as is.
 ///
+/// A `.geo` file is a gmsh program, not data: it can run shell commands
+/// (`System`), loop, or end the process (`Exit`). Read only trusted `.geo` files;
+/// a `.msh` file is data. A `.geo` that ends the process while it is read makes
+/// contactrom print one error line naming it and exit with code 2.
+///
 /// Each call opens and closes its own gmsh session (initialize ... finalize,
 /// no config files, nothing printed), so it may be called any number of times,
 /// but NOT concurrently from several threads, and not while the caller itself

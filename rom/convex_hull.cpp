@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <set>
 
+#include "fom/input_values.hpp"
 #include "rom/pod.hpp"
 
 namespace contactrom::rom {
@@ -387,7 +389,18 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
   on.iterations = res.focuss_iterations;
   on.converged = status == Status::Success && settled;
   on.status = status;
-  if (status == Status::Success && !settled) {
+  // The projected problem may be solved exactly and still leave the load
+  // unbalanced: the query lies outside the hull. That is not a success.
+  if (on.converged && !(res.projected_residual <= opt.residual_tolerance)) {
+    on.converged = false;
+    on.status = Status::NoConvergence;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "no convex combination of the training snapshots balances this load: projected residual %.3g > %.3g"
+                  " (query outside the convex hull, e.g. outside the training range)",
+                  res.projected_residual, opt.residual_tolerance);
+    on.message = text;
+  } else if (status == Status::Success && !settled) {
     on.status = Status::NoConvergence;
     on.message = "convex-hull pairing fixed point did not settle in " + std::to_string(opt.max_pairing_iterations) +
                  " iterations";
@@ -447,6 +460,8 @@ ConvexHullOptions convex_hull_options(const OnlineSolverOptions& options) {
       const long long n = parse_integer(key, value);
       if (n < 1 || n > 1000000) throw InputError("convex-hull focuss_max_iterations = " + value + " invalid; expected >= 1");
       o.focuss.max_iterations = static_cast<int>(n);
+    } else if (key == "residual_tolerance") {
+      o.residual_tolerance = parse_number(value, "convex-hull option residual_tolerance", Interval::at_least(0));
     } else if (key == "focuss_tolerance") {
       o.focuss.tolerance = parse_double(key, value);
     } else if (key == "prune_tolerance") {
@@ -454,7 +469,8 @@ ConvexHullOptions convex_hull_options(const OnlineSolverOptions& options) {
     } else {
       throw InputError("convex-hull option '" + key +
                        "' unknown; expected basis, basis_delta, rank_l, seed, sum_weight, polish, "
-                       "max_pairing_iterations, selection_iterations, anderson_depth, pairing_tolerance, focuss_max_iterations, focuss_tolerance or "
+                       "max_pairing_iterations, selection_iterations, anderson_depth, pairing_tolerance, residual_tolerance, "
+                       "focuss_max_iterations, focuss_tolerance or "
                        "prune_tolerance");
     }
   }

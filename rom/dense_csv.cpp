@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fom/errors.hpp"
+#include "fom/input_values.hpp"
 
 namespace contactrom::rom {
 
@@ -31,10 +32,10 @@ double parse_value(const std::string& field, const std::string& name, std::size_
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
   if (end != text.c_str() + text.size() || end == text.c_str()) {
-    throw InputError(where + "'" + text + "' is not a number");
+    throw InputError(where + quoted(text) + " is not a number");
   }
   if (!std::isfinite(value)) {  // nan, inf, or overflow (strtod returns HUGE_VAL)
-    throw InputError(where + "'" + text + "' is not a finite number");
+    throw InputError(where + quoted(text) + " is not a finite number");
   }
   return value;
 }

@@ -4,10 +4,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <mutex>
 #include <ostream>
 
 #include "fom/atomic_file.hpp"
+#include "fom/input_values.hpp"
 #include "rom/greedy_active_set.hpp"
 
 namespace contactrom::rom {
@@ -65,23 +67,12 @@ void check_extra_options(const OnlineSolverOptions& options, const std::string& 
 }
 
 double parse_option_number(const std::string& method, const std::string& key, const std::string& text) {
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(text, &used);
-    if (used == text.size() && std::isfinite(v)) return v;
-  } catch (const std::exception&) {
-  }
-  throw InputError(method + " option " + key + " = '" + text + "' is not a number");
+  return parse_number(text, method + " option " + key);
 }
 
 long long parse_option_integer(const std::string& method, const std::string& key, const std::string& text) {
-  try {
-    std::size_t used = 0;
-    const long long v = std::stoll(text, &used);
-    if (used == text.size()) return v;
-  } catch (const std::exception&) {
-  }
-  throw InputError(method + " option " + key + " = '" + text + "' is not an integer");
+  return parse_integer(text, method + " option " + key, std::numeric_limits<long long>::min(),
+                       std::numeric_limits<long long>::max());
 }
 
 std::vector<std::string> online_solver_names() {

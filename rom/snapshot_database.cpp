@@ -8,53 +8,34 @@
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <type_traits>
 
 #include "fom/atomic_file.hpp"
+#include "rom/hdf5_io.hpp"
 
 namespace contactrom::rom {
 namespace {
 
+/// Negative pressures down to this fraction of the largest |pressure| (at least 1)
+/// are rounding; below it a database is refused.
+constexpr double kNegativePressureTolerance = 1e-9;
+/// Relative distance within which a stored parameter equals its training-set value.
+constexpr double kParameterMatchTolerance = 1e-12;
+
 // The HDF5 C API reports failure through negative return values and prints an
-// error stack on stderr by default; we turn the printing off (the user gets our
-// one-line message instead) and translate failures into exceptions.
+// error stack on stderr by default; rom/hdf5_io turns the printing off (the user
+// gets our one-line message instead), checks shapes, types and sizes before
+// reading, and translates failures into exceptions.
+using hdf5::Handle;
+using hdf5::check;
+using hdf5::write_dataset;
+using hdf5::write_scalar_attribute;
+using hdf5::write_string_attribute;
+using hdf5::read_string_attribute;
+using hdf5::has_attribute;
+using Hdf5Failure = hdf5::Failure;
 
-/// Failure inside an HDF5 call sequence; `what()` names the object involved.
-struct Hdf5Failure : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-void silence_hdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
-
-/// Owns one HDF5 identifier and closes it with the matching H5*close.
-class Handle {
- public:
-  using Closer = herr_t (*)(hid_t);
-  Handle(hid_t id, Closer closer, const std::string& what) : m_id(id), m_closer(closer) {
-    if (id < 0) throw Hdf5Failure(what);
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  ~Handle() {
-    if (m_id >= 0) m_closer(m_id);
-  }
-  /// Closes now and reports failure (closing a file flushes it).
-  void close(const std::string& what) {
-    const herr_t rc = m_closer(m_id);
-    m_id = -1;
-    if (rc < 0) throw Hdf5Failure(what);
-  }
-  hid_t id() const { return m_id; }
-
- private:
-  hid_t m_id;
-  Closer m_closer;
-};
-
-void check(herr_t rc, const std::string& what) {
-  if (rc < 0) throw Hdf5Failure(what);
-}
-
-// ---------------------------------------------------------------- writing
+void silence_hdf5() { hdf5::silence(); }
 
 /// Fixed-length, null-padded UTF-8 string type of `size` bytes (at least 1).
 /// Fixed-length strings only: libhdf5 1.10 can crash on corrupted variable-length ones.
@@ -65,17 +46,6 @@ hid_t fixed_string_type(size_t size) {
   H5Tset_strpad(type, H5T_STR_NULLPAD);
   H5Tset_cset(type, H5T_CSET_UTF8);
   return type;
-}
-
-void write_string_attribute(hid_t loc, const char* name, const std::string& value) {
-  // h5py returns a fixed-length string as bytes: f.attrs[name].decode().
-  const std::string what = std::string("attribute ") + name;
-  Handle type(fixed_string_type(value.size()), H5Tclose, what);
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose, what);
-  Handle attr(H5Acreate2(loc, name, type.id(), space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
-  std::string padded = value;
-  padded.resize(std::max<size_t>(value.size(), 1), '\0');
-  check(H5Awrite(attr.id(), type.id(), padded.data()), what);
 }
 
 /// A 1-D dataset of fixed-length strings (one element per item).
@@ -92,57 +62,21 @@ void write_string_list(hid_t loc, hid_t dcpl, const char* name, const std::vecto
   if (!items.empty()) check(H5Dwrite(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()), what);
 }
 
-void write_scalar_attribute(hid_t loc, const char* name, hid_t file_type, hid_t mem_type, const void* value) {
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose, std::string("attribute ") + name);
-  Handle attr(H5Acreate2(loc, name, file_type, space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-              std::string("attribute ") + name);
-  check(H5Awrite(attr.id(), mem_type, value), std::string("attribute ") + name);
-}
-
-/// Writes a dataset of rank 1 (length rows) or rank 2 (rows × cols, row-major).
-void write_dataset(hid_t file, hid_t dcpl, const char* name, hid_t file_type, hid_t mem_type, int rank, hsize_t rows,
-                   hsize_t cols, const void* data) {
-  const std::string what = std::string("dataset /") + name;
-  const hsize_t dims[2] = {rows, cols};
-  Handle space(H5Screate_simple(rank, dims, nullptr), H5Sclose, what);
-  Handle set(H5Dcreate2(file, name, file_type, space.id(), H5P_DEFAULT, dcpl, H5P_DEFAULT), H5Dclose, what);
-  const hsize_t count = rank == 2 ? rows * cols : rows;
-  if (count > 0) check(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), what);
-}
-
-// ---------------------------------------------------------------- reading
-
-std::string read_string_attribute(hid_t loc, const char* name) {
-  const std::string what = std::string("attribute ") + name;
-  Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose, what);
-  Handle type(H5Aget_type(attr.id()), H5Tclose, what);
-  if (H5Tget_class(type.id()) != H5T_STRING) throw Hdf5Failure(what + " is not a string");
-  // Variable-length strings are refused without reading them (libhdf5 1.10 can
-  // crash on corrupted ones); contactrom writes fixed-length strings only.
-  if (H5Tis_variable_str(type.id()) != 0) throw Hdf5Failure(what + " is a variable-length string");
-  Handle space(H5Aget_space(attr.id()), H5Sclose, what);
-  if (H5Sget_simple_extent_npoints(space.id()) != 1) throw Hdf5Failure(what + " is not a scalar");
-  const size_t size = H5Tget_size(type.id());
-  if (size == 0 || size > (16u << 20)) throw Hdf5Failure(what + " has an implausible size");
-  std::string buf(size, '\0');
-  check(H5Aread(attr.id(), type.id(), buf.data()), what);
-  const size_t end = buf.find('\0');
-  return end == std::string::npos ? buf : buf.substr(0, end);
-}
-
-/// Reads a 1-D dataset of fixed-length strings (refuses variable-length ones unread).
-std::vector<std::string> read_string_list(hid_t loc, const char* name) {
+/// Reads a 1-D dataset of fixed-length strings (refuses variable-length ones unread),
+/// at most `max_bytes` in all.
+std::vector<std::string> read_string_list(hid_t loc, const char* name, std::uint64_t max_bytes) {
   const std::string what = std::string("dataset ") + name;
   Handle set(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose, what);
   Handle type(H5Dget_type(set.id()), H5Tclose, what);
   if (H5Tget_class(type.id()) != H5T_STRING || H5Tis_variable_str(type.id()) != 0)
-    throw Hdf5Failure(what + " is not a list of fixed-length strings");
+    throw hdf5::Refused(what + " is not a list of fixed-length strings");
   Handle space(H5Dget_space(set.id()), H5Sclose, what);
-  if (H5Sget_simple_extent_ndims(space.id()) != 1) throw Hdf5Failure(what + " is not one-dimensional");
+  if (H5Sget_simple_extent_ndims(space.id()) != 1) throw hdf5::Refused(what + " is not one-dimensional");
   hsize_t n = 0;
   H5Sget_simple_extent_dims(space.id(), &n, nullptr);
   const size_t width = H5Tget_size(type.id());
-  if (width == 0 || width > (1u << 20) || n > (1u << 20)) throw Hdf5Failure(what + " has an implausible size");
+  if (width == 0 || n > max_bytes || width > max_bytes / std::max<hsize_t>(n, 1))
+    throw hdf5::Refused(what + " declares more bytes than the file holds");
   std::string buf(width * n, '\0');
   if (n > 0) check(H5Dread(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()), what);
   std::vector<std::string> out;
@@ -154,56 +88,72 @@ std::vector<std::string> read_string_list(hid_t loc, const char* name) {
   return out;
 }
 
+/// A rank-1 or rank-2 dataset of ints or doubles (shape and size checked by hdf5_io).
 template <typename T>
-T read_scalar_attribute(hid_t loc, const char* name, hid_t mem_type) {
-  const std::string what = std::string("attribute ") + name;
-  Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose, what);
-  Handle space(H5Aget_space(attr.id()), H5Sclose, what);
-  if (H5Sget_simple_extent_npoints(space.id()) != 1) throw Hdf5Failure(what + " is not a scalar");
-  T value{};
-  check(H5Aread(attr.id(), mem_type, &value), what);
-  return value;
-}
-
-bool has_attribute(hid_t loc, const char* name) { return H5Aexists(loc, name) > 0; }
-
-/// Reads a dataset of rank 1 or 2 into `out` (resized to its number of
-/// elements); returns its dimensions (cols = 1 for rank 1).
-template <typename T>
-void read_dataset(hid_t file, const char* name, hid_t mem_type, std::vector<T>& out, hsize_t& rows, hsize_t& cols) {
-  const std::string what = std::string("dataset /") + name;
-  Handle set(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, what);
-  Handle space(H5Dget_space(set.id()), H5Sclose, what);
-  const int rank = H5Sget_simple_extent_ndims(space.id());
-  if (rank < 1 || rank > 2) throw Hdf5Failure(what + " has rank " + std::to_string(rank) + ", expected 1 or 2");
-  hsize_t dims[2] = {0, 1};
-  if (H5Sget_simple_extent_dims(space.id(), dims, nullptr) < 0) throw Hdf5Failure(what);
-  rows = dims[0];
-  cols = rank == 2 ? dims[1] : 1;
-  out.assign(static_cast<size_t>(rows * cols), T{});
-  if (!out.empty()) check(H5Dread(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), what);
+void read_dataset(hid_t file, const char* name, std::vector<T>& out, hsize_t& rows, hsize_t& cols) {
+  if constexpr (std::is_same_v<T, int>) hdf5::read_int_dataset(file, name, out, rows, cols);
+  else hdf5::read_double_dataset(file, name, out, rows, cols);
 }
 
 /// Reads an n_snap × width dataset into the columns of a width × n_snap matrix.
 Eigen::MatrixXd read_matrix(hid_t file, const char* name, hsize_t expected_rows) {
   std::vector<double> buf;
   hsize_t rows = 0, cols = 0;
-  read_dataset(file, name, H5T_NATIVE_DOUBLE, buf, rows, cols);
-  if (rows != expected_rows)
-    throw Hdf5Failure(std::string("dataset /") + name + " has " + std::to_string(rows) + " rows, expected " +
-                      std::to_string(expected_rows) + " (one per snapshot)");
+  const std::vector<hsize_t> dims = hdf5::dataset_shape(file, name);
+  if (dims[0] != expected_rows || dims.size() != 2)
+    throw hdf5::Refused(std::string("dataset /") + name + " has " + std::to_string(dims[0]) + " rows" +
+                      (dims.size() != 2 ? " and rank 1" : "") + ", expected " + std::to_string(expected_rows) +
+                      " (one per snapshot) and rank 2");
+  hdf5::read_double_dataset(file, name, buf, rows, cols);
   return Eigen::Map<Eigen::MatrixXd>(buf.data(), static_cast<Eigen::Index>(cols), static_cast<Eigen::Index>(rows));
 }
 
 template <typename T>
-std::vector<T> read_vector(hid_t file, const char* name, hid_t mem_type, hsize_t expected) {
+std::vector<T> read_vector(hid_t file, const char* name, hsize_t expected) {
   std::vector<T> out;
   hsize_t rows = 0, cols = 0;
-  read_dataset(file, name, mem_type, out, rows, cols);
-  if (rows != expected || cols != 1)
-    throw Hdf5Failure(std::string("dataset /") + name + " has " + std::to_string(rows * cols) + " entries, expected " +
-                      std::to_string(expected));
+  // Shape first: the size of /status bounds every other dataset before any allocation.
+  const std::vector<hsize_t> dims = hdf5::dataset_shape(file, name);
+  if (dims.size() != 1 || dims[0] != expected)
+    throw hdf5::Refused(std::string("dataset /") + name + " has shape (" + std::to_string(dims[0]) +
+                      (dims.size() == 2 ? ", " + std::to_string(dims[1]) : std::string()) + "), expected (" +
+                      std::to_string(expected) + ")");
+  if constexpr (std::is_same_v<T, int>) hdf5::read_int_dataset(file, name, out, rows, cols);
+  else hdf5::read_double_dataset(file, name, out, rows, cols);
   return out;
+}
+
+std::string format_value(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+/// Refuses values that no offline run writes: non-finite numbers, negative
+/// pressures (beyond rounding), negative counts or times, a training size < 1.
+void validate_values(const SnapshotDatabase& db) {
+  const auto first_bad = [](const Eigen::MatrixXd& m, const auto& bad) -> std::string {
+    for (Eigen::Index j = 0; j < m.cols(); ++j)
+      for (Eigen::Index i = 0; i < m.rows(); ++i)
+        if (bad(m(i, j)))
+          return "row " + std::to_string(j) + ", column " + std::to_string(i) + " holds " + format_value(m(i, j));
+    return "";
+  };
+  const auto not_finite = [](double v) { return !std::isfinite(v); };
+  for (const auto& [name, m] : {std::pair<const char*, const Eigen::MatrixXd*>{"parameters", &db.parameters},
+                                {"primal", &db.primal}, {"dual", &db.dual}})
+    if (const std::string where = first_bad(*m, not_finite); !where.empty())
+      throw hdf5::Refused(std::string("dataset /") + name + " " + where + ", expected finite numbers");
+  // Contact pressures are >= 0; the FOM's dual QP may leave rounding-level negatives.
+  const double scale = std::max(1.0, db.dual.size() ? db.dual.cwiseAbs().maxCoeff() : 0.0);
+  if (const std::string where = first_bad(db.dual, [&](double v) { return v < -kNegativePressureTolerance * scale; });
+      !where.empty())
+    throw hdf5::Refused("dataset /dual " + where + ", expected contact pressures >= 0");
+  for (size_t j = 0; j < db.time_s.size(); ++j)
+    if (!(db.time_s[j] >= 0.0) || !std::isfinite(db.time_s[j]) || db.iterations[j] < 0 || db.pairing_iterations[j] < 0)
+      throw hdf5::Refused("snapshot " + std::to_string(j) + " has a negative or non-finite time or iteration count");
+  if (db.training_size < 1)
+    throw hdf5::Refused("attribute training_size is " + std::to_string(db.training_size) + ", expected >= 1");
 }
 
 std::string join(const std::vector<std::string>& items, const char* sep) {
@@ -264,7 +214,7 @@ std::shared_ptr<const fom::Mesh> read_mesh(hid_t f) {
   auto mesh = std::make_shared<fom::Mesh>();
   std::vector<double> xy;
   hsize_t rows = 0, cols = 0;
-  read_dataset(f, "mesh/nodes", H5T_NATIVE_DOUBLE, xy, rows, cols);
+  read_dataset(f, "mesh/nodes", xy, rows, cols);
   if (cols != 2) throw Hdf5Failure("dataset /mesh/nodes does not have 2 columns");
   for (double v : xy)
     if (!std::isfinite(v)) throw Hdf5Failure("dataset /mesh/nodes holds a non-finite coordinate");
@@ -276,22 +226,22 @@ std::shared_ptr<const fom::Mesh> read_mesh(hid_t f) {
                                                 ", expected 0.." + std::to_string(nn - 1));
   };
   std::vector<int> quads;
-  read_dataset(f, "mesh/quads", H5T_NATIVE_INT, quads, rows, cols);
+  read_dataset(f, "mesh/quads", quads, rows, cols);
   if (cols != 4) throw Hdf5Failure("dataset /mesh/quads does not have 4 columns");
   check_ids(quads, "mesh/quads");
   for (size_t q = 0; q + 3 < quads.size(); q += 4) mesh->quads.push_back({quads[q], quads[q + 1], quads[q + 2], quads[q + 3]});
-  mesh->quad_body = read_vector<int>(f, "mesh/quad_body", H5T_NATIVE_INT, rows);
-  mesh->body_names = read_string_list(f, "mesh/body_names");
+  mesh->quad_body = read_vector<int>(f, "mesh/quad_body", rows);
+  mesh->body_names = read_string_list(f, "mesh/body_names", hdf5::file_size(f));
   for (int b : mesh->quad_body)
     if (b < 0 || b >= static_cast<int>(mesh->body_names.size()))
       throw Hdf5Failure("dataset /mesh/quad_body holds the body " + std::to_string(b) + " of " +
                         std::to_string(mesh->body_names.size()));
-  const std::vector<std::string> curves = read_string_list(f, "mesh/curve_names");
+  const std::vector<std::string> curves = read_string_list(f, "mesh/curve_names", hdf5::file_size(f));
   for (size_t i = 0; i < curves.size(); ++i) {
     const std::string base = "mesh/curve_" + std::to_string(i);
     std::vector<int> nodes, segs;
-    read_dataset(f, (base + "_nodes").c_str(), H5T_NATIVE_INT, nodes, rows, cols);
-    read_dataset(f, (base + "_segments").c_str(), H5T_NATIVE_INT, segs, rows, cols);
+    read_dataset(f, (base + "_nodes").c_str(), nodes, rows, cols);
+    read_dataset(f, (base + "_segments").c_str(), segs, rows, cols);
     if (cols != 2 && !segs.empty()) throw Hdf5Failure("dataset /" + base + "_segments does not have 2 columns");
     check_ids(nodes, base + "_nodes");
     check_ids(segs, base + "_segments");
@@ -317,7 +267,11 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
       db.iterations.size() != n || db.pairing_iterations.size() != n || db.time_s.size() != n)
     throw std::invalid_argument("write_database: inconsistent snapshot counts");
   silence_hdf5();
-  const std::string tmp = temporary_path_for(path);
+  check_output_path(path);
+  // The file is built in memory and written by write_file_atomically: HDF5 never
+  // writes to the disk, so a full disk is our error to report, not a half-closed
+  // file left inside libhdf5.
+  std::string image;
   try {
     // Object modification times are not stored, so that two runs on the same
     // data give the same bytes (except the timing datasets).
@@ -325,7 +279,7 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
     check(H5Pset_obj_track_times(fcpl.id(), false), "file creation properties");
     Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "dataset creation properties");
     check(H5Pset_obj_track_times(dcpl.id(), false), "dataset creation properties");
-    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, fcpl.id(), H5P_DEFAULT), H5Fclose, "file creation");
+    Handle file(hdf5::create_memory_file(path, fcpl.id()), H5Fclose, "file creation");
     const hid_t f = file.id();
 
     const int version = kDatabaseFormatVersion;
@@ -356,13 +310,12 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
                   db.pairing_iterations.data());
     write_dataset(f, dcpl.id(), "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, n, 0, db.time_s.data());
     write_problem(f, dcpl.id(), db);
+    image = hdf5::file_image(f);
     file.close("file close");
   } catch (const Hdf5Failure& e) {
-    std::remove(tmp.c_str());
-    throw InputError("cannot write database '" + path + "': HDF5 failed on " + e.what() +
-                     " (folder missing, not writable or disk full?)");
+    throw InputError("cannot write database '" + path + "': HDF5 failed on " + e.what());
   }
-  commit_temporary(tmp, path);
+  write_file_atomically(path, [&image](std::ostream& out) { out.write(image.data(), static_cast<std::streamsize>(image.size())); });
 }
 
 SnapshotDatabase read_database(const std::string& path) {
@@ -380,7 +333,7 @@ SnapshotDatabase read_database(const std::string& path) {
     const hid_t f = file.id();
     if (!has_attribute(f, "format_version"))
       throw InputError("database '" + path + "' has no format_version attribute; not a contactrom database");
-    const int version = read_scalar_attribute<int>(f, "format_version", H5T_NATIVE_INT);
+    const int version = hdf5::read_int_attribute(f, "format_version");
     if (version != kDatabaseFormatVersion)
       throw InputError("database '" + path + "' has format_version " + std::to_string(version) +
                        ", but this contactrom reads version " + std::to_string(kDatabaseFormatVersion) + "; rebuild it with contactrom offline");
@@ -388,55 +341,58 @@ SnapshotDatabase read_database(const std::string& path) {
     db.mesh_fingerprint = read_string_attribute(f, "mesh_fingerprint");
     db.created_by = read_string_attribute(f, "created_by");
     db.training_kind = read_string_attribute(f, "training_kind");
-    db.training_size = read_scalar_attribute<int>(f, "training_size", H5T_NATIVE_INT);
+    db.training_size = hdf5::read_int_attribute(f, "training_size");
     db.param_names = split(read_string_attribute(f, "param_names"), ',');
     if (has_attribute(f, "setup_time_s"))
-      db.setup_time_s = read_scalar_attribute<double>(f, "setup_time_s", H5T_NATIVE_DOUBLE);
+      db.setup_time_s = hdf5::read_double_attribute(f, "setup_time_s");
     if (has_attribute(f, "wall_time_s"))
-      db.wall_time_s = read_scalar_attribute<double>(f, "wall_time_s", H5T_NATIVE_DOUBLE);
-    if (has_attribute(f, "threads")) db.threads = read_scalar_attribute<int>(f, "threads", H5T_NATIVE_INT);
+      db.wall_time_s = hdf5::read_double_attribute(f, "wall_time_s");
+    if (has_attribute(f, "threads")) db.threads = hdf5::read_int_attribute(f, "threads");
 
     std::vector<int> status;
     hsize_t n = 0, cols = 0;
-    read_dataset(f, "status", H5T_NATIVE_INT, status, n, cols);
-    if (cols != 1) throw Hdf5Failure("dataset /status is not one-dimensional");
+    if (hdf5::dataset_shape(f, "status").size() != 1) throw hdf5::Refused("dataset /status is not one-dimensional");
+    hdf5::read_int_dataset(f, "status", status, n, cols);
     db.parameters = read_matrix(f, "parameters", n);
     db.primal = read_matrix(f, "primal", n);
     db.dual = read_matrix(f, "dual", n);
-    db.iterations = read_vector<int>(f, "iterations", H5T_NATIVE_INT, n);
-    db.pairing_iterations = read_vector<int>(f, "pairing_iterations", H5T_NATIVE_INT, n);
-    db.time_s = read_vector<double>(f, "time_s", H5T_NATIVE_DOUBLE, n);
+    db.iterations = read_vector<int>(f, "iterations", n);
+    db.pairing_iterations = read_vector<int>(f, "pairing_iterations", n);
+    db.time_s = read_vector<double>(f, "time_s", n);
     for (int s : status) {
       if (s < 0 || s > static_cast<int>(Status::InvalidInput))
-        throw Hdf5Failure("dataset /status holds the unknown status code " + std::to_string(s));
+        throw hdf5::Refused("dataset /status holds the unknown status code " + std::to_string(s));
       db.status.push_back(static_cast<Status>(s));
     }
     if (db.parameters.rows() != static_cast<Eigen::Index>(db.param_names.size()))
-      throw Hdf5Failure("dataset /parameters has " + std::to_string(db.parameters.rows()) +
+      throw hdf5::Refused("dataset /parameters has " + std::to_string(db.parameters.rows()) +
                         " columns but param_names lists " + std::to_string(db.param_names.size()));
     if (db.training_kind != "train" && db.training_kind != "level" && db.training_kind != "list")
-      throw Hdf5Failure("attribute training_kind is '" + db.training_kind + "', expected 'train', 'level' or 'list'");
+      throw hdf5::Refused("attribute training_kind is '" + db.training_kind + "', expected 'train', 'level' or 'list'");
     if (H5Lexists(f, "problem_file", H5P_DEFAULT) > 0) {
-      const std::vector<std::string> text = read_string_list(f, "problem_file");
-      if (text.size() != 1) throw Hdf5Failure("dataset /problem_file does not hold one text");
+      const std::vector<std::string> text = read_string_list(f, "problem_file", hdf5::file_size(f));
+      if (text.size() != 1) throw hdf5::Refused("dataset /problem_file does not hold one text");
       db.problem_text = text[0];
     }
     if (H5Lexists(f, "mesh", H5P_DEFAULT) > 0) db.mesh = read_mesh(f);
     const Eigen::MatrixXd points = read_matrix(f, "contact/points", static_cast<hsize_t>(db.dual.rows()));
-    if (points.rows() != 2) throw Hdf5Failure("dataset /contact/points does not have 2 columns");
+    if (points.rows() != 2) throw hdf5::Refused("dataset /contact/points does not have 2 columns");
     db.contact_points = points;
     const std::vector<double> weights =
-        read_vector<double>(f, "contact/weights", H5T_NATIVE_DOUBLE, static_cast<hsize_t>(db.dual.rows()));
+        read_vector<double>(f, "contact/weights", static_cast<hsize_t>(db.dual.rows()));
     db.contact_weights = Eigen::Map<const Eigen::VectorXd>(weights.data(), static_cast<Eigen::Index>(weights.size()));
     std::vector<double> lift;
     hsize_t terms = 0, width = 0;
-    read_dataset(f, "lifting", H5T_NATIVE_DOUBLE, lift, terms, width);
+    read_dataset(f, "lifting", lift, terms, width);
     if (width != static_cast<hsize_t>(db.primal.rows()))
-      throw Hdf5Failure("dataset /lifting has " + std::to_string(width) + " columns, expected one per dof (" +
+      throw hdf5::Refused("dataset /lifting has " + std::to_string(width) + " columns, expected one per dof (" +
                         std::to_string(db.primal.rows()) + ")");
     db.lifting_terms = Eigen::Map<Eigen::MatrixXd>(lift.data(), static_cast<Eigen::Index>(width),
                                                    static_cast<Eigen::Index>(terms));
+    validate_values(db);
     file.close("file close");
+  } catch (const hdf5::Refused& e) {
+    throw InputError("database '" + path + "' is not a valid contactrom database: " + e.what());
   } catch (const Hdf5Failure& e) {
     throw InputError("database '" + path + "' is truncated or corrupt (HDF5 cannot read " + e.what() + ")");
   }
@@ -461,7 +417,36 @@ void check_database(const SnapshotDatabase& db, const fom::Problem& problem, con
   if (db.training_kind != selector)
     throw InputError("database '" + path + "' selects its training set by '" + db.training_kind + "', but " +
                      problem.name() + " uses '" + selector + "'");
+  check_training_set(db, problem, path);
 }
+
+void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path) {
+  for (int j = 0; j < db.num_snapshots(); ++j) {
+    try {
+      problem.check_param(db.parameter(j));
+    } catch (const InputError& e) {
+      throw InputError("database '" + path + "' dataset /parameters row " + std::to_string(j) + ": " + e.what());
+    }
+  }
+  const std::string option = db.training_kind == "level" ? "level " : db.training_kind == "list" ? "the list of " : "training size ";
+  std::vector<fom::Param> expected;
+  try {
+    expected = fom::training_set(problem, db.training_size);
+  } catch (const InputError& e) {
+    throw InputError("database '" + path + "' attribute training_size: " + e.what());
+  }
+  const auto mismatch = [&](const std::string& why) {
+    return InputError("database '" + path + "' claims " + option + std::to_string(db.training_size) + " of " +
+                      problem.name() + ", but " + why + "; expected the snapshots of that training set");
+  };
+  if (static_cast<int>(expected.size()) != db.num_snapshots())
+    throw mismatch("it holds " + std::to_string(db.num_snapshots()) + " snapshots instead of " +
+                   std::to_string(expected.size()));
+  for (int j = 0; j < db.num_snapshots(); ++j) {
+    const double scale = std::max(1.0, expected[j].cwiseAbs().maxCoeff());
+    if ((db.parameter(j) - expected[j]).cwiseAbs().maxCoeff() > kParameterMatchTolerance * scale)
+      throw mismatch("its snapshot " + std::to_string(j) + " is not at the training parameter of that set");
+  }
 
 void describe_problem(const fom::Problem& problem, SnapshotDatabase& db) {
   db.problem = problem.name();
@@ -490,6 +475,8 @@ std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, 
   }
   check_database(db, *problem, path);
   return problem;
+
+}
 }
 
 std::vector<fom::Param> database_training_set(const SnapshotDatabase& db, const fom::Problem& problem) {

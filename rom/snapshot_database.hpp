@@ -71,16 +71,19 @@ struct SnapshotDatabase {
   std::vector<int> successful_snapshots() const;
 };
 
-/// \brief Writes `db` to `path` (HDF5) atomically: the file is written at
-/// temporary_path_for(path) and renamed over `path` once complete.
-/// \throws InputError naming `path` if the folder is not writable or HDF5 fails;
-///   no partial file is left behind.
+/// \brief Writes `db` to `path` (HDF5) atomically: the file is built in memory,
+/// written to a temporary file next to `path` and renamed over it once complete.
+/// \throws InputError naming `path` and the reason if the target is refused
+///   (fom/atomic_file.hpp: a link, folder or device), the folder is not writable
+///   or the disk is full; no partial file is left behind.
 void write_database(const std::string& path, const SnapshotDatabase& db);
 
 /// \brief Reads a database written by write_database.
 /// \throws InputError (one line, naming `path`) if the file is missing, is not an
-///   HDF5 file, is truncated or corrupt, has another `format_version`, or has
-///   inconsistent dataset sizes.
+///   HDF5 file, is truncated or corrupt, has another `format_version`, has
+///   inconsistent dataset sizes or an attribute of the wrong shape or type, declares
+///   a dataset larger than the file, or holds values no offline run writes
+///   (non-finite numbers, negative pressures, times or counts).
 SnapshotDatabase read_database(const std::string& path);
 
 /// \brief Checks that `db` (read from `path`) was built for `problem`: same
@@ -98,6 +101,13 @@ std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, 
 /// \brief Fills the problem fields of `db` (name, fingerprint, text, mesh, contact
 /// points, lifting terms) from `problem`.
 void describe_problem(const fom::Problem& problem, SnapshotDatabase& db);
+
+/// \brief Checks that every stored parameter lies in `problem`'s range and that
+/// the snapshots are those of the training set named by the database's
+/// training_size (same count, same parameters): a database relabelled with
+/// another size or level is refused. Called by check_database.
+/// \throws InputError naming `path`, the dataset or attribute and the value.
+void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path);
 
 /// \brief Training set of `problem` selected by the database's options
 /// (training_set(training_size)).

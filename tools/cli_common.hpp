@@ -1,14 +1,50 @@
 #pragma once
 /// \file cli_common.hpp
 /// \brief Small helpers shared by the subcommands.
+#include <CLI/CLI.hpp>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "fom/input_values.hpp"
 #include "fom/kkt.hpp"
 #include "fom/problem.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::cli {
+
+/// Adds a real-valued option checked by the shared validation layer
+/// (fom/input_values.hpp): NaN, infinities, trailing text and values outside
+/// `range` end the run with one line quoting the value as typed.
+inline CLI::Option* add_number(CLI::App* sub, const std::string& name, double& target, const std::string& help,
+                               const Interval& range) {
+  return sub->add_option_function<std::string>(
+                name, [&target, name, range](const std::string& text) { target = parse_number(text, name, range); },
+                help)
+      ->type_name("NUMBER");
+}
+
+/// Adds an integer option in [lower, upper]; "2.5" is refused as not an integer.
+template <typename Int>
+CLI::Option* add_integer(CLI::App* sub, const std::string& name, Int& target, const std::string& help,
+                         long long lower, long long upper) {
+  return sub->add_option_function<std::string>(
+                name,
+                [&target, name, lower, upper](const std::string& text) {
+                  target = static_cast<Int>(parse_integer(text, name, lower, upper));
+                },
+                help)
+      ->type_name("INT");
+}
+
+/// Validator of a file or folder option: an empty value ("--out ''") is refused
+/// rather than read as "not given".
+inline CLI::Validator non_empty_path() {
+  return CLI::Validator(
+      [](std::string& value) {
+        return value.empty() ? std::string("'' is empty; expected a path") : std::string();
+      },
+      "PATH");
+}
 
 /// A parameter as a JSON number (one value) or array (several).
 inline nlohmann::json param_json(const fom::Param& mu) {

@@ -32,6 +32,7 @@
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"
+#include "tools/cli_common.hpp"
 
 namespace contactrom::cli {
 namespace {
@@ -207,15 +208,14 @@ CommandRegistrar reg("bench", [](CLI::App& app) {
   auto* sub = app.add_subcommand("bench", "Median per-query times of the FOM solvers and every ROM, in one run");
   sub->add_option("--problem", a->problem, "a shipped problem (contactrom problems) or a problem file path");
   sub->add_option("--db", a->db, "a snapshot database instead of --problem (no offline stage)");
-  sub->add_option("--train", a->train, "training size (default: the problem file's [training] default_size; hertz 30)");
-  sub->add_option("--level", a->level, "training level (default: the problem file's default_size; ironing 7, ironing2 3)");
-  sub->add_option("--refine", a->refine, "extra uniform mesh refinements (each splits every quad in four)")
-      ->check(CLI::Range(0, 6));
-  sub->add_option("--delta", a->delta, "POD energy tolerance (default 1e-8)");
-  sub->add_option("--repeats", a->repeats, "timing passes over the queries (default 3)");
-  sub->add_option("--queries", a->queries, "number of validation parameters timed (default 30)");
-  sub->add_option("--ipopt-queries", a->ipopt_queries, "queries timed for Ipopt (default 5)");
-  sub->add_option("--threads", a->threads, "threads of the offline stage (default: all cores)");
+  add_integer(sub, "--train", a->train, "training size (default: the problem file's [training] default_size; hertz 30)", 1, 10000000);
+  add_integer(sub, "--level", a->level, "training level (default: the problem file's default_size; ironing 7, ironing2 3)", 0, 20);
+  add_integer(sub, "--refine", a->refine, "extra uniform mesh refinements (each splits every quad in four)", 0, 6);
+  add_number(sub, "--delta", a->delta, "POD energy tolerance (default 1e-8)", Interval::closed(0, 1));
+  add_integer(sub, "--repeats", a->repeats, "timing passes over the queries (default 3)", 1, 1000);
+  add_integer(sub, "--queries", a->queries, "number of validation parameters timed (default 30)", 1, 1000000);
+  add_integer(sub, "--ipopt-queries", a->ipopt_queries, "queries timed for Ipopt (default 5)", 1, 1000000);
+  add_integer(sub, "--threads", a->threads, "threads of the offline stage (default: all cores)", 1, 1024);
   sub->add_flag("--json", a->json, "print one JSON object");
   sub->callback([a] { run_bench(*a); });
 });

@@ -25,6 +25,7 @@
 #include "rom/nnls.hpp"
 #include "rom/omp.hpp"
 #include "tools/cli.hpp"
+#include "tools/cli_common.hpp"
 
 namespace {
 
@@ -180,8 +181,10 @@ const contactrom::cli::CommandRegistrar registrar("bench-sparse", [](CLI::App& a
   auto args = std::make_shared<BenchArgs>();
   auto* sub = app.add_subcommand("bench-sparse", "Micro-benchmark of the NNLS, OMP, FOCUSS and nnFOCUSS kernels");
   sub->add_flag("--json", args->json, "print one JSON object");
-  sub->add_option("--repeats", args->repeats, "timing samples per kernel, median reported (default 7)");
-  sub->add_option("--noise", args->noise, "relative Gaussian noise added to the planted signals (default 0)");
+  contactrom::cli::add_integer(sub, "--repeats", args->repeats, "timing samples per kernel, median reported (default 7)",
+                               1, 1000);
+  contactrom::cli::add_number(sub, "--noise", args->noise, "relative Gaussian noise added to the planted signals (default 0)",
+                              contactrom::Interval::at_least(0));
   sub->callback([args] { run_bench(*args); });
 });
 

@@ -60,6 +60,7 @@ struct ChlsArgs {
 };
 
 void run_chls(const ChlsArgs& a) {
+  if (!a.out.empty()) check_output_path(a.out);
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
   const std::vector<int> used = db.successful_snapshots();
@@ -118,8 +119,10 @@ void run_chls(const ChlsArgs& a) {
 CommandRegistrar reg_chls("chls", [](CLI::App& app) {
   auto args = std::make_shared<ChlsArgs>();
   auto* sub = app.add_subcommand("chls", "Leave-one-out convex hull least squares of the primal snapshots");
-  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
-  sub->add_option("--out", args->out, "CSV file: parameter columns, chls_error, status, iterations, support");
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
+      ->check(non_empty_path())->required();
+  sub->add_option("--out", args->out, "CSV file: parameter columns, chls_error, status, iterations, support")
+      ->check(non_empty_path());
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_chls(*args); });
 });
@@ -144,6 +147,7 @@ struct HullRow {
 };
 
 void run_hull_report(const HullArgs& a) {
+  if (!a.out.empty()) check_output_path(a.out);
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
   rom::check_convex_hull_applicable(*problem);
@@ -297,30 +301,28 @@ void run_hull_report(const HullArgs& a) {
 CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
   auto args = std::make_shared<HullArgs>();
   auto* sub = app.add_subcommand("hull-report", "Convex-hull ROM errors, sparsity and KKT compliance per query");
-  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
+      ->check(non_empty_path())->required();
   sub->add_option("--set", args->set, "training | validation (default)")
       ->check(CLI::IsMember({"training", "validation"}));
-  sub->add_option("--delta", args->delta, "POD/SVD energy tolerance (default 1e-8; paper rope: 1e-7)")
-      ->check(CLI::Range(0.0, 1.0));
+  add_number(sub, "--delta", args->delta, "POD/SVD energy tolerance (default 1e-8; paper rope: 1e-7)", Interval::closed(0, 1));
   sub->add_option("--basis", args->basis, "projection basis: svd (default) | random")
       ->check(CLI::IsMember({"svd", "random"}));
-  sub->add_option("--basis-delta", args->basis_delta, "SVD tolerance of the projection basis (default: --delta)");
-  sub->add_option("--rank-l", args->rank_l, "random basis: number of combinations L (default: SVD rank)")
-      ->check(CLI::Range(1, 100000));
-  sub->add_option("--seed", args->seed, "random basis: seed of std::mt19937_64 (default 42)")
-      ->check(CLI::NonNegativeNumber);
-  sub->add_option("--sum-weight", args->sum_weight, "weight of the convexity row, relative (default 0.1)")
-      ->check(CLI::PositiveNumber);
+  add_number(sub, "--basis-delta", args->basis_delta, "SVD tolerance of the projection basis (default: --delta)",
+             Interval::closed(0, 1));
+  add_integer(sub, "--rank-l", args->rank_l, "random basis: number of combinations L (default: SVD rank)", 1, 100000);
+  add_integer(sub, "--seed", args->seed, "random basis: seed of std::mt19937_64 (default 42)", 0,
+              std::numeric_limits<long long>::max());
+  add_number(sub, "--sum-weight", args->sum_weight, "weight of the convexity row, relative (default 0.1)", Interval::greater_than(0));
   sub->add_flag("--no-polish", args->no_polish, "keep the plain nnFOCUSS coefficients (no exact simplex re-solve)");
-  sub->add_option("--max-pairing-iterations", args->max_pairing_iterations, "pairing fixed-point cap (default 20)")
-      ->check(CLI::Range(1, 100000));
+  add_integer(sub, "--max-pairing-iterations", args->max_pairing_iterations, "pairing fixed-point cap (default 20)", 1, 100000);
   sub->add_option("--option", args->options,
                   "further convex-hull setting KEY=VALUE (repeatable; keys: see rom/convex_hull.hpp)");
-  sub->add_option("--out", args->out, "CSV file, one row per query");
-  sub->add_option("--threads", args->threads, "threads for the FOM references (default: hardware concurrency)")
-      ->check(CLI::Range(1, 1024));
+  sub->add_option("--out", args->out, "CSV file, one row per query")
+      ->check(non_empty_path());
+  add_integer(sub, "--threads", args->threads, "threads for the FOM references (default: hardware concurrency)", 1, 1024);
   sub->add_flag("--time", args->time, "also time the online solve (rom::time_online)");
-  sub->add_option("--repeats", args->repeats, "passes over the set for --time (default 3)")->check(CLI::Range(1, 1000));
+  add_integer(sub, "--repeats", args->repeats, "passes over the set for --time (default 3)", 1, 1000);
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_hull_report(*args); });
 });

@@ -28,6 +28,7 @@
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"
+#include "tools/cli_common.hpp"
 
 namespace contactrom::cli {
 namespace {
@@ -167,11 +168,11 @@ void run_demo(const DemoArgs& a) {
 CommandRegistrar reg("demo", [](CLI::App& app) {
   auto args = std::make_shared<DemoArgs>();
   auto* sub = app.add_subcommand("demo", "Full pipeline on hertz: FOM table, offline, online greedy with errors and speedup");
-  sub->add_option("--dir", args->dir, "keep the database in this folder (default: temporary, removed)");
-  sub->add_option("--train", args->train, "training size (default 30)")->check(CLI::Range(2, 1000));
-  sub->add_option("--delta", args->delta, "POD energy tolerance (default 1e-8)")->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--threads", args->threads, "offline threads (default: hardware concurrency)")
-      ->check(CLI::Range(1, 1024));
+  sub->add_option("--dir", args->dir, "keep the database in this folder (default: temporary, removed)")
+      ->check(non_empty_path());
+  add_integer(sub, "--train", args->train, "training size (default 30)", 2, 1000);
+  add_number(sub, "--delta", args->delta, "POD energy tolerance (default 1e-8)", Interval::closed(0, 1));
+  add_integer(sub, "--threads", args->threads, "offline threads (default: hardware concurrency)", 1, 1024);
   sub->callback([args] { run_demo(*args); });
 });
 

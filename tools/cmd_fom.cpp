@@ -26,7 +26,7 @@ void run_fom(const FomArgs& a) {
   fom::ProblemOptions popt;
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);
-  const fom::Param mu = fom::parse_param(*problem, a.param);
+  const fom::Param mu = parse_problem_param(*problem, a.param);
   fom::FomSolution sol;
   double setup = 0.0;
   if (a.solver == "active-set") {
@@ -38,11 +38,14 @@ void run_fom(const FomArgs& a) {
     setup = solver.setup_time();
     sol = solver.solve(mu);
   }
+  // A failed solve may carry no field at all (its status and message say why).
+  const bool has_fields = sol.u.size() == problem->num_dofs() && sol.lambda.size() == problem->contact().num_constraints();
+  if (!has_fields)
+    throw InputError("the " + a.solver + " solver returned no solution for problem '" + problem->name() + "' (status " +
+                     to_string(sol.status) + (sol.message.empty() ? "" : ": " + sol.message) + ")");
   const fom::KktResiduals kkt = fom::kkt_residuals(*problem, mu, sol.u, sol.lambda);
   if (!a.out.empty()) {
-    fom::ensure_directory(a.out);
-    fom::write_vtu(a.out + "/" + problem->name() + ".vtu", *problem, mu, sol.u, sol.lambda);
-    fom::write_surface_csv(a.out + "/" + problem->name() + "_surface.csv", *problem, sol.u, sol.lambda);
+    fom::write_fields(a.out, problem->name(), *problem, mu, sol.u, sol.lambda);
   }
   nlohmann::json j;
   j["problem"] = problem->name();
@@ -83,7 +86,8 @@ CommandRegistrar reg("fom", [](CLI::App& app) {
       ->check(CLI::Range(0, 6));
   sub->add_option("--solver", args->solver, "active-set (default) | ipopt")
       ->check(CLI::IsMember({"active-set", "ipopt"}));
-  sub->add_option("--out", args->out, "folder for <problem>.vtu and <problem>_surface.csv");
+  sub->add_option("--out", args->out, "folder for <problem>.vtu and <problem>_surface.csv")
+      ->check(non_empty_path());
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_fom(*args); });
 });

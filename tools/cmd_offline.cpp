@@ -21,6 +21,7 @@
 #include "rom/offline_mpi.hpp"
 #endif
 #include "rom/snapshot_database.hpp"
+#include "fom/atomic_file.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 
@@ -86,6 +87,7 @@ void run_offline(const OfflineArgs& a) {
 #else
   const Ranks ranks;
 #endif
+  if (ranks.root()) check_output_path(a.out);  // before the snapshots are computed
   fom::ProblemOptions popt;
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);
@@ -153,16 +155,14 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
   auto args = std::make_shared<OfflineArgs>();
   auto* sub = app.add_subcommand("offline", "Compute FOM snapshots at the training parameters into an HDF5 database");
   sub->add_option("--problem", args->problem, "a shipped problem (contactrom problems) or a problem file path")->required();
-  auto* train = sub->add_option("--train", args->train, "training size N, for problems with uniform or random training (hertz: d_i = 0.3 i/N)")
-                    ->check(CLI::Range(1, 10000000));
-  auto* level = sub->add_option("--level", args->level, "training level n, for problems with nested training (ironing: 2^n+1 points)")
-                    ->check(CLI::Range(0, 20));
-  sub->add_option("--refine", args->refine, "extra uniform mesh refinements (each splits every quad in four)")
-      ->check(CLI::Range(0, 6));
+  auto* train = add_integer(sub, "--train", args->train,
+                            "training size N, for problems with uniform or random training (hertz: d_i = 0.3 i/N)", 1, 10000000);
+  auto* level = add_integer(sub, "--level", args->level,
+                            "training level n, for problems with nested training (ironing: 2^n+1 points)", 0, 20);
+  add_integer(sub, "--refine", args->refine, "extra uniform mesh refinements (each splits every quad in four)", 0, 6);
   train->excludes(level);
-  sub->add_option("--out", args->out, "output database (.h5)")->required();
-  sub->add_option("--threads", args->threads, "worker threads (default: hardware concurrency)")
-      ->check(CLI::Range(1, 1024));
+  sub->add_option("--out", args->out, "output database (.h5)")->check(non_empty_path())->required();
+  add_integer(sub, "--threads", args->threads, "worker threads (default: hardware concurrency)", 1, 1024);
   sub->add_option("--part", args->part,
                   "k/K: only the k-th of K contiguous parts of the training set (join the parts with merge)");
   sub->add_flag("--progress", args->progress, "draw the progress bar even when stderr is not a terminal");

@@ -21,6 +21,7 @@
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
+#include "fom/atomic_file.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 
@@ -39,7 +40,7 @@ nlohmann::json selected_json(const std::vector<int>& selected) { return selected
 
 void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::ReducedModel& model,
                 const rom::OnlineSolver& solver) {
-  const fom::Param mu = fom::parse_param(problem, a.param);
+  const fom::Param mu = parse_problem_param(problem, a.param);
   const rom::OnlineResult res = solver.solve(mu);
   const fom::ActiveSetSolver fom_solver(problem);
   const fom::FomSolution ref = fom_solver.solve(mu);
@@ -49,10 +50,7 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
   std::vector<int> snapshots;
   for (int c : res.selected) snapshots.push_back(model.dictionary_snapshots()[c]);
   if (!a.out.empty()) {
-    fom::ensure_directory(a.out);
-    const std::string stem = a.out + "/" + problem.name() + "_" + solver.name();
-    fom::write_vtu(stem + ".vtu", problem, mu, res.u, res.lambda);
-    fom::write_surface_csv(stem + "_surface.csv", problem, res.u, res.lambda);
+    fom::write_fields(a.out, problem.name() + "_" + solver.name(), problem, mu, res.u, res.lambda);
   }
   nlohmann::json j;
   j["problem"] = problem.name();
@@ -64,6 +62,7 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
   j["primal_rank"] = model.primal_rank();
   j["status"] = to_string(res.status);
   j["converged"] = res.converged;
+  if (!res.message.empty()) j["message"] = res.message;
   j["iterations"] = res.iterations;
   j["sparsity"] = res.selected.size();
   j["selected"] = selected_json(snapshots);
@@ -80,7 +79,8 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
     return;
   }
   std::cout << "online " << solver.name() << " on " << problem.name() << " at " << j["param"].dump() << ": "
-            << to_string(res.status) << ", " << res.iterations << " iterations\n"
+            << to_string(res.status) << (res.message.empty() ? "" : " (" + res.message + ")") << ", "
+            << res.iterations << " iterations\n"
             << "dictionary " << model.dictionary_size() << " columns, primal rank " << model.primal_rank()
             << " (delta " << model.delta() << ")\n"
             << "selected snapshots " << j["selected"].dump() << " coefficients " << j["coefficients"].dump() << "\n"
@@ -145,6 +145,7 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
 }
 
 void run_online(const OnlineArgs& a) {
+  if (!a.out.empty() && a.param.empty()) check_output_path(a.out);
   if (!a.param.empty() && a.validation)
     throw InputError("--param and --validation exclude each other; give one");
   const rom::SnapshotDatabase db = rom::read_database(a.db);
@@ -181,28 +182,26 @@ void run_online(const OnlineArgs& a) {
 CommandRegistrar reg("online", [](CLI::App& app) {
   auto args = std::make_shared<OnlineArgs>();
   auto* sub = app.add_subcommand("online", "Evaluate a reduced model built from a snapshot database");
-  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
+      ->check(non_empty_path())->required();
   sub->add_option("--method", args->method, "online method (default greedy; see the error text for all)");
-  sub->add_option("--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--tau", args->tau, "greedy penetration threshold (default: tau = delta)")
-      ->check(CLI::NonNegativeNumber);
+  add_number(sub, "--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
+  add_number(sub, "--tau", args->tau, "greedy penetration threshold (default: tau = delta)", Interval::at_least(0));
   sub->add_option("--tau-scaling", args->tau_scaling, "absolute (default, paper) | relative")
       ->check(CLI::IsMember({"absolute", "relative"}));
   sub->add_option("--lifting", args->lifting,
                   "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet")
       ->check(CLI::IsMember({"harmonic", "dirichlet"}));
-  sub->add_option("--max-iterations", args->max_iterations, "iteration cap k_max (default 50)")
-      ->check(CLI::Range(1, 100000));
+  add_integer(sub, "--max-iterations", args->max_iterations, "iteration cap k_max (default 50)", 1, 100000);
   sub->add_option("--option", args->options,
                   "method setting KEY=VALUE, repeatable: init=empty|cell|nearest|primal, schedule, anderson_depth, "
                   "max_solves (greedy; see docs/rom.md); cpg_tolerance, cpg_max_size, inner_solve, init=empty|primal|cell "
                   "(cpg); inner_solve, init (full-dictionary); basis, rank_l, seed, ... (convex-hull; see docs/convex_hull.md)");
   sub->add_flag("--validation", args->validation, "evaluate on the validation set (default without --param)");
   sub->add_option("--param", args->param, "one query V or V1,V2");
-  sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)");
-  sub->add_option("--threads", args->threads, "threads for the FOM references (default: hardware concurrency)")
-      ->check(CLI::Range(1, 1024));
+  sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)")
+      ->check(non_empty_path());
+  add_integer(sub, "--threads", args->threads, "threads for the FOM references (default: hardware concurrency)", 1, 1024);
   sub->add_flag("--kkt", args->kkt, "also compute the FOM KKT residuals of every ROM solution");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_online(*args); });

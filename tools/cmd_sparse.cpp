@@ -11,7 +11,10 @@
 // --max-iter: NNLS active-set changes, FOCUSS/nnFOCUSS re-weighted solves, OMP atoms.
 // --json prints one object {method, status, iterations, residual, coefficients, ...};
 // a numerical failure is reported as a status (exit 0), bad input exits 2.
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <limits>
@@ -26,6 +29,7 @@
 #include "rom/nnls.hpp"
 #include "rom/omp.hpp"
 #include "tools/cli.hpp"
+#include "tools/cli_common.hpp"
 
 namespace {
 
@@ -102,6 +106,26 @@ SparseRun run_method(const SparseArgs& args, bool has_tol, bool has_max_iter, bo
   return run;
 }
 
+/// NNLS, OMP and nnFOCUSS work with the n x n Gram matrix of the dictionary's
+/// columns: refuse, naming the size, a dictionary whose Gram matrix cannot fit in
+/// this machine's memory instead of failing inside the allocator.
+void check_gram_fits(const SparseArgs& args, const MatrixXd& d) {
+  if (args.method == "focuss") return;
+  const double n = static_cast<double>(d.cols());
+  const double bytes = n * n * sizeof(double);
+  const double memory = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  if (memory > 0.0 && bytes > 0.5 * memory) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "dictionary '%s' has %lld columns: %s works with their %lld x %lld Gram matrix (%.3g GB), more than "
+                  "half of this machine's %.3g GB of memory; expected at most %lld columns",
+                  args.dictionary.c_str(), static_cast<long long>(d.cols()), args.method.c_str(),
+                  static_cast<long long>(d.cols()), static_cast<long long>(d.cols()), bytes / 1e9, memory / 1e9,
+                  static_cast<long long>(std::sqrt(0.5 * memory / sizeof(double))));
+    throw InputError(text);
+  }
+}
+
 void run_sparse(const SparseArgs& args, bool has_tol, bool has_max_iter, bool has_atoms) {
   if (args.method != "nnls" && args.method != "omp" && args.method != "focuss" && args.method != "nnfocuss") {
     throw InputError("unknown --method '" + args.method + "': expected nnls, omp, focuss or nnfocuss");
@@ -126,6 +150,7 @@ void run_sparse(const SparseArgs& args, bool has_tol, bool has_max_iter, bool ha
                      std::to_string(d.rows()) + " (the rows of dictionary '" + args.dictionary + "')");
   }
 
+  check_gram_fits(args, d);
   const SparseRun run = run_method(args, has_tol, has_max_iter, has_atoms, d, x);
   const double residual = (d * run.coefficients - x).norm();
   const double x_norm = x.norm();
@@ -169,13 +194,21 @@ const contactrom::cli::CommandRegistrar registrar("sparse", [](CLI::App& app) {
   auto args = std::make_shared<SparseArgs>();
   auto* sub = app.add_subcommand("sparse", "Sparse regression of a signal on a dictionary (NNLS, OMP, FOCUSS, nnFOCUSS)");
   sub->add_option("--method", args->method, "nnls | omp | focuss | nnfocuss")->required();
-  sub->add_option("--dictionary", args->dictionary, "CSV file of D (one row per line)")->required();
-  sub->add_option("--signal", args->signal, "CSV file of x (one column or one row)")->required();
-  auto* atoms = sub->add_option("--atoms", args->atoms, "OMP: largest number of atoms (default min(rows, cols))");
-  auto* tol = sub->add_option("--tol", args->tolerance,
-                              "tolerance: NNLS KKT (1e-12), OMP relative residual (1e-8), FOCUSS change (1e-10)");
-  auto* max_iter = sub->add_option("--max-iter", args->max_iterations,
-                                   "iteration cap: NNLS active-set changes (3n), FOCUSS solves (100), OMP atoms");
+  sub->add_option("--dictionary", args->dictionary, "CSV file of D (one row per line)")
+      ->check(contactrom::cli::non_empty_path())->required();
+  sub->add_option("--signal", args->signal, "CSV file of x (one column or one row)")
+      ->check(contactrom::cli::non_empty_path())->required();
+  using contactrom::Interval;
+  using contactrom::cli::add_integer;
+  using contactrom::cli::add_number;
+  auto* atoms = add_integer(sub, "--atoms", args->atoms, "OMP: largest number of atoms (default min(rows, cols))", 0,
+                            100000000);
+  auto* tol = add_number(sub, "--tol", args->tolerance,
+                         "tolerance: NNLS KKT (1e-12), OMP relative residual (1e-8), FOCUSS change (1e-10)",
+                         Interval::at_least(0));
+  auto* max_iter = add_integer(sub, "--max-iter", args->max_iterations,
+                               "iteration cap: NNLS active-set changes (3n), FOCUSS solves (100), OMP atoms", 1,
+                               100000000);
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args, atoms, tol, max_iter] {
     run_sparse(*args, tol->count() > 0, max_iter->count() > 0, atoms->count() > 0);

@@ -222,6 +222,7 @@ void write_csv(const std::string& path, const fom::Problem& problem, const std::
 }
 
 void run_verify(const VerifyArgs& a) {
+  if (!a.out.empty()) check_output_path(a.out);
   const std::vector<std::string> methods = split_methods(a.methods);
   const std::vector<std::string> names = rom::online_solver_names();
   for (const std::string& m : methods)
@@ -416,20 +417,16 @@ void run_verify(const VerifyArgs& a) {
 CommandRegistrar reg("verify", [](CLI::App& app) {
   auto args = std::make_shared<VerifyArgs>();
   auto* sub = app.add_subcommand("verify", "KKT verification of reduced solutions against the Ipopt reference");
-  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")->required();
+  sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
+      ->check(non_empty_path())->required();
   sub->add_option("--method", args->methods, "online method(s), comma-separated (e.g. greedy,cpg,full-dictionary)")
       ->required();
-  sub->add_option("--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--tau", args->tau, "penetration threshold of the reduced constraint (default: tau = delta)")
-      ->check(CLI::NonNegativeNumber);
+  add_number(sub, "--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
+  add_number(sub, "--tau", args->tau, "penetration threshold of the reduced constraint (default: tau = delta)", Interval::at_least(0));
   sub->add_option("--tau-scaling", args->tau_scaling, "absolute (default, paper) | relative")
       ->check(CLI::IsMember({"absolute", "relative"}));
-  sub->add_option("--max-iterations", args->max_iterations, "iteration cap k_max (default 50)")
-      ->check(CLI::Range(1, 100000));
-  sub->add_option("--cpg-tolerance", args->cpg_tolerance,
-                  "CPG cone-projection tolerance (default: 1e-2 hertz, 5e-2 ironing/ironing2, 1e-2 otherwise)")
-      ->check(CLI::Range(0.0, 1.0));
+  add_integer(sub, "--max-iterations", args->max_iterations, "iteration cap k_max (default 50)", 1, 100000);
+  add_number(sub, "--cpg-tolerance", args->cpg_tolerance, "CPG cone-projection tolerance (default: 1e-2 hertz, 5e-2 ironing/ironing2, 1e-2 otherwise)", Interval::closed(0, 1));
   sub->add_option("--inner-solve", args->inner_solve,
                   "cpg/full-dictionary saddle-point solve: nonnegative (default) | equality (textbook PDAS)")
       ->check(CLI::IsMember({"nonnegative", "equality"}));
@@ -437,14 +434,12 @@ CommandRegistrar reg("verify", [](CLI::App& app) {
                   "starting point of greedy/greedy-nested (empty|cell|nearest|primal; default cell) and of "
                   "cpg/full-dictionary (empty|primal|cell; default empty)");
   sub->add_option("--reference", args->reference, "reference solver: ipopt (default) | fom (custom active set)");
-  sub->add_option("--threads", args->threads, "threads for the reference solves (default: hardware concurrency)")
-      ->check(CLI::Range(1, 1024));
-  sub->add_option("--limit", args->limit, "use N evenly spaced validation parameters (default: all)")
-      ->check(CLI::Range(1, 1000000));
+  add_integer(sub, "--threads", args->threads, "threads for the reference solves (default: hardware concurrency)", 1, 1024);
+  add_integer(sub, "--limit", args->limit, "use N evenly spaced validation parameters (default: all)", 1, 1000000);
   sub->add_flag("--bench", args->bench, "also time each method and the FOM, in interleaved rounds (rom::time_interleaved)");
-  sub->add_option("--repeats", args->repeats, "timing passes over the parameters with --bench (default 3)")
-      ->check(CLI::Range(1, 1000));
-  sub->add_option("--out", args->out, "CSV file with one row per method and parameter");
+  add_integer(sub, "--repeats", args->repeats, "timing passes over the parameters with --bench (default 3)", 1, 1000);
+  sub->add_option("--out", args->out, "CSV file with one row per method and parameter")
+      ->check(non_empty_path());
   sub->add_flag("--progress", args->progress, "draw progress bars even when stderr is not a terminal");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_verify(*args); });

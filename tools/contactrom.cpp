@@ -10,8 +10,11 @@
 #include <algorithm>
 #include <iostream>
 #include <memory>
+#include <new>
+#include <stdexcept>
 
 #include "fom/errors.hpp"
+#include "fom/input_values.hpp"
 #include "tools/cli.hpp"
 #ifdef CONTACTROM_HAVE_MPI
 #include "rom/offline_mpi.hpp"
@@ -40,6 +43,17 @@ int main(int argc, char** argv) {
   if (rom::mpi::launched_by_mpi()) mpi_session = std::make_unique<rom::mpi::Session>();
   if (rom::mpi::world_rank() != 0) std::cerr.setstate(std::ios::badbit);
 #endif
+  // CLI11 would only say that a subcommand is required; name the unknown one.
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string name = argv[1];
+    const bool known = std::any_of(table.begin(), table.end(), [&](const auto& e) { return e.name == name; });
+    if (!known) {
+      std::string names;
+      for (const auto& e : table) names += (names.empty() ? "" : ", ") + e.name;
+      std::cerr << "contactrom: error: unknown command " << quoted(name) << "; expected one of: " << names << "\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -49,6 +63,14 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::cerr << "contactrom: error: " << e.what() << "\n";
     return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "contactrom: error: out of memory: a size given in the input (mesh, database, dictionary or option)"
+                 " is too large for this machine\n";
+    return 1;
+  } catch (const std::length_error&) {
+    std::cerr << "contactrom: error: a size given in the input (mesh, database, dictionary or option) is too large to"
+                 " allocate\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "contactrom: error: " << e.what() << "\n";
     return 1;

@@ -132,7 +132,7 @@ BOOST_AUTO_TEST_CASE(layout_as_seen_from_h5py) {
   const SnapshotDatabase db = synthetic(5, 40, 9);
   const std::string path = temp().file("layout.h5");
   contactrom::rom::write_database(path, db);
-  // /primal is n_snap × n_dofs, row j = snapshot j; attributes are Python str/int.
+  // /primal is n_snap × n_dofs, row j = snapshot j; string attributes are fixed-length (bytes in h5py).
   char script[2048];
   std::snprintf(script, sizeof script,
                 "/usr/bin/python3 -c \"import h5py, numpy as np; f = h5py.File('%s', 'r'); "
@@ -212,7 +212,8 @@ BOOST_AUTO_TEST_CASE(database_of_another_mesh_or_problem_is_refused) {
   db.problem = "hertz";
   db.mesh_fingerprint = hertz->fingerprint();
   db.param_names = {"d"};
-  db.parameters = Eigen::MatrixXd::Zero(1, 1);
+  db.training_size = 1;                               // hertz --train 1: d = 0.3
+  db.parameters = Eigen::MatrixXd::Constant(1, 1, 0.3);
   db.primal = Eigen::MatrixXd::Zero(hertz->num_dofs(), 1);
   db.dual = Eigen::MatrixXd::Zero(hertz->contact().num_constraints(), 1);
   BOOST_CHECK_NO_THROW(contactrom::rom::check_database(db, *hertz, "ok.h5"));

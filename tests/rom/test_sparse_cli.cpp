@@ -257,7 +257,7 @@ BOOST_AUTO_TEST_CASE(bad_input_gives_a_one_line_error_and_exit_code_2) {
       {sparse_args("lasso", d, x), "unknown --method 'lasso': expected nnls, omp, focuss or nnfocuss"},
       {sparse_args("nnls", dir.file("empty.csv"), x), "empty.csv: no values (empty file)"},
       {sparse_args("nnls", d, x, "--atoms 2"), "--atoms applies to --method omp only"},
-      {"bench-sparse --repeats 0", "--repeats 0: expected a count >= 1"},
+      {"bench-sparse --repeats 0", "--repeats '0' is outside the range; expected an integer in [1, 1000]"},
   };
   std::vector<std::string> args;
   for (const auto& c : cases) args.push_back(c.args);

@@ -1,0 +1,191 @@
+#include "rom/hdf5_io.hpp"
+
+#include <cstdio>
+#include <limits>
+
+namespace contactrom::rom::hdf5 {
+namespace {
+
+std::string attribute_what(const char* name) { return std::string("attribute ") + name; }
+std::string dataset_what(const char* name) { return std::string("dataset /") + name; }
+
+/// Number of elements of an attribute's dataspace (scalar: 1).
+hssize_t attribute_elements(hid_t attr, const std::string& what) {
+  Handle space(H5Aget_space(attr), H5Sclose, what);
+  const hssize_t n = H5Sget_simple_extent_npoints(space.id());
+  if (n < 0) throw Refused(what + " has an unreadable dataspace");
+  return n;
+}
+
+/// Opens a numeric attribute and checks it holds one element of class `cls`.
+template <typename T>
+T read_numeric_attribute(hid_t loc, const char* name, H5T_class_t cls, hid_t mem_type, const char* expected) {
+  const std::string what = attribute_what(name);
+  Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose, what);
+  Handle type(H5Aget_type(attr.id()), H5Tclose, what);
+  if (H5Tget_class(type.id()) != cls) throw Refused(what + " is not " + expected);
+  const hssize_t n = attribute_elements(attr.id(), what);
+  if (n != 1) throw Refused(what + " has " + std::to_string(n) + " elements, expected a single " + expected);
+  T value{};
+  check(H5Aread(attr.id(), mem_type, &value), what);
+  return value;
+}
+
+/// Reads a rank-1/2 dataset of class `cls` into `out` after checking its
+/// declared size against the file's size.
+template <typename T>
+void read_numeric_dataset(hid_t file, const char* name, H5T_class_t cls, hid_t mem_type, const char* expected,
+                          std::vector<T>& out, hsize_t& rows, hsize_t& cols) {
+  const std::string what = dataset_what(name);
+  Handle set(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, what);
+  Handle type(H5Dget_type(set.id()), H5Tclose, what);
+  if (H5Tget_class(type.id()) != cls) throw Refused(what + " does not hold " + expected);
+  const size_t element = H5Tget_size(type.id());
+  if (element == 0 || element > 16) throw Refused(what + " has elements of " + std::to_string(element) + " bytes");
+  const std::vector<hsize_t> dims = dataset_shape(file, name);
+  rows = dims[0];
+  cols = dims.size() == 2 ? dims[1] : 1;
+  // Declared bytes, overflow-checked, must fit in the file (datasets are stored
+  // uncompressed), and the elements in memory.
+  const std::uint64_t limit = file_size(file);
+  const long double declared = static_cast<long double>(rows) * static_cast<long double>(cols) * element;
+  if (declared > static_cast<long double>(limit))
+  {
+    char bytes[32];
+    std::snprintf(bytes, sizeof bytes, "%.3Lg", declared);
+    throw Refused(what + " declares " + std::to_string(rows) + " x " + std::to_string(cols) + " elements (" + bytes +
+                  " bytes), more than the file's " + std::to_string(limit) + " bytes");
+  }
+  out.assign(static_cast<size_t>(rows * cols), T{});
+  if (!out.empty()) check(H5Dread(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), what);
+}
+
+}  // namespace
+
+void silence() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
+Handle::Handle(hid_t id, Closer closer, const std::string& what) : m_id(id), m_closer(closer) {
+  if (id < 0) throw Failure(what);
+}
+
+Handle::~Handle() {
+  if (m_id >= 0) m_closer(m_id);
+}
+
+void Handle::close(const std::string& what) {
+  const herr_t rc = m_closer(m_id);
+  m_id = -1;
+  if (rc < 0) throw Failure(what);
+}
+
+void check(herr_t rc, const std::string& what) {
+  if (rc < 0) throw Failure(what);
+}
+
+void write_string_attribute(hid_t loc, const char* name, const std::string& value) {
+  const std::string what = attribute_what(name);
+  if (value.size() > kMaxStringAttribute) throw Refused(what + " is too long");
+  // Fixed length, padded with NULs: never a variable-length heap reference.
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose, what);
+  check(H5Tset_size(type.id(), value.empty() ? 1 : value.size()), what);
+  check(H5Tset_strpad(type.id(), H5T_STR_NULLPAD), what);
+  check(H5Tset_cset(type.id(), H5T_CSET_UTF8), what);
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, what);
+  Handle attr(H5Acreate2(loc, name, type.id(), space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
+  std::string buffer = value.empty() ? std::string(1, '\0') : value;
+  check(H5Awrite(attr.id(), type.id(), buffer.data()), what);
+}
+
+std::string read_string_attribute(hid_t loc, const char* name) {
+  const std::string what = attribute_what(name);
+  Handle attr(H5Aopen(loc, name, H5P_DEFAULT), H5Aclose, what);
+  Handle type(H5Aget_type(attr.id()), H5Tclose, what);
+  if (H5Tget_class(type.id()) != H5T_STRING) throw Refused(what + " is not a string");
+  if (H5Tis_variable_str(type.id()) != 0)
+    throw Refused(what + " is a variable-length string, expected a fixed-length one (not read)");
+  const hssize_t n = attribute_elements(attr.id(), what);
+  if (n != 1) throw Refused(what + " has " + std::to_string(n) + " elements, expected a single string");
+  const size_t size = H5Tget_size(type.id());
+  if (size == 0 || size > kMaxStringAttribute)
+    throw Refused(what + " has a string size of " + std::to_string(size) + " bytes");
+  // Read through a memory type of the same size, so the buffer always matches.
+  Handle mem(H5Tcopy(H5T_C_S1), H5Tclose, what);
+  check(H5Tset_size(mem.id(), size), what);
+  check(H5Tset_strpad(mem.id(), H5T_STR_NULLPAD), what);
+  const H5T_cset_t cset = H5Tget_cset(type.id());
+  if (cset != H5T_CSET_ASCII && cset != H5T_CSET_UTF8) throw Refused(what + " has an unknown character set");
+  check(H5Tset_cset(mem.id(), cset), what);
+  std::string buffer(size, '\0');
+  check(H5Aread(attr.id(), mem.id(), buffer.data()), what);
+  const size_t end = buffer.find('\0');
+  return end == std::string::npos ? buffer : buffer.substr(0, end);
+}
+
+bool has_attribute(hid_t loc, const char* name) { return H5Aexists(loc, name) > 0; }
+
+void write_scalar_attribute(hid_t loc, const char* name, hid_t file_type, hid_t mem_type, const void* value) {
+  const std::string what = attribute_what(name);
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, what);
+  Handle attr(H5Acreate2(loc, name, file_type, space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
+  check(H5Awrite(attr.id(), mem_type, value), what);
+}
+
+int read_int_attribute(hid_t loc, const char* name) {
+  return read_numeric_attribute<int>(loc, name, H5T_INTEGER, H5T_NATIVE_INT, "integer");
+}
+
+double read_double_attribute(hid_t loc, const char* name) {
+  return read_numeric_attribute<double>(loc, name, H5T_FLOAT, H5T_NATIVE_DOUBLE, "floating-point number");
+}
+
+std::uint64_t file_size(hid_t file) {
+  hsize_t size = 0;
+  check(H5Fget_filesize(file, &size), "the file size");
+  return size;
+}
+
+std::vector<hsize_t> dataset_shape(hid_t file, const char* name) {
+  const std::string what = dataset_what(name);
+  Handle set(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, what);
+  Handle space(H5Dget_space(set.id()), H5Sclose, what);
+  const int rank = H5Sget_simple_extent_ndims(space.id());
+  if (rank < 1 || rank > 2) throw Refused(what + " has rank " + std::to_string(rank) + ", expected 1 or 2");
+  std::vector<hsize_t> dims(static_cast<size_t>(rank), 0);
+  if (H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr) < 0) throw Failure(what);
+  return dims;
+}
+
+void read_int_dataset(hid_t file, const char* name, std::vector<int>& out, hsize_t& rows, hsize_t& cols) {
+  read_numeric_dataset(file, name, H5T_INTEGER, H5T_NATIVE_INT, "integers", out, rows, cols);
+}
+
+void read_double_dataset(hid_t file, const char* name, std::vector<double>& out, hsize_t& rows, hsize_t& cols) {
+  read_numeric_dataset(file, name, H5T_FLOAT, H5T_NATIVE_DOUBLE, "floating-point numbers", out, rows, cols);
+}
+
+void write_dataset(hid_t file, hid_t dcpl, const char* name, hid_t file_type, hid_t mem_type, int rank, hsize_t rows,
+                   hsize_t cols, const void* data) {
+  const std::string what = dataset_what(name);
+  const hsize_t dims[2] = {rows, cols};
+  Handle space(H5Screate_simple(rank, dims, nullptr), H5Sclose, what);
+  Handle set(H5Dcreate2(file, name, file_type, space.id(), H5P_DEFAULT, dcpl, H5P_DEFAULT), H5Dclose, what);
+  const hsize_t count = rank == 2 ? rows * cols : rows;
+  if (count > 0) check(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), what);
+}
+
+hid_t create_memory_file(const std::string& label, hid_t fcpl) {
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "file access properties");
+  check(H5Pset_fapl_core(fapl.id(), std::size_t{1} << 20, false), "file access properties");
+  return H5Fcreate(label.c_str(), H5F_ACC_TRUNC, fcpl, fapl.id());
+}
+
+std::string file_image(hid_t file) {
+  check(H5Fflush(file, H5F_SCOPE_GLOBAL), "file flush");
+  const ssize_t size = H5Fget_file_image(file, nullptr, 0);
+  if (size < 0) throw Failure("file image");
+  std::string image(static_cast<size_t>(size), '\0');
+  if (H5Fget_file_image(file, image.data(), image.size()) != size) throw Failure("file image");
+  return image;
+}
+
+}  // namespace contactrom::rom::hdf5

@@ -1,0 +1,122 @@
+#pragma once
+/// \file hdf5_io.hpp
+/// \brief Checked access to HDF5 files for the files contactrom writes and reads
+/// (snapshot databases, reduced models).
+///
+/// HDF5 itself trusts a file's metadata: it reads a string attribute of any
+/// shape into a buffer sized for one string, allocates whatever size a dataset
+/// declares, and follows variable-length string heaps that a corrupted file can
+/// point anywhere (libhdf5 1.10 crashes or hangs on such files). These helpers
+/// check before they read:
+///  - string attributes are written as scalar fixed-length UTF-8 strings, and read
+///    only from a scalar dataspace with a fixed-length string type of bounded
+///    size; a variable-length string is refused without being read;
+///  - numeric attributes must be scalar (or hold one element) of the expected
+///    class (integer or floating point);
+///  - datasets must have rank 1 or 2, the expected class, and a declared size
+///    that fits in the file (contactrom stores datasets uncompressed), so no
+///    allocation is larger than the file that asked for it.
+///
+/// Failures throw hdf5::Failure whose `what()` names the object and the
+/// problem ("attribute problem has 3 elements, expected a single string"); the
+/// caller adds the file name.
+#include <hdf5.h>
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace contactrom::rom::hdf5 {
+
+/// \brief A failed or refused HDF5 operation; `what()` names the object involved.
+struct Failure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// \brief A file refused by a check (wrong shape, type or size) rather than a
+/// failed HDF5 call; `what()` is a whole sentence naming the object.
+struct Refused : Failure {
+  using Failure::Failure;
+};
+
+/// \brief Turns off HDF5's own error printing (the caller reports one line instead).
+void silence();
+
+/// \brief Owns one HDF5 identifier and closes it with the matching H5*close.
+class Handle {
+ public:
+  using Closer = herr_t (*)(hid_t);
+  /// \throws Failure(`what`) if `id` is negative (the call that made it failed).
+  Handle(hid_t id, Closer closer, const std::string& what);
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle();
+  /// Closes now and reports failure (closing a file flushes it).
+  void close(const std::string& what);
+  hid_t id() const { return m_id; }
+
+ private:
+  hid_t m_id;
+  Closer m_closer;
+};
+
+/// \brief Throws Failure(`what`) if `rc` is negative.
+void check(herr_t rc, const std::string& what);
+
+/// \brief Largest string attribute read or written (bytes); longer is refused.
+inline constexpr std::size_t kMaxStringAttribute = std::size_t{1} << 24;
+
+/// \brief Writes a scalar fixed-length UTF-8 string attribute (h5py returns it as bytes
+/// or str depending on its version; its length is the string's, at least 1).
+void write_string_attribute(hid_t loc, const char* name, const std::string& value);
+
+/// \brief Reads a string attribute written by write_string_attribute.
+/// \throws Failure if it is missing, not a string, not scalar, a variable-length
+///   string (refused without reading: corrupted ones crash libhdf5), or longer
+///   than kMaxStringAttribute.
+std::string read_string_attribute(hid_t loc, const char* name);
+
+/// \brief Whether `loc` has an attribute `name`.
+bool has_attribute(hid_t loc, const char* name);
+
+/// \brief Writes a scalar numeric attribute.
+void write_scalar_attribute(hid_t loc, const char* name, hid_t file_type, hid_t mem_type, const void* value);
+
+/// \brief Reads a scalar 32-bit integer attribute (class integer, one element).
+int read_int_attribute(hid_t loc, const char* name);
+
+/// \brief Reads a scalar double attribute (class floating point, one element).
+double read_double_attribute(hid_t loc, const char* name);
+
+/// \brief Size of the open file `file` in bytes.
+std::uint64_t file_size(hid_t file);
+
+/// \brief Dimensions of a dataset of rank 1 ({rows}) or rank 2 ({rows, cols}).
+/// \throws Failure if it is missing or of another rank.
+std::vector<hsize_t> dataset_shape(hid_t file, const char* name);
+
+/// \brief Reads a rank-1 or rank-2 dataset of integers into `out` (row-major);
+/// returns its dimensions as (rows, cols), cols = 1 for rank 1.
+/// \throws Failure if it is missing, of another rank or class, or declares more
+///   bytes than the file holds.
+void read_int_dataset(hid_t file, const char* name, std::vector<int>& out, hsize_t& rows, hsize_t& cols);
+
+/// \brief As read_int_dataset for floating-point data read as double.
+void read_double_dataset(hid_t file, const char* name, std::vector<double>& out, hsize_t& rows, hsize_t& cols);
+
+/// \brief Writes a dataset of rank 1 (length rows) or rank 2 (rows × cols, row-major).
+void write_dataset(hid_t file, hid_t dcpl, const char* name, hid_t file_type, hid_t mem_type, int rank, hsize_t rows,
+                   hsize_t cols, const void* data);
+
+/// \brief Creates an HDF5 file in memory (core driver, no backing store) with the
+/// file-creation properties `fcpl`: HDF5 never touches the disk, so a full disk
+/// or a failing device cannot leave a half-closed file inside the library.
+/// Write it out with file_image() and fom/atomic_file.
+/// \param label name of the file in HDF5's error messages
+hid_t create_memory_file(const std::string& label, hid_t fcpl);
+
+/// \brief The bytes of an open file (flushed first), as they would be on disk.
+std::string file_image(hid_t file);
+
+}  // namespace contactrom::rom::hdf5
