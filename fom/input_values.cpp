@@ -155,7 +155,7 @@ fom::Param parse_problem_param(const fom::Problem& problem, const std::string& t
     } catch (const InputError& e) {
       throw InputError(std::string(e.what()) + expected);
     }
-    const Interval range{problem.param_lower()(i), problem.param_upper()(i), problem.lower_open(), false};
+    const Interval range{problem.param_lower()(i), problem.param_upper()(i), problem.parameters().lower_open[i] != 0, false};
     if (!range.contains(value))
       throw InputError(what + " " + quoted(trim_blanks(items[i])) + " is outside the range of '" + problem.name() + "'" +
                        expected);

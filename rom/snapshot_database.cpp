@@ -447,6 +447,7 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
     if ((db.parameter(j) - expected[j]).cwiseAbs().maxCoeff() > kParameterMatchTolerance * scale)
       throw mismatch("its snapshot " + std::to_string(j) + " is not at the training parameter of that set");
   }
+}
 
 void describe_problem(const fom::Problem& problem, SnapshotDatabase& db) {
   db.problem = problem.name();
@@ -476,7 +477,6 @@ std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, 
   check_database(db, *problem, path);
   return problem;
 
-}
 }
 
 std::vector<fom::Param> database_training_set(const SnapshotDatabase& db, const fom::Problem& problem) {

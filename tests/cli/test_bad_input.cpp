@@ -54,6 +54,15 @@ void check_case(const Case& c) {
   }
 }
 
+/// A copy of problems/hertz.toml in `dir` whose mesh is `dir`/hertz.geo; returns its path.
+std::string hertz_problem_next_to(const std::string& dir) {
+  std::string text = contactrom::test::slurp(std::string(CONTACTROM_SOURCE_DIR) + "/problems/hertz.toml");
+  const std::string from = "../meshes/hertz.geo";
+  text.replace(text.find(from), from.size(), "hertz.geo");
+  std::ofstream(dir + "/hertz.toml") << text;
+  return dir + "/hertz.toml";
+}
+
 struct Fixture {
   std::string dir = contactrom::test::temp_dir();
   std::string rope_db = kCorpus + "rope.h5";
@@ -212,26 +221,19 @@ BOOST_FIXTURE_TEST_CASE(csv_messages_are_cut_and_escaped, Fixture) {
 }
 
 BOOST_FIXTURE_TEST_CASE(unheld_body_is_named_and_stdout_stays_clean, Fixture) {
-  // hertz.geo with its top Dirichlet group moved to the bottom body's clamp:
+  // hertz.toml without the Dirichlet condition of the top body's load face:
   // nothing holds the top body, the stiffness is singular.
   const std::string meshes = file("meshes");
   fs::create_directories(meshes);
-  std::ifstream in(std::string(CONTACTROM_SOURCE_DIR) + "/meshes/hertz.geo");
-  std::ofstream geo(meshes + "/hertz.geo");
-  std::string line;
-  bool replaced = false;
-  while (std::getline(in, line)) {
-    if (line.rfind("Physical Curve(\"top_load\"", 0) == 0) {
-      line = "Physical Curve(\"top_load\", 12) = {1};";
-      replaced = true;
-    }
-    geo << line << "\n";
-  }
-  geo.close();
-  BOOST_REQUIRE(replaced);
-  const std::string env = "CONTACTROM_MESH_DIR=" + meshes + " ";
-  check_case({"fom --problem hertz --param 0.1 --json", "body 'top' is held by no Dirichlet condition", "", env});
-  check_case({"offline --problem hertz --train 3 --out " + file("s.h5"), "body 'top'", file("s.h5"), env});
+  fs::copy_file(std::string(CONTACTROM_SOURCE_DIR) + "/meshes/hertz.geo", meshes + "/hertz.geo");
+  const std::string problem = hertz_problem_next_to(meshes);
+  std::string text = contactrom::test::slurp(problem);
+  const std::string held = "[[dirichlet]]\ngroup = \"top_load\"\ndisplacement = [0.0, \"-d\"]\n";
+  BOOST_REQUIRE(text.find(held) != std::string::npos);
+  text.replace(text.find(held), held.size(), "");
+  std::ofstream(problem) << text;
+  check_case({"fom --problem " + problem + " --param 0.1 --json", "body 'top' is held by no Dirichlet condition", "", ""});
+  check_case({"offline --problem " + problem + " --train 3 --out " + file("s.h5"), "body 'top'", file("s.h5"), ""});
 }
 
 BOOST_FIXTURE_TEST_CASE(geo_that_exits_is_an_error_not_a_silent_success, Fixture) {
@@ -242,6 +244,6 @@ BOOST_FIXTURE_TEST_CASE(geo_that_exits_is_an_error_not_a_silent_success, Fixture
   std::ofstream geo(meshes + "/hertz.geo");
   geo << "Exit;\n" << in.rdbuf();
   geo.close();
-  check_case({"fom --problem hertz --param 0.1 --json", "/hertz.geo' ended the program while gmsh read it", "",
-              "CONTACTROM_MESH_DIR=" + meshes + " "});
+  check_case({"fom --problem " + hertz_problem_next_to(meshes) + " --param 0.1 --json",
+              "/hertz.geo' ended the program while gmsh read it", "", ""});
 }
