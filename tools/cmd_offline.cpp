@@ -87,7 +87,7 @@ void run_offline(const OfflineArgs& a) {
 #else
   const Ranks ranks;
 #endif
-  if (ranks.root()) check_output_path(a.out);  // before the snapshots are computed
+  check_output_path(a.out);  // before the snapshots are computed (every rank: all refuse alike)
   fom::ProblemOptions popt;
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);

@@ -310,7 +310,7 @@ Physical Curve("base_bottom", 14) = {8};
   const std::string file = write_temp(dir, "good.toml", hertz_text());
   const auto r = run_command(kExe + " fom --problem " + file + " --param 0.31 --out " + dir + "/out");
   BOOST_TEST(r.exit_code == 2);
-  BOOST_TEST(r.err.find("d = 0.31 is outside") != std::string::npos, r.err);
+  BOOST_TEST(r.err.find("d = '0.31' is outside") != std::string::npos, r.err);
   BOOST_TEST(!fs::exists(dir + "/out"));
   fs::remove_all(dir);
 }
