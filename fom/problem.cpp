@@ -45,7 +45,7 @@ struct AffineVectors {
 /// Builds a problem from its definition and mesh (see build_problem).
 class Builder {
  public:
-  Builder(Problem& p, const ProblemDefinition& def, const Mesh& mesh) : m_p(p), m_def(def), m_mesh(mesh) {}
+  Builder(const ProblemDefinition& def, const Mesh& mesh) : m_def(def), m_mesh(mesh) {}
 
   void check_bodies() {
     for (const BodySpec& b : m_def.bodies)
@@ -172,7 +172,6 @@ class Builder {
     return it->second;
   }
 
-  Problem& m_p;
   const ProblemDefinition& m_def;
   const Mesh& m_mesh;
 };
@@ -267,7 +266,7 @@ std::unique_ptr<Problem> build_problem(ProblemDefinition definition, Mesh mesh) 
   const ProblemDefinition& def = p->m_definition;
   const Mesh& m = *p->m_mesh;
   const int n = 2 * m.num_nodes(), np = def.parameters.size();
-  Builder b(*p, def, m);
+  Builder b(def, m);
   b.check_bodies();
   b.assemble_stiffness_terms(p->m_k_terms, p->m_k_coeff);
   p->m_h1 = assemble_h1_gram(m);
