@@ -8,6 +8,7 @@
 
 #include "baselines/cpg.hpp"
 #include "baselines/full_dictionary.hpp"
+#include "baselines/online_methods.hpp"
 
 namespace contactrom::baselines {
 
@@ -255,9 +256,6 @@ double reduced_penetration(const rom::ReducedModel& model, const std::vector<int
   return worst;
 }
 
-void register_baseline_online_solvers() {
-  rom::register_online_solver("cpg", make_cpg_solver);
-  rom::register_online_solver("full-dictionary", make_full_dictionary_solver);
-}
+void register_baseline_online_solvers() { (void)baseline_online_methods(); }
 
 }  // namespace contactrom::baselines

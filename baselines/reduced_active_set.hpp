@@ -156,9 +156,9 @@ class ReducedActiveSet : public rom::OnlineSolver {
 double reduced_penetration(const rom::ReducedModel& model, const std::vector<int>& columns,
                            const Eigen::VectorXd& u);
 
-/// \brief Registers "cpg" and "full-dictionary" with rom::register_online_solver
-/// (idempotent). The CLI registers them from tools/cmd_verify.cpp; programs that do
-/// not link that file (tests) call this.
+/// \brief Registers "cpg" and "full-dictionary" (idempotent). Not needed: linking
+/// contactrom::baselines registers them (baselines/online_methods.hpp); kept for
+/// programs written before.
 void register_baseline_online_solvers();
 
 }  // namespace contactrom::baselines

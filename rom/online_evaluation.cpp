@@ -5,41 +5,12 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <mutex>
 #include <ostream>
 
 #include "fom/atomic_file.hpp"
-#include "fom/input_values.hpp"
-#include "rom/greedy_active_set.hpp"
 
 namespace contactrom::rom {
 namespace {
-
-struct Registry {
-  std::mutex mutex;
-  std::map<std::string, OnlineSolverFactory> factories;
-};
-
-/// The registry, with the built-in methods. A function-local static, so that
-/// registrars running during static initialisation find it constructed.
-Registry& registry() {
-  static Registry* r = [] {
-    auto* reg = new Registry;  // never destroyed: registrars may outlive static destruction order
-    reg->factories["greedy"] = [](const ReducedModel& model, const OnlineSolverOptions& options) {
-      check_extra_options(options, "greedy", {"schedule", "anderson_depth", "max_solves", "init"});
-      return std::unique_ptr<OnlineSolver>(std::make_unique<GreedyActiveSet>(model, greedy_options(options)));
-    };
-    // The same solver with the nested operator-rebuild schedule (GreedySchedule::Nested).
-    reg->factories["greedy-nested"] = [](const ReducedModel& model, const OnlineSolverOptions& options) {
-      check_extra_options(options, "greedy-nested", {"anderson_depth", "max_solves", "init"});
-      GreedyOptions g = greedy_options(options);
-      g.schedule = GreedySchedule::Nested;
-      return std::unique_ptr<OnlineSolver>(std::make_unique<GreedyActiveSet>(model, g));
-    };
-    return reg;
-  }();
-  return *r;
-}
 
 std::string format_double(double v) {
   char buf[32];
@@ -48,57 +19,6 @@ std::string format_double(double v) {
 }
 
 }  // namespace
-
-void register_online_solver(const std::string& name, OnlineSolverFactory factory) {
-  Registry& r = registry();
-  std::lock_guard<std::mutex> lock(r.mutex);
-  r.factories[name] = std::move(factory);
-}
-
-void check_extra_options(const OnlineSolverOptions& options, const std::string& method,
-                         const std::vector<std::string>& known) {
-  for (const auto& entry : options.extra) {
-    if (std::find(known.begin(), known.end(), entry.first) != known.end()) continue;
-    std::string list;
-    for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-    throw InputError("online method '" + method + "' has no option '" + entry.first + "'; it knows: " +
-                     (list.empty() ? "none" : list));
-  }
-}
-
-double parse_option_number(const std::string& method, const std::string& key, const std::string& text) {
-  return parse_number(text, method + " option " + key);
-}
-
-long long parse_option_integer(const std::string& method, const std::string& key, const std::string& text) {
-  return parse_integer(text, method + " option " + key, std::numeric_limits<long long>::min(),
-                       std::numeric_limits<long long>::max());
-}
-
-std::vector<std::string> online_solver_names() {
-  Registry& r = registry();
-  std::lock_guard<std::mutex> lock(r.mutex);
-  std::vector<std::string> names;
-  for (const auto& entry : r.factories) names.push_back(entry.first);
-  return names;
-}
-
-std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const ReducedModel& model,
-                                                 const OnlineSolverOptions& options) {
-  OnlineSolverFactory factory;
-  {
-    Registry& r = registry();
-    std::lock_guard<std::mutex> lock(r.mutex);
-    const auto it = r.factories.find(name);
-    if (it != r.factories.end()) factory = it->second;
-  }
-  if (!factory) {
-    std::string known;
-    for (const std::string& n : online_solver_names()) known += (known.empty() ? "" : ", ") + n;
-    throw InputError("unknown online method '" + name + "'; expected one of: " + known);
-  }
-  return factory(model, options);
-}
 
 std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& solver,
                                                  const std::vector<fom::Param>& params, int threads,

@@ -10,14 +10,9 @@
 ///   contactrom online --db hertz30.h5 --method greedy --delta 1e-8 --validation --out hertz30.csv --json
 /// \endcode
 ///
-/// Adding a method: implement OnlineSolver, then register a factory under its name
-/// — with register_online_solver() at run time, or with a static
-/// OnlineSolverRegistrar in a translation unit that is linked into the program.
-/// Beware: `contactrom_rom` is a static library, and the linker drops a library
-/// object file that nothing references, together with its static registrar. A
-/// registrar placed in a tools/cmd_*.cpp file (always linked into the CLI), or in
-/// a library file whose other symbols the program uses, is safe. "greedy" is
-/// registered here, built in.
+/// The registry itself, with every method's options, is in rom/online_methods.hpp.
+/// Adding a method: implement OnlineSolver, then register it with
+/// register_online_method() (declaring its options) or register_online_solver().
 #include <Eigen/Dense>
 #include <chrono>
 #include <functional>
@@ -123,8 +118,9 @@ using OnlineSolverFactory =
 /// \brief Registers (or replaces) the factory of method `name`.
 void register_online_solver(const std::string& name, OnlineSolverFactory factory);
 
-/// \brief Registers a method at static-initialisation time; see the file comment
-/// for where such an object must live to be linked.
+/// \brief Registers a method at static-initialisation time. Beware: in a static
+/// library the linker drops an object file that nothing references, together with
+/// its registrar; a registrar in a program's own source file is safe.
 struct OnlineSolverRegistrar {
   OnlineSolverRegistrar(const std::string& name, OnlineSolverFactory factory) {
     register_online_solver(name, std::move(factory));
@@ -147,8 +143,10 @@ double parse_option_number(const std::string& method, const std::string& key, co
 /// \throws InputError "<method> option <key> = '<text>' is not an integer".
 long long parse_option_integer(const std::string& method, const std::string& key, const std::string& text);
 
-/// \brief Builds the solver registered as `name`.
-/// \throws InputError "unknown online method 'x'; expected one of: ..." for an unknown name.
+/// \brief Builds the solver registered as `name`, after checking `options` against
+/// the method's declared options (validate_online_options in rom/online_methods.hpp).
+/// \throws InputError "unknown online method 'x'; expected one of: ..." for an unknown
+/// name, or naming the method, option, value and what was expected.
 std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const ReducedModel& model,
                                                  const OnlineSolverOptions& options = {});
 

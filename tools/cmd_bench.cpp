@@ -29,6 +29,7 @@
 #include "fom/active_set_solver.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_evaluation.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"
@@ -217,6 +218,7 @@ CommandRegistrar reg("bench", [](CLI::App& app) {
   add_integer(sub, "--ipopt-queries", a->ipopt_queries, "queries timed for Ipopt (default 5)", 1, 1000000);
   add_integer(sub, "--threads", a->threads, "threads of the offline stage (default: all cores)", 1, 1024);
   sub->add_flag("--json", a->json, "print one JSON object");
+  sub->footer(rom::describe_online_methods());
   sub->callback([a] { run_bench(*a); });
 });
 

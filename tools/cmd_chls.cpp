@@ -17,10 +17,6 @@
 //     penetration, complementarity (relative, as fom/kkt.hpp, and absolute),
 //     errors, sparsity, selected snapshots and coefficients. --time also measures
 //     the median online time per query with rom::time_online.
-//
-// This file also registers the online method "convex-hull" (a static registrar in
-// a file that is always linked into the CLI; see rom/online_evaluation.hpp), so
-// `contactrom online --method convex-hull` works.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -44,7 +40,6 @@
 namespace contactrom::cli {
 namespace {
 
-const rom::OnlineSolverRegistrar convex_hull_registrar("convex-hull", rom::make_convex_hull_solver);
 
 std::string format_double(double v) {
   char buf[32];

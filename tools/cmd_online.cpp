@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "fom/active_set_solver.hpp"
@@ -19,6 +20,7 @@
 #include "fom/field_output.hpp"
 #include "fom/kkt.hpp"
 #include "rom/online_evaluation.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
 #include "fom/atomic_file.hpp"
@@ -150,23 +152,17 @@ void run_online(const OnlineArgs& a) {
     throw InputError("--param and --validation exclude each other; give one");
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
-  rom::OnlineSolverOptions options;
-  options.tau = a.tau;
-  options.tau_scaling = a.tau_scaling;
-  options.max_iterations = a.max_iterations;
+  // --option KEY=VALUE pairs and the named flags, checked against the method's
+  // declared options (rom/online_methods.hpp) before the model is built.
+  std::map<std::string, std::string> values;
   for (const std::string& kv : a.options) {
-    const size_t eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError("--option '" + kv + "' invalid; expected KEY=VALUE (e.g. cpg_tolerance=1e-2)");
-    options.extra[kv.substr(0, eq)] = kv.substr(eq + 1);
+    auto [key, value] = rom::split_option(kv);
+    values[key] = value;
   }
-  // Validate the method name before the (more expensive) model construction.
-  const std::vector<std::string> names = rom::online_solver_names();
-  if (std::find(names.begin(), names.end(), a.method) == names.end()) {
-    std::string known;
-    for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-    throw InputError("unknown online method '" + a.method + "'; expected one of: " + known);
-  }
+  rom::OnlineSolverOptions options = rom::options_from_map(a.method, values);
+  if (!values.count("tau")) options.tau = a.tau;
+  if (!values.count("tau_scaling")) options.tau_scaling = a.tau_scaling;
+  if (!values.count("max_iterations")) options.max_iterations = a.max_iterations;
   rom::ReducedModelOptions model_options;
   model_options.delta = a.delta;
   model_options.lifting = a.lifting == "dirichlet" ? rom::LiftingKind::Dirichlet : rom::LiftingKind::Harmonic;
@@ -184,7 +180,8 @@ CommandRegistrar reg("online", [](CLI::App& app) {
   auto* sub = app.add_subcommand("online", "Evaluate a reduced model built from a snapshot database");
   sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
       ->check(non_empty_path())->required();
-  sub->add_option("--method", args->method, "online method (default greedy; see the error text for all)");
+  sub->add_option("--method", args->method, "online method (default greedy; listed below)");
+  sub->footer(rom::describe_online_methods());
   add_number(sub, "--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
   add_number(sub, "--tau", args->tau, "greedy penetration threshold (default: tau = delta)", Interval::at_least(0));
   sub->add_option("--tau-scaling", args->tau_scaling, "absolute (default, paper) | relative")
@@ -194,9 +191,7 @@ CommandRegistrar reg("online", [](CLI::App& app) {
       ->check(CLI::IsMember({"harmonic", "dirichlet"}));
   add_integer(sub, "--max-iterations", args->max_iterations, "iteration cap k_max (default 50)", 1, 100000);
   sub->add_option("--option", args->options,
-                  "method setting KEY=VALUE, repeatable: init=empty|cell|nearest|primal, schedule, anderson_depth, "
-                  "max_solves (greedy; see docs/rom.md); cpg_tolerance, cpg_max_size, inner_solve, init=empty|primal|cell "
-                  "(cpg); inner_solve, init (full-dictionary); basis, rank_l, seed, ... (convex-hull; see docs/convex_hull.md)");
+                  "method setting KEY=VALUE, repeatable; each method's keys are listed below");
   sub->add_flag("--validation", args->validation, "evaluate on the validation set (default without --param)");
   sub->add_option("--param", args->param, "one query V or V1,V2");
   sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)")

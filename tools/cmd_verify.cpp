@@ -18,9 +18,6 @@
 // --bench adds the median online time per query (also without the construction of
 // the contact operators, the paper's convention) and the FOM time with the
 // factorisation reused, all timed in interleaved rounds (rom::time_interleaved).
-//
-// This file also registers the online methods "cpg" and "full-dictionary" (it is
-// always linked into the CLI; see rom/online_evaluation.hpp on static libraries).
 #include <unistd.h>
 
 #include <algorithm>
@@ -46,6 +43,7 @@
 #include "rom/greedy_active_set.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_evaluation.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"
@@ -54,8 +52,6 @@
 namespace contactrom::cli {
 namespace {
 
-const rom::OnlineSolverRegistrar cpg_registrar("cpg", baselines::make_cpg_solver);
-const rom::OnlineSolverRegistrar full_dictionary_registrar("full-dictionary", baselines::make_full_dictionary_solver);
 
 /// Slack of the reduced-level acceptance test: max_p W_pᵀ(Cu − g) ≤ τ + this.
 constexpr double kReducedPenetrationSlack = 1e-10;
@@ -442,6 +438,7 @@ CommandRegistrar reg("verify", [](CLI::App& app) {
       ->check(non_empty_path());
   sub->add_flag("--progress", args->progress, "draw progress bars even when stderr is not a terminal");
   sub->add_flag("--json", args->json, "print one JSON object");
+  sub->footer(rom::describe_online_methods());
   sub->callback([args] { run_verify(*args); });
 });
 
