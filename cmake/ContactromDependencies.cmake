@@ -1,8 +1,7 @@
-# Finds the Debian-packaged dependencies and wraps those without a CMake
-# config (CHOLMOD, gmsh) in IMPORTED targets.
+# Finds the Debian-packaged dependencies of the build; those without a CMake
+# config (CHOLMOD, gmsh, Ipopt) become IMPORTED targets in
+# ContactromImportedDependencies.cmake, which the installed package reuses.
 find_package(Eigen3 3.4 REQUIRED CONFIG)
-find_package(PkgConfig REQUIRED)
-pkg_check_modules(IPOPT REQUIRED IMPORTED_TARGET ipopt)
 find_package(HDF5 REQUIRED COMPONENTS C)
 find_package(Threads REQUIRED)
 find_package(nlohmann_json 3 REQUIRED CONFIG)
@@ -13,18 +12,4 @@ if(NOT CLI11_FOUND)
   add_library(CLI11::CLI11 INTERFACE IMPORTED)
   set_target_properties(CLI11::CLI11 PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${CLI11_INCLUDE_DIR}")
 endif()
-
-find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
-find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
-find_library(SUITESPARSECONFIG_LIBRARY suitesparseconfig REQUIRED)
-add_library(contactrom_cholmod INTERFACE)
-target_include_directories(contactrom_cholmod INTERFACE ${CHOLMOD_INCLUDE_DIR})
-target_link_libraries(contactrom_cholmod INTERFACE ${CHOLMOD_LIBRARY} ${SUITESPARSECONFIG_LIBRARY})
-add_library(SuiteSparse::CHOLMOD ALIAS contactrom_cholmod)
-
-find_path(GMSH_INCLUDE_DIR gmsh.h REQUIRED)
-find_library(GMSH_LIBRARY gmsh REQUIRED)
-add_library(contactrom_gmsh INTERFACE)
-target_include_directories(contactrom_gmsh INTERFACE ${GMSH_INCLUDE_DIR})
-target_link_libraries(contactrom_gmsh INTERFACE ${GMSH_LIBRARY})
-add_library(gmsh::gmsh ALIAS contactrom_gmsh)
+include(ContactromImportedDependencies)

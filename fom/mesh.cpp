@@ -1,5 +1,7 @@
 #include "fom/mesh.hpp"
 
+#include "fom/data_directory.hpp"
+
 #include <gmsh.h>
 
 #include <algorithm>
@@ -492,10 +494,6 @@ Mesh load_mesh(const std::string& path, const MeshOptions& options) {
   }
 }
 
-std::string mesh_directory() {
-  const char* env = std::getenv("CONTACTROM_MESH_DIR");
-  if (env != nullptr && *env != '\0') return env;
-  return CONTACTROM_DEFAULT_MESH_DIR;
-}
+std::string mesh_directory() { return data_directory("meshes", "CONTACTROM_MESH_DIR"); }
 
 }  // namespace contactrom::fom

@@ -91,7 +91,8 @@ struct MeshOptions {
 Mesh load_mesh(const std::string& path, const MeshOptions& options = {});
 
 /// \brief The folder holding the project's `.geo` files: `$CONTACTROM_MESH_DIR`
-/// if set, else the source tree's `meshes/` recorded at configure time.
+/// if set, else `share/contactrom/meshes` of the build tree or install prefix
+/// (fom/data_directory.hpp).
 std::string mesh_directory();
 
 }  // namespace contactrom::fom

@@ -1,5 +1,7 @@
 #include "fom/problem_file.hpp"
 
+#include "fom/data_directory.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -375,10 +377,7 @@ ProblemDefinition parse_problem_text(const std::string& text, const std::string&
 
 ProblemDefinition read_problem_file(const std::string& path) { return parse_problem_text(read_text_file(path), path); }
 
-std::string problem_directory() {
-  if (const char* dir = std::getenv("CONTACTROM_PROBLEM_DIR"); dir && *dir) return dir;
-  return CONTACTROM_DEFAULT_PROBLEM_DIR;
-}
+std::string problem_directory() { return data_directory("problems", "CONTACTROM_PROBLEM_DIR"); }
 
 std::vector<std::string> shipped_problem_names() {
   std::vector<std::string> names{"rope"};

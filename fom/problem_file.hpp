@@ -93,7 +93,8 @@ ProblemDefinition read_problem_file(const std::string& path);
 ProblemDefinition parse_problem_text(const std::string& text, const std::string& path);
 
 /// \brief Folder of the shipped problem files: `$CONTACTROM_PROBLEM_DIR` if set,
-/// else the `problems/` folder recorded at build time.
+/// else `share/contactrom/problems` of the build tree or install prefix
+/// (fom/data_directory.hpp).
 std::string problem_directory();
 
 /// \brief Resolves `--problem`: a path (contains '/' or ends in .toml) is used as

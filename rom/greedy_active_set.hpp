@@ -42,8 +42,8 @@
 /// one-change steps 2–3 are repeated on FROZEN operators until they change nothing
 /// (or revisit a selection: a cycle), and only then are the operators rebuilt at the
 /// new iterate (step 1), Anderson-accelerated while the selection is unchanged. With
-/// the operators frozen, $ A = C_R \Phi_s $ is formed once per rebuild, and each
-/// selected column p keeps $ \hat C_p $, $ K̂^{-1} \hat C_p^T $ and its effect on
+/// the operators frozen, \f$ A = C_R \Phi_s \f$ is formed once per rebuild, and each
+/// selected column p keeps \f$ \hat C_p \f$, \f$ \hat K^{-1} \hat C_p^T \f$ and its effect on
 /// every column's violation, so a one-change step costs O(|I|(r + m) + |I|³) and
 /// needs no contact search. Stopping test and confirmation are those of step 4;
 /// k_max counts the rebuilds, GreedyOptions::max_solves the one-change steps.

@@ -63,7 +63,7 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
 SnapshotDatabase generate_snapshots(const fom::Problem& problem, int n, const OfflineOptions& options = {});
 
 /// \brief A one-line progress bar "label [#####.....] 17/30  42.1/s  ETA 0.3 s"
-/// redrawn in place with '\r'. It draws only when enabled (the CLI enables it
+/// redrawn in place with a carriage return. It draws only when enabled (the CLI enables it
 /// when stderr is a terminal or with --progress); finish() ends the line.
 class ProgressBar {
  public:

@@ -31,7 +31,9 @@
 #include "fom/kkt.hpp"
 #include "rom/chls.hpp"
 #include "rom/convex_hull.hpp"
+#include "rom/convex_hull_report.hpp"
 #include "rom/online_evaluation.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"
@@ -58,33 +60,15 @@ void run_chls(const ChlsArgs& a) {
   if (!a.out.empty()) check_output_path(a.out);
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
-  const std::vector<int> used = db.successful_snapshots();
-  if (used.size() < 2)
-    throw InputError("database " + a.db + " holds " + std::to_string(used.size()) +
-                     " successful snapshots; CHLS needs at least 2");
-  Eigen::MatrixXd primal(db.num_dofs(), static_cast<Eigen::Index>(used.size()));
-  for (std::size_t c = 0; c < used.size(); ++c) primal.col(static_cast<Eigen::Index>(c)) = db.primal.col(used[c]);
-  const rom::ChlsResult r = rom::chls_leave_one_out(primal);
-
+  const rom::DatabaseChls chls = rom::chls_of_database(db);
+  const std::vector<int>& used = chls.snapshots;
+  const rom::ChlsResult& r = chls.result;
   auto support_text = [&](std::size_t k) {
     std::string s;
-    for (std::size_t j = 0; j < used.size(); ++j)
-      if (r.coefficients(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)) > 0.0)
-        s += (s.empty() ? "" : " ") + std::to_string(used[j]);
+    for (int c : chls.support(k)) s += (s.empty() ? "" : " ") + std::to_string(c);
     return s;
   };
-  if (!a.out.empty()) {
-    write_file_atomically(a.out, [&](std::ostream& out) {
-      for (const std::string& name : db.param_names) out << name << ',';
-      out << "chls_error,status,iterations,support\n";
-      for (std::size_t k = 0; k < used.size(); ++k) {
-        const fom::Param mu = db.parameter(used[k]);
-        for (Eigen::Index i = 0; i < mu.size(); ++i) out << format_double(mu(i)) << ',';
-        out << format_double(r.errors(static_cast<Eigen::Index>(k))) << ',' << to_string(r.status[k]) << ','
-            << r.iterations[k] << ',' << support_text(k) << '\n';
-      }
-    });
-  }
+  if (!a.out.empty()) rom::write_chls_csv(a.out, db, chls);
   nlohmann::json j;
   j["problem"] = db.problem;
   j["snapshots"] = used.size();
@@ -133,14 +117,6 @@ struct HullArgs {
   std::vector<std::string> options;
 };
 
-struct HullRow {
-  fom::Param mu;
-  rom::ConvexHullResult r;
-  double primal_error = 0.0, dual_error = 0.0;
-  fom::KktResiduals kkt;
-  double penetration_abs = 0.0, complementarity_abs = 0.0;
-};
-
 void run_hull_report(const HullArgs& a) {
   if (!a.out.empty()) check_output_path(a.out);
   const rom::SnapshotDatabase db = rom::read_database(a.db);
@@ -160,118 +136,58 @@ void run_hull_report(const HullArgs& a) {
   generic.extra["polish"] = a.no_polish ? "0" : "1";
   generic.extra["max_pairing_iterations"] = std::to_string(a.max_pairing_iterations);
   for (const std::string& kv : a.options) {
-    const auto eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError("--option '" + kv + "' malformed; expected KEY=VALUE");
-    generic.extra[kv.substr(0, eq)] = kv.substr(eq + 1);
+    auto [key, value] = rom::split_option(kv);
+    generic.extra[key] = value;
   }
+  rom::validate_online_options("convex-hull", generic);
   const rom::ConvexHullOptions options = rom::convex_hull_options(generic);
   const rom::ConvexHullSolver solver(model, options);
 
   const std::vector<fom::Param> params =
       a.set == "training" ? rom::database_training_set(db, *problem) : rom::database_validation_set(db, *problem);
-  const fom::ActiveSetSolver fom_solver(*problem);
-  const std::vector<fom::FomSolution> refs = rom::compute_references(fom_solver, params, a.threads);
-  const Eigen::VectorXd& w = problem->contact().weights();
+  rom::HullReportOptions report_options;
+  report_options.threads = a.threads;
+  report_options.time = a.time;
+  report_options.repeats = a.repeats;
+  const rom::HullReport r = rom::convex_hull_report(solver, params, report_options);
+  if (!a.out.empty()) rom::write_hull_report_csv(a.out, solver, r);
 
-  std::vector<HullRow> rows;
-  for (std::size_t i = 0; i < params.size(); ++i) {
-    HullRow row;
-    row.mu = params[i];
-    row.r = solver.solve_detailed(params[i]);
-    const rom::OnlineResult& on = row.r.online;
-    row.primal_error = fom::relative_h1_error(*problem, on.u, refs[i].u);
-    row.dual_error = fom::relative_l2_pressure_error(*problem, on.lambda, refs[i].lambda);
-    row.kkt = fom::kkt_residuals(*problem, params[i], on.u, on.lambda);
-    // Absolute compliance: largest penetration (length) and |λᵀ(Cu − g)| = |Σ w_s λ_s gap_s|.
-    const Eigen::VectorXd gaps = fom::normal_gaps(*problem, on.u);
-    double comp = 0.0;
-    for (Eigen::Index s = 0; s < gaps.size(); ++s) {
-      if (!std::isfinite(gaps(s))) continue;
-      row.penetration_abs = std::max(row.penetration_abs, -gaps(s));
-      comp += w(s) * on.lambda(s) * gaps(s);
-    }
-    row.complementarity_abs = std::abs(comp);
-    rows.push_back(std::move(row));
-  }
-
-  auto selected_text = [&](const rom::OnlineResult& on, bool coefficients) {
-    std::string s;
-    for (std::size_t k = 0; k < on.selected.size(); ++k) {
-      s += k ? " " : "";
-      s += coefficients ? format_double(on.coefficients(static_cast<Eigen::Index>(k)))
-                        : std::to_string(model.dictionary_snapshots()[static_cast<std::size_t>(on.selected[k])]);
-    }
-    return s;
-  };
-  if (!a.out.empty()) {
-    write_file_atomically(a.out, [&](std::ostream& out) {
-      for (const std::string& name : problem->param_names()) out << name << ',';
-      out << "primal_h1_error,dual_l2_error,sparsity,sum_violation,penetration,penetration_abs,complementarity,"
-             "complementarity_abs,stationarity,negative_pressure,projected_residual,iterations,pairing_iterations,"
-             "converged,status,time_s,selected,coefficients\n";
-      for (const HullRow& row : rows) {
-        const rom::OnlineResult& on = row.r.online;
-        for (Eigen::Index k = 0; k < row.mu.size(); ++k) out << format_double(row.mu(k)) << ',';
-        out << format_double(row.primal_error) << ',' << format_double(row.dual_error) << ',' << on.selected.size()
-            << ',' << format_double(row.r.sum_violation) << ',' << format_double(row.kkt.penetration) << ','
-            << format_double(row.penetration_abs) << ',' << format_double(row.kkt.complementarity) << ','
-            << format_double(row.complementarity_abs) << ',' << format_double(row.kkt.stationarity) << ','
-            << format_double(row.kkt.negative_pressure) << ',' << format_double(row.r.projected_residual) << ','
-            << on.iterations << ',' << row.r.pairing_iterations << ',' << (on.converged ? 1 : 0) << ','
-            << to_string(on.status) << ',' << format_double(on.time_s) << ',' << selected_text(on, false) << ','
-            << selected_text(on, true) << '\n';
-      }
-    });
-  }
-
-  auto max_of = [&](auto get) {
-    double v = 0.0;
-    for (const HullRow& row : rows) v = std::max(v, static_cast<double>(get(row)));
-    return v;
-  };
-  auto mean_of = [&](auto get) {
-    double v = 0.0;
-    for (const HullRow& row : rows) v += static_cast<double>(get(row));
-    return rows.empty() ? 0.0 : v / static_cast<double>(rows.size());
-  };
   nlohmann::json j;
   j["problem"] = problem->name();
   j["method"] = "convex-hull";
   j["set"] = a.set;
-  j["queries"] = rows.size();
   j["delta"] = model.delta();
   j["basis"] = a.basis;
   j["projection_rank"] = solver.dictionary().projection_rank();
   j["dictionary_size"] = solver.dictionary().size();
-  j["mean_primal_error"] = mean_of([](const HullRow& r) { return r.primal_error; });
-  j["max_primal_error"] = max_of([](const HullRow& r) { return r.primal_error; });
-  j["mean_dual_error"] = mean_of([](const HullRow& r) { return r.dual_error; });
-  j["max_dual_error"] = max_of([](const HullRow& r) { return r.dual_error; });
-  j["mean_sparsity"] = mean_of([](const HullRow& r) { return r.r.online.selected.size(); });
-  j["max_sparsity"] = max_of([](const HullRow& r) { return r.r.online.selected.size(); });
-  j["max_sum_violation"] = max_of([](const HullRow& r) { return r.r.sum_violation; });
-  j["max_penetration"] = max_of([](const HullRow& r) { return r.kkt.penetration; });
-  j["max_penetration_abs"] = max_of([](const HullRow& r) { return r.penetration_abs; });
-  j["max_complementarity"] = max_of([](const HullRow& r) { return r.kkt.complementarity; });
-  j["max_complementarity_abs"] = max_of([](const HullRow& r) { return r.complementarity_abs; });
-  j["max_stationarity"] = max_of([](const HullRow& r) { return r.kkt.stationarity; });
-  j["max_projected_residual"] = max_of([](const HullRow& r) { return r.r.projected_residual; });
-  j["mean_iterations"] = mean_of([](const HullRow& r) { return r.r.online.iterations; });
-  j["mean_pairing_iterations"] = mean_of([](const HullRow& r) { return r.r.pairing_iterations; });
-  j["nonconverged"] = std::count_if(rows.begin(), rows.end(), [](const HullRow& r) { return !r.r.online.converged; });
+  j["queries"] = r.rows.size();
+  j["mean_primal_error"] = r.mean_primal_error;
+  j["max_primal_error"] = r.max_primal_error;
+  j["mean_dual_error"] = r.mean_dual_error;
+  j["max_dual_error"] = r.max_dual_error;
+  j["mean_sparsity"] = r.mean_sparsity;
+  j["max_sparsity"] = r.max_sparsity;
+  j["max_sum_violation"] = r.max_sum_violation;
+  j["max_penetration"] = r.max_penetration;
+  j["max_penetration_abs"] = r.max_penetration_abs;
+  j["max_complementarity"] = r.max_complementarity;
+  j["max_complementarity_abs"] = r.max_complementarity_abs;
+  j["max_stationarity"] = r.max_stationarity;
+  j["max_projected_residual"] = r.max_projected_residual;
+  j["mean_iterations"] = r.mean_iterations;
+  j["mean_pairing_iterations"] = r.mean_pairing_iterations;
+  j["nonconverged"] = r.nonconverged;
   if (a.time) {
-    const rom::OnlineTiming t = rom::time_online(solver, params, a.repeats);
-    j["median_time_s"] = t.median_core_s;
-    j["median_total_time_s"] = t.median_total_s;
-    j["timed_queries"] = t.queries;
+    j["median_time_s"] = r.timing.median_core_s;
+    j["median_total_time_s"] = r.timing.median_total_s;
+    j["timed_queries"] = r.timing.queries;
   }
   if (a.json) {
     std::cout << j.dump() << std::endl;
     return;
   }
   std::cout << "convex-hull on " << problem->name() << " (" << db.training_kind << " " << db.training_size << "), "
-            << a.set << " set: " << rows.size() << " queries\n"
+            << a.set << " set: " << r.rows.size() << " queries\n"
             << "dictionary " << j["dictionary_size"] << " columns, projection basis " << a.basis << " of rank "
             << j["projection_rank"] << " (delta " << model.delta() << ")\n"
             << std::setprecision(3) << std::left << std::setw(28) << "" << std::setw(12) << "mean" << "max\n"
@@ -286,7 +202,7 @@ void run_hull_report(const HullArgs& a) {
             << j["max_penetration_abs"].get<double>() << "\n"
             << std::setw(28) << "complementarity (rel / abs)" << std::setw(12) << j["max_complementarity"].get<double>()
             << j["max_complementarity_abs"].get<double>() << "\n"
-            << "not converged: " << j["nonconverged"] << " of " << rows.size() << "\n";
+            << "not converged: " << j["nonconverged"] << " of " << r.rows.size() << "\n";
   if (a.time)
     std::cout << "median online time per query " << j["median_time_s"].get<double>() * 1e6 << " us (with full field "
               << j["median_total_time_s"].get<double>() * 1e6 << " us)\n";

@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 packages=(build-essential cmake ninja-build pkg-config libeigen3-dev libsuitesparse-dev
           coinor-libipopt-dev gmsh libgmsh-dev libboost-test-dev libhdf5-dev libcli11-dev
           nlohmann-json3-dev libtomlplusplus-dev python3 python3-numpy python3-scipy python3-matplotlib python3-h5py
-          libopenmpi-dev openmpi-bin)  # MPI: CONTACTROM_MPI, mpirun ... offline (tests run mpirun as root)
+          doxygen libopenmpi-dev openmpi-bin)  # doxygen: docs/Doxyfile (test docs.doxygen); MPI: CONTACTROM_MPI, mpirun ... offline (tests run mpirun as root)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,0 +1,26 @@
+# IMPORTED targets for the dependencies without a CMake package: CHOLMOD and gmsh
+# (found by header and library name) and Ipopt (pkg-config). Included by the build
+# and by the installed contactromConfig.cmake.
+if(NOT TARGET SuiteSparse::CHOLMOD)
+  find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+  find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
+  find_library(SUITESPARSECONFIG_LIBRARY suitesparseconfig REQUIRED)
+  add_library(SuiteSparse::CHOLMOD INTERFACE IMPORTED)
+  set_target_properties(SuiteSparse::CHOLMOD PROPERTIES
+    INTERFACE_INCLUDE_DIRECTORIES "${CHOLMOD_INCLUDE_DIR}"
+    INTERFACE_LINK_LIBRARIES "${CHOLMOD_LIBRARY};${SUITESPARSECONFIG_LIBRARY}")
+endif()
+
+if(NOT TARGET gmsh::gmsh)
+  find_path(GMSH_INCLUDE_DIR gmsh.h REQUIRED)
+  find_library(GMSH_LIBRARY gmsh REQUIRED)
+  add_library(gmsh::gmsh INTERFACE IMPORTED)
+  set_target_properties(gmsh::gmsh PROPERTIES
+    INTERFACE_INCLUDE_DIRECTORIES "${GMSH_INCLUDE_DIR}"
+    INTERFACE_LINK_LIBRARIES "${GMSH_LIBRARY}")
+endif()
+
+if(NOT TARGET PkgConfig::IPOPT)
+  find_package(PkgConfig REQUIRED)
+  pkg_check_modules(IPOPT REQUIRED IMPORTED_TARGET ipopt)
+endif()

@@ -1,0 +1,148 @@
+#include "rom/convex_hull_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ostream>
+
+#include "fom/active_set_solver.hpp"
+#include "fom/atomic_file.hpp"
+#include "rom/offline.hpp"
+
+namespace contactrom::rom {
+namespace {
+
+std::string format_double(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+HullReportRow report_row(const ConvexHullSolver& solver, const fom::Param& mu, const fom::FomSolution& ref) {
+  const fom::Problem& problem = solver.model().problem();
+  HullReportRow row;
+  row.mu = mu;
+  row.result = solver.solve_detailed(mu);
+  const OnlineResult& on = row.result.online;
+  row.primal_error = fom::relative_h1_error(problem, on.u, ref.u);
+  row.dual_error = fom::relative_l2_pressure_error(problem, on.lambda, ref.lambda);
+  row.kkt = fom::kkt_residuals(problem, mu, on.u, on.lambda);
+  // Absolute compliance: largest penetration (length) and |λᵀ(Cu − g)| = |Σ w_s λ_s gap_s|.
+  const Eigen::VectorXd& w = problem.contact().weights();
+  const Eigen::VectorXd gaps = fom::normal_gaps(problem, on.u);
+  double comp = 0.0;
+  for (Eigen::Index s = 0; s < gaps.size(); ++s) {
+    if (!std::isfinite(gaps(s))) continue;
+    row.penetration_abs = std::max(row.penetration_abs, -gaps(s));
+    comp += w(s) * on.lambda(s) * gaps(s);
+  }
+  row.complementarity_abs = std::abs(comp);
+  return row;
+}
+
+void summarize(HullReport& r) {
+  const double n = std::max<double>(1.0, static_cast<double>(r.rows.size()));
+  for (const HullReportRow& row : r.rows) {
+    const OnlineResult& on = row.result.online;
+    const double sparsity = static_cast<double>(on.selected.size());
+    r.mean_primal_error += row.primal_error / n;
+    r.max_primal_error = std::max(r.max_primal_error, row.primal_error);
+    r.mean_dual_error += row.dual_error / n;
+    r.max_dual_error = std::max(r.max_dual_error, row.dual_error);
+    r.mean_sparsity += sparsity / n;
+    r.max_sparsity = std::max(r.max_sparsity, sparsity);
+    r.max_sum_violation = std::max(r.max_sum_violation, row.result.sum_violation);
+    r.max_penetration = std::max(r.max_penetration, row.kkt.penetration);
+    r.max_penetration_abs = std::max(r.max_penetration_abs, row.penetration_abs);
+    r.max_complementarity = std::max(r.max_complementarity, row.kkt.complementarity);
+    r.max_complementarity_abs = std::max(r.max_complementarity_abs, row.complementarity_abs);
+    r.max_stationarity = std::max(r.max_stationarity, row.kkt.stationarity);
+    r.max_projected_residual = std::max(r.max_projected_residual, row.result.projected_residual);
+    r.mean_iterations += on.iterations / n;
+    r.mean_pairing_iterations += row.result.pairing_iterations / n;
+    if (!on.converged) ++r.nonconverged;
+  }
+}
+
+}  // namespace
+
+std::vector<int> DatabaseChls::support(std::size_t k) const {
+  std::vector<int> out;
+  for (std::size_t j = 0; j < snapshots.size(); ++j)
+    if (result.coefficients(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)) > 0.0)
+      out.push_back(snapshots[j]);
+  return out;
+}
+
+DatabaseChls chls_of_database(const SnapshotDatabase& db, const ChlsOptions& options) {
+  DatabaseChls c;
+  c.snapshots = db.successful_snapshots();
+  if (c.snapshots.size() < 2)
+    throw InputError("database holds " + std::to_string(c.snapshots.size()) +
+                     " successful snapshots; CHLS needs at least 2");
+  Eigen::MatrixXd primal(db.num_dofs(), static_cast<Eigen::Index>(c.snapshots.size()));
+  for (std::size_t k = 0; k < c.snapshots.size(); ++k)
+    primal.col(static_cast<Eigen::Index>(k)) = db.primal.col(c.snapshots[k]);
+  c.result = chls_leave_one_out(primal, options);
+  return c;
+}
+
+void write_chls_csv(const std::string& path, const SnapshotDatabase& db, const DatabaseChls& c) {
+  write_file_atomically(path, [&](std::ostream& out) {
+    for (const std::string& name : db.param_names) out << name << ',';
+    out << "chls_error,status,iterations,support\n";
+    for (std::size_t k = 0; k < c.snapshots.size(); ++k) {
+      const fom::Param mu = db.parameter(c.snapshots[k]);
+      for (Eigen::Index i = 0; i < mu.size(); ++i) out << format_double(mu(i)) << ',';
+      out << format_double(c.result.errors(static_cast<Eigen::Index>(k))) << ',' << to_string(c.result.status[k])
+          << ',' << c.result.iterations[k] << ',';
+      const std::vector<int> support = c.support(k);
+      for (std::size_t j = 0; j < support.size(); ++j) out << (j ? " " : "") << support[j];
+      out << '\n';
+    }
+  });
+}
+
+HullReport convex_hull_report(const ConvexHullSolver& solver, const std::vector<fom::Param>& params,
+                              const HullReportOptions& options) {
+  const fom::ActiveSetSolver fom_solver(solver.model().problem());
+  const std::vector<fom::FomSolution> refs = compute_references(fom_solver, params, options.threads);
+  HullReport r;
+  for (std::size_t i = 0; i < params.size(); ++i) r.rows.push_back(report_row(solver, params[i], refs[i]));
+  summarize(r);
+  if (options.time) r.timing = time_online(solver, params, options.repeats);
+  return r;
+}
+
+void write_hull_report_csv(const std::string& path, const ConvexHullSolver& solver, const HullReport& report) {
+  const ReducedModel& model = solver.model();
+  auto selected_text = [&](const OnlineResult& on, bool coefficients) {
+    std::string s;
+    for (std::size_t k = 0; k < on.selected.size(); ++k) {
+      s += k ? " " : "";
+      s += coefficients ? format_double(on.coefficients(static_cast<Eigen::Index>(k)))
+                        : std::to_string(model.dictionary_snapshots()[static_cast<std::size_t>(on.selected[k])]);
+    }
+    return s;
+  };
+  write_file_atomically(path, [&](std::ostream& out) {
+    for (const std::string& name : model.problem().param_names()) out << name << ',';
+    out << "primal_h1_error,dual_l2_error,sparsity,sum_violation,penetration,penetration_abs,complementarity,"
+           "complementarity_abs,stationarity,negative_pressure,projected_residual,iterations,pairing_iterations,"
+           "converged,status,time_s,selected,coefficients\n";
+    for (const HullReportRow& row : report.rows) {
+      const OnlineResult& on = row.result.online;
+      for (Eigen::Index k = 0; k < row.mu.size(); ++k) out << format_double(row.mu(k)) << ',';
+      out << format_double(row.primal_error) << ',' << format_double(row.dual_error) << ',' << on.selected.size()
+          << ',' << format_double(row.result.sum_violation) << ',' << format_double(row.kkt.penetration) << ','
+          << format_double(row.penetration_abs) << ',' << format_double(row.kkt.complementarity) << ','
+          << format_double(row.complementarity_abs) << ',' << format_double(row.kkt.stationarity) << ','
+          << format_double(row.kkt.negative_pressure) << ',' << format_double(row.result.projected_residual) << ','
+          << on.iterations << ',' << row.result.pairing_iterations << ',' << (on.converged ? 1 : 0) << ','
+          << to_string(on.status) << ',' << format_double(on.time_s) << ',' << selected_text(on, false) << ','
+          << selected_text(on, true) << '\n';
+    }
+  });
+}
+
+}  // namespace contactrom::rom

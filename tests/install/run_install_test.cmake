@@ -1,0 +1,60 @@
+# ctest install.example: installs the build tree into a temporary prefix, checks
+# that nothing installed points into the source or build folder, runs the
+# installed CLI (which must find its data relative to the prefix), then configures,
+# builds and runs examples/cpp against the installed package.
+# cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DWORK_DIR=... -DGENERATOR=... -P run_install_test.cmake
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "failed (${rc}): ${ARGN}\n${out}\n${err}")
+  endif()
+  set(out "${out}" PARENT_SCOPE)
+endfunction()
+
+function(expect text pattern what)
+  if(NOT text MATCHES "${pattern}")
+    message(FATAL_ERROR "${what}: expected /${pattern}/ in:\n${text}")
+  endif()
+endfunction()
+
+# The installed copy must find everything by itself.
+unset(ENV{CONTACTROM_PROBLEM_DIR})
+unset(ENV{CONTACTROM_MESH_DIR})
+set(prefix ${WORK_DIR}/prefix)
+file(REMOVE_RECURSE ${WORK_DIR})
+run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+
+foreach(dir ${SOURCE_DIR} ${BUILD_DIR})
+  get_filename_component(real ${dir} REALPATH)
+  foreach(path ${dir} ${real})
+    execute_process(COMMAND grep -r -l -F ${path} ${prefix} RESULT_VARIABLE rc OUTPUT_VARIABLE hits)
+    if(NOT rc EQUAL 1)
+      message(FATAL_ERROR "installed files mention ${path}:\n${hits}")
+    endif()
+  endforeach()
+endforeach()
+
+run(${prefix}/bin/contactrom problems)
+expect("${out}" "${prefix}/share/contactrom/problems" "installed CLI's problem folder")
+run(${prefix}/bin/contactrom online --help)
+expect("${out}" "cpg_tolerance" "online --help lists the options of cpg")
+run(${prefix}/bin/contactrom fom --problem hertz --param 0.1 --json)
+expect("${out}" "\"iterations\"" "installed CLI solves hertz")
+
+run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/cpp -B ${WORK_DIR}/example -G ${GENERATOR}
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix})
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/example -j 2)
+# The example is not under the prefix: it is given the installed problem file.
+run(${WORK_DIR}/example/hertz_rom ${prefix}/share/contactrom/problems/hertz.toml 0.1275)
+message(STATUS "${out}")
+expect("${out}" "FOM: success" "FOM status")
+foreach(method greedy cpg)
+  expect("${out}" "ROM ${method}: success, contact force [^,]+, primal H1 error ([^,]+), dual L2 error ([^,]+)," "ROM ${method}")
+  string(REGEX MATCH "ROM ${method}: success, contact force [^,]+, primal H1 error ([^,]+), dual L2 error ([^,]+),"
+         line "${out}")
+  # hertz from 12 snapshots, query between two of them: errors of a working ROM.
+  if(NOT CMAKE_MATCH_1 LESS 1e-2 OR NOT CMAKE_MATCH_2 LESS 0.2)
+    message(FATAL_ERROR "ROM ${method}: errors ${CMAKE_MATCH_1} (primal) ${CMAKE_MATCH_2} (dual) too large")
+  endif()
+endforeach()
+file(REMOVE_RECURSE ${WORK_DIR})

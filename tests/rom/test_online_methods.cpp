@@ -1,0 +1,142 @@
+// The registry of online methods (rom/online_methods.hpp): complete after linking
+// (no registration call in this file), each method's declared options agree with
+// what its factory accepts, option text round-trips, and refusals name the method,
+// the key, the value and what was expected.
+#define BOOST_TEST_MODULE online_methods
+#include <boost/test/unit_test.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "baselines/online_methods.hpp"
+#include "common/run_command.hpp"
+#include "fom/problem.hpp"
+#include "rom/offline.hpp"
+#include "rom/online_methods.hpp"
+#include "rom/reduced_model.hpp"
+
+using namespace contactrom;
+
+namespace {
+
+/// rope from 9 snapshots: small enough to build every method in well under a second.
+struct Rope {
+  std::unique_ptr<fom::Problem> problem = fom::make_problem("rope");
+  rom::SnapshotDatabase db = rom::generate_snapshots(*problem, 9);
+  rom::ReducedModel model{*problem, db, [] {
+                            rom::ReducedModelOptions o;
+                            o.delta = 1e-7;
+                            return o;
+                          }()};
+};
+
+const Rope& rope() {
+  static const Rope r;
+  return r;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(every_builtin_method_is_registered_without_a_call) {
+  const std::vector<std::string> names = rom::online_solver_names();
+  for (const rom::OnlineMethod& m : baselines::builtin_online_methods())
+    BOOST_TEST((std::find(names.begin(), names.end(), m.name) != names.end()), m.name);
+  for (const char* name : {"greedy", "greedy-nested", "convex-hull", "cpg", "full-dictionary"}) {
+    const auto solver = rom::make_online_solver(name, rope().model);
+    BOOST_TEST(solver->name() == name);
+    const rom::OnlineResult r = solver->solve(fom::Param::Constant(1, 31.0));
+    BOOST_TEST(r.u.size() == rope().problem->num_dofs());
+  }
+}
+
+BOOST_AUTO_TEST_CASE(every_declared_choice_and_bound_is_accepted_by_the_factory) {
+  for (const rom::OnlineMethod& m : rom::online_methods()) {
+    for (const rom::OptionSpec& s : m.options) {
+      std::vector<std::string> values = s.choices;
+      if (s.type == rom::OptionType::Flag) values = {"true", "false"};
+      if (s.type == rom::OptionType::Integer) values = {std::to_string(static_cast<long long>(s.range.lower))};
+      if (s.type == rom::OptionType::Number && std::isfinite(s.range.lower)) values = {"0.5"};
+      for (const std::string& v : values) {
+        const rom::OnlineSolverOptions o = rom::options_from_map(m.name, {{s.key, v}});
+        BOOST_CHECK_NO_THROW(rom::make_online_solver(m.name, rope().model, o));
+      }
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(option_text_round_trips) {
+  const std::map<std::string, std::string> cpg{{"cpg_tolerance", "0.05"}, {"init", "cell"}, {"tau", "1e-7"},
+                                               {"max_iterations", "30"}, {"time_operators", "true"}};
+  const rom::OnlineSolverOptions o = rom::options_from_map("cpg", cpg);
+  BOOST_TEST(o.tau == 1e-7);
+  BOOST_TEST(o.max_iterations == 30);
+  BOOST_TEST(o.time_operators);
+  BOOST_TEST(o.extra.at("cpg_tolerance") == "0.05");
+  const auto text = rom::options_to_map("cpg", o);
+  for (const auto& [k, v] : cpg) BOOST_TEST(rom::options_from_map("cpg", {{k, text.at(k)}}).extra.size() <= 1u);
+  const rom::OnlineSolverOptions back = rom::options_from_map("cpg", text);
+  BOOST_TEST(back.tau == o.tau);
+  BOOST_TEST(back.max_iterations == o.max_iterations);
+  BOOST_TEST(back.step_tolerance == o.step_tolerance);
+  BOOST_TEST(back.tau_scaling == o.tau_scaling);
+  BOOST_TEST(back.time_operators == o.time_operators);
+  BOOST_TEST((back.extra == o.extra));
+  // A method that reads none of the named fields does not store them.
+  BOOST_TEST(rom::options_to_map("convex-hull", rom::OnlineSolverOptions{}).empty());
+}
+
+BOOST_AUTO_TEST_CASE(refusals_name_method_key_value_and_expectation) {
+  std::string m = error_of([] { rom::options_from_map("cpg", {{"cpg_tolerance", "2"}}); });
+  BOOST_TEST(contains(m, "cpg"));
+  BOOST_TEST(contains(m, "cpg_tolerance"));
+  BOOST_TEST(contains(m, "'2'"));
+  BOOST_TEST(contains(m, "[0, 1]"));
+  m = error_of([] { rom::options_from_map("greedy", {{"schedule", "sideways"}}); });
+  BOOST_TEST(contains(m, "'sideways'"));
+  BOOST_TEST(contains(m, "interleaved, nested"));
+  m = error_of([] { rom::options_from_map("convex-hull", {{"polish", "maybe"}}); });
+  BOOST_TEST(contains(m, "true or false"));
+  m = error_of([] { rom::options_from_map("full-dictionary", {{"cpg_tolerance", "0.1"}}); });
+  BOOST_TEST(contains(m, "has no option 'cpg_tolerance'"));
+  m = error_of([] { rom::options_from_map("greedy", {{"max_iterations", "2.5"}}); });
+  BOOST_TEST(contains(m, "'2.5'"));
+  // make_online_solver checks the same way.
+  rom::OnlineSolverOptions o;
+  o.max_iterations = 0;
+  m = error_of([&] { rom::make_online_solver("greedy", rope().model, o); });
+  BOOST_TEST(contains(m, "max_iterations"));
+  m = error_of([] { rom::online_method("sideways"); });
+  BOOST_TEST(contains(m, "expected one of"));
+  BOOST_TEST(contains(m, "cpg"));
+}
+
+BOOST_AUTO_TEST_CASE(split_option_needs_a_key_and_an_equals_sign) {
+  BOOST_TEST((rom::split_option("a=b=c") == std::pair<std::string, std::string>{"a", "b=c"}));
+  BOOST_CHECK_THROW(rom::split_option("=1"), InputError);
+  BOOST_CHECK_THROW(rom::split_option("key"), InputError);
+}
+
+BOOST_AUTO_TEST_CASE(cli_help_lists_every_option_of_every_method) {
+  for (const char* command : {"online", "bench", "verify"}) {
+    const auto r = contactrom::test::run_command(std::string(CONTACTROM_EXE) + " " + command + " --help");
+    BOOST_REQUIRE_EQUAL(r.exit_code, 0);
+    for (const rom::OnlineMethod& m : rom::online_methods()) {
+      BOOST_TEST(contains(r.out, "  " + m.name + ": "), command << " " << m.name);
+      for (const rom::OptionSpec& s : m.options) BOOST_TEST(contains(r.out, "    " + s.key + ": "), m.name << " " << s.key);
+    }
+  }
+}
