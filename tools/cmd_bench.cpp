@@ -1,6 +1,6 @@
 // contactrom bench (--problem P [--train N | --level n] [--refine k] | --db DB.h5) [--delta D] [--repeats R] [--json]
-// Median per-query times of every solver, all measured in the same run so that
-// their ratios are meaningful on a noisy machine:
+// Median per-query times of every solver (baselines::benchmark, baselines/benchmark.hpp),
+// all measured in the same run so that their ratios are meaningful on a noisy machine:
 //   fom_active_set  custom active-set FOM, factorisation reused (built before timing)
 //   fom_ipopt       Ipopt on the same QP (fewer queries: it is slow)
 //   rom_<method>    every registered online method (greedy, cpg, full-dictionary,
@@ -25,7 +25,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "baselines/ipopt_qp.hpp"
+#include "baselines/benchmark.hpp"
 #include "fom/active_set_solver.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_evaluation.hpp"
@@ -45,19 +45,6 @@ struct BenchArgs {
   double delta = 1e-8;
   bool json = false;
 };
-
-std::vector<fom::Param> thin(const std::vector<fom::Param>& all, int n) {
-  if (n <= 0 || static_cast<int>(all.size()) <= n) return all;
-  std::vector<fom::Param> out;
-  for (int i = 0; i < n; ++i) out.push_back(all[(static_cast<size_t>(i) * (all.size() - 1)) / std::max(n - 1, 1)]);
-  return out;
-}
-
-std::string key_of(const std::string& method) {
-  std::string k = "rom_" + method;
-  std::replace(k.begin(), k.end(), '-', '_');
-  return k;
-}
 
 void run_bench(const BenchArgs& a) {
   if (a.repeats < 1) throw InputError("--repeats " + std::to_string(a.repeats) + " invalid; expected >= 1");
@@ -90,7 +77,6 @@ void run_bench(const BenchArgs& a) {
     if (!a.json) std::cerr << s << std::endl;
   };
 
-  fom::ActiveSetSolver fom_solver(*problem);
   rom::OfflineOptions off;
   off.threads = a.threads;
   if (a.db.empty()) {
@@ -98,104 +84,40 @@ void run_bench(const BenchArgs& a) {
     db = rom::generate_snapshots(*problem, n, off);
     offline_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  const std::vector<fom::Param> queries = thin(rom::database_validation_set(db, *problem), a.queries);
-  j["queries"] = queries.size();
   j["offline_s"] = offline_s;
   j["snapshots"] = db.parameters.cols();
   log("offline: " + std::to_string(db.parameters.cols()) + " snapshots in " + std::to_string(offline_s) + " s");
-
-  {
-    baselines::IpoptQpSolver ipopt(*problem);
-    std::vector<double> times;
-    for (const fom::Param& mu : thin(queries, a.ipopt_queries)) {
-      const auto s0 = std::chrono::steady_clock::now();
-      ipopt.solve(mu);
-      times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count());
-    }
-    j["fom_ipopt"] = rom::median(times);
-    j["ipopt_queries"] = times.size();
-  }
 
   rom::ReducedModelOptions ro;
   ro.delta = a.delta;
   const rom::ReducedModel model(*problem, db, ro);
   j["primal_rank"] = model.primal_rank();
   j["dictionary_size"] = model.dictionary_size();
-  nlohmann::json skipped = nlohmann::json::object();
-  // Every ROM twice: as is, and clocking the construction of the contact operators
-  // (the paper's convention, times without it; a separate solver so that the clock
-  // reads do not touch the main times). All timed with the FOM in interleaved rounds.
-  std::vector<std::string> keys;
-  std::vector<std::unique_ptr<rom::OnlineSolver>> owned;
-  std::vector<const rom::OnlineSolver*> solvers, clocked;
-  rom::OnlineSolverOptions clock_options;
-  clock_options.time_operators = true;
-  // Every registered method with its defaults, then the variants that make the
-  // comparison honest: the greedy schedules started as in the paper's Alg. 1
-  // (init=empty) and CPG warm-started like the greedy (init=cell).
-  struct Variant {
-    std::string key, method;
-    std::map<std::string, std::string> extra;
-  };
-  std::vector<Variant> variants;
-  for (const std::string& method : rom::online_solver_names()) variants.push_back({key_of(method), method, {}});
-  for (const char* method : {"greedy", "greedy-nested"})
-    variants.push_back({key_of(method) + "_init_empty", method, {{"init", "empty"}}});
-  variants.push_back({"rom_cpg_warm", "cpg", {{"init", "cell"}}});
-  for (const Variant& v : variants) {
-    rom::OnlineSolverOptions options, clocked_options = clock_options;
-    options.extra = clocked_options.extra = v.extra;
-    try {
-      owned.push_back(rom::make_online_solver(v.method, model, options));
-    } catch (const InputError& e) {
-      skipped[v.key] = e.what();  // e.g. convex-hull on a non-convex feasible set
-      continue;
-    }
-    solvers.push_back(owned.back().get());
-    owned.push_back(rom::make_online_solver(v.method, model, clocked_options));
-    clocked.push_back(owned.back().get());
-    keys.push_back(v.key);
+  baselines::BenchOptions options;
+  options.repeats = a.repeats;
+  options.queries = a.queries;
+  options.ipopt_queries = a.ipopt_queries;
+  const baselines::BenchReport r = baselines::benchmark(model, rom::database_validation_set(db, *problem), options);
+  j["queries"] = r.queries;
+  j["fom_ipopt"] = r.fom_ipopt_s;
+  j["ipopt_queries"] = r.ipopt_queries;
+  j["fom_active_set"] = r.fom_active_set_s;
+  j["fom_active_set_rounds"] = r.fom_active_set_rounds;  // per-round medians: the machine's noise
+  for (const baselines::BenchMethod& m : r.methods) {
+    const std::string& k = m.variant.key;
+    j[k] = m.timing.median_core_s;
+    j[k + "_with_reconstruction"] = m.timing.median_total_s;
+    if (m.timing.median_without_operators_s >= 0.0) j[k + "_without_operators"] = m.timing.median_without_operators_s;
   }
-  const rom::InterleavedTiming timing = rom::time_interleaved(fom_solver, solvers, queries, a.repeats, clocked);
-  const double t_fom = timing.fom_median_s;
-  j["fom_active_set"] = t_fom;
-  j["fom_active_set_rounds"] = timing.fom_round_median_s;  // per-round medians: the machine's noise
-  for (size_t i = 0; i < keys.size(); ++i) {
-    const rom::OnlineTiming& t = timing.online[i];
-    j[keys[i]] = t.median_core_s;
-    j[keys[i] + "_with_reconstruction"] = t.median_total_s;
-    if (t.median_without_operators_s >= 0.0) j[keys[i] + "_without_operators"] = t.median_without_operators_s;
-  }
-  if (!skipped.empty()) j["not_applicable"] = skipped;
-
-  nlohmann::json ratios = nlohmann::json::object();
-  ratios["fom_ipopt/fom_active_set"] = j["fom_ipopt"].get<double>() / t_fom;
-  for (const std::string& k : keys) {
-    ratios["fom_active_set/" + k] = t_fom / j[k].get<double>();
-    if (k.rfind("rom_greedy", 0) == 0) {
-      // The paper's starting point against the default one.
-      const std::string warm = k.substr(0, k.size() - std::string("_init_empty").size());
-      if (k.size() > warm.size() && k.compare(warm.size(), std::string::npos, "_init_empty") == 0 && j.contains(warm))
-        ratios[k + "/" + warm] = j[k].get<double>() / j[warm].get<double>();
-      if (k == "rom_greedy_nested" && j.contains("rom_greedy"))
-        ratios[k + "/rom_greedy"] = j[k].get<double>() / j["rom_greedy"].get<double>();
-      continue;
-    }
-    // The baselines against both greedy schedules, with and without the construction
-    // of the contact operators (the paper's timing convention).
-    for (const std::string greedy : {"rom_greedy", "rom_greedy_nested"}) {
-      if (j.contains(greedy)) ratios[k + "/" + greedy] = j[k].get<double>() / j[greedy].get<double>();
-      const std::string kw = k + "_without_operators", gw = greedy + "_without_operators";
-      if (j.contains(kw) && j.contains(gw)) ratios[kw + "/" + gw] = j[kw].get<double>() / j[gw].get<double>();
-    }
-  }
-  j["ratios"] = ratios;
+  if (!r.not_applicable.empty()) j["not_applicable"] = r.not_applicable;
+  j["ratios"] = r.ratios;
+  const nlohmann::json& ratios = j["ratios"];
   if (a.json) {
     std::cout << j.dump() << std::endl;
     return;
   }
   std::cout << "contactrom bench: " << problem->name() << ", training " << n << ", delta " << a.delta << ", "
-            << queries.size() << " queries x " << a.repeats << " repeats (median seconds per query)\n";
+            << r.queries << " queries x " << a.repeats << " repeats (median seconds per query)\n";
   for (auto it = j.begin(); it != j.end(); ++it)
     if ((it.key().rfind("fom_", 0) == 0 || it.key().rfind("rom_", 0) == 0) && it.value().is_number())
       std::cout << "  " << std::left << std::setw(40) << it.key() << std::setprecision(4) << it.value().get<double>() << "\n";
