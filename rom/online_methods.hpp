@@ -114,7 +114,8 @@ std::pair<std::string, std::string> split_option(const std::string& key_value);
 /// default and help.
 std::string describe_online_methods();
 
-/// \brief "number in [0, 1]", "integer >= 1", "one of a|b", "true or false".
+/// \brief What a value of `spec` must be, e.g. "a number in [0, 1]", "an integer >= 1",
+/// "empty, primal or cell", "true or false (1 or 0)".
 std::string describe_option_type(const OptionSpec& spec);
 
 }  // namespace contactrom::rom
