@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <ostream>
 
@@ -11,18 +10,13 @@
 #include "baselines/ipopt_qp.hpp"
 #include "baselines/reduced_active_set.hpp"
 #include "fom/atomic_file.hpp"
+#include "fom/parameter_space.hpp"
 #include "rom/greedy_active_set.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_methods.hpp"
 
 namespace contactrom::baselines {
 namespace {
-
-std::string format_double(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 void report_progress(const VerifyOptions& o, const std::string& stage, int done, int total) {
   if (o.progress) o.progress(stage, done, total);
@@ -174,28 +168,28 @@ void write_verify_csv(const std::string& path, const fom::Problem& problem, cons
            "complementarity,reduced_penetration,tau,converged,status,iterations,sparsity,time_s\n";
     auto params_text = [&](size_t i) {
       std::string s;
-      for (int k = 0; k < r.params[i].size(); ++k) s += format_double(r.params[i](k)) + ",";
+      for (int k = 0; k < r.params[i].size(); ++k) s += fom::format_number(r.params[i](k)) + ",";
       return s;
     };
     auto kkt_text = [](const fom::KktResiduals& k) {
-      return format_double(k.stationarity) + ',' + format_double(k.penetration) + ',' +
-             format_double(k.negative_pressure) + ',' + format_double(k.complementarity);
+      return fom::format_number(k.stationarity) + ',' + fom::format_number(k.penetration) + ',' +
+             fom::format_number(k.negative_pressure) + ',' + fom::format_number(k.complementarity);
     };
     for (size_t i = 0; i < r.params.size(); ++i) {
       const fom::FomSolution& ref = r.references[i];
       out << r.reference << ',' << params_text(i) << "0,0,0," << kkt_text(r.reference_reports[i].kkt) << ",,,"
           << (ref.status == Status::Success ? 1 : 0) << ',' << to_string(ref.status) << ',' << ref.iterations << ','
-          << ref.active << ',' << format_double(ref.time_s) << '\n';
+          << ref.active << ',' << fom::format_number(ref.time_s) << '\n';
     }
     for (const MethodVerification& m : r.methods)
       for (size_t i = 0; i < r.params.size(); ++i) {
         const VerifyRow& row = m.rows[i];
         const fom::SolutionErrors& e = row.report.errors;
-        out << m.name << ',' << params_text(i) << format_double(e.primal_h1) << ',' << format_double(e.dual_l2)
+        out << m.name << ',' << params_text(i) << fom::format_number(e.primal_h1) << ',' << fom::format_number(e.dual_l2)
             << ',' << e.active_set_differences << ',' << kkt_text(row.report.kkt) << ','
-            << format_double(row.reduced_penetration) << ',' << format_double(m.tau) << ','
+            << fom::format_number(row.reduced_penetration) << ',' << fom::format_number(m.tau) << ','
             << (row.converged ? 1 : 0) << ',' << to_string(row.status) << ',' << row.iterations << ','
-            << row.sparsity << ',' << format_double(row.time_s) << '\n';
+            << row.sparsity << ',' << fom::format_number(row.time_s) << '\n';
       }
   });
 }

@@ -1,12 +1,12 @@
 #include "rom/online_methods.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <limits>
 #include <mutex>
 #include <sstream>
 
 #include "fom/input_values.hpp"
+#include "fom/parameter_space.hpp"
 #include "rom/convex_hull.hpp"
 #include "rom/greedy_active_set.hpp"
 
@@ -97,12 +97,6 @@ Registry& registry() {
   return *r;
 }
 
-std::string format_double(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 const OptionSpec* find_spec(const OnlineMethod& m, const std::string& key) {
   for (const OptionSpec& s : m.options)
     if (s.key == key) return &s;
@@ -116,10 +110,10 @@ bool is_shared(const std::string& key) {
 
 /// Text of a named field of OnlineSolverOptions.
 std::string shared_value(const OnlineSolverOptions& o, const std::string& key) {
-  if (key == "tau") return format_double(o.tau);
+  if (key == "tau") return fom::format_number(o.tau);
   if (key == "tau_scaling") return o.tau_scaling;
   if (key == "max_iterations") return std::to_string(o.max_iterations);
-  if (key == "step_tolerance") return format_double(o.step_tolerance);
+  if (key == "step_tolerance") return fom::format_number(o.step_tolerance);
   return o.time_operators ? "true" : "false";  // time_operators
 }
 

@@ -28,6 +28,7 @@
 #include "fom/atomic_file.hpp"
 #include "fom/errors.hpp"
 #include "fom/kkt.hpp"
+#include "fom/parameter_space.hpp"
 #include "rom/greedy_active_set.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_evaluation.hpp"
@@ -66,9 +67,7 @@ std::vector<baselines::VerifyMethod> methods_of(const VerifyArgs& a) {
   for (const std::string& m : split_list(a.methods, "--method")) {
     (void)rom::online_method(m);  // unknown names are refused before the database is read
     rom::OnlineSolverOptions o = options;
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.17g", a.cpg_tolerance);
-    if (m == "cpg" && a.cpg_tolerance >= 0.0) o.extra["cpg_tolerance"] = buf;
+    if (m == "cpg" && a.cpg_tolerance >= 0.0) o.extra["cpg_tolerance"] = fom::format_number(a.cpg_tolerance);
     if ((m == "cpg" || m == "full-dictionary") && !a.inner_solve.empty()) o.extra["inner_solve"] = a.inner_solve;
     if ((m == "greedy" || m == "greedy-nested" || m == "cpg" || m == "full-dictionary") && !a.init.empty())
       o.extra["init"] = a.init;
