@@ -49,6 +49,7 @@
 /// k_max counts the rebuilds, GreedyOptions::max_solves the one-change steps.
 #include <iosfwd>
 
+#include "fom/anderson.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/support_rows.hpp"
@@ -122,8 +123,14 @@ struct GreedyOptions {
   WarmStart init = WarmStart::Cell;
   /// Operator-rebuild schedule. Default Interleaved (paper Alg. 1).
   GreedySchedule schedule = GreedySchedule::Interleaved;
-  /// Nested schedule: Anderson depth of the rebuild point (0: plain). Default 5.
+  /// Anderson depth of the rebuild point while the selection stays the same (0:
+  /// plain substitution, as in the paper's Alg. 1). Default 5.
   int anderson_depth = 5;
+  /// Interleaved schedule: when a one-change step brings back a selection already
+  /// met in the query, go on with the nested schedule (from the current û and
+  /// selection, with the rebuilds left). false: the paper's Alg. 1, which may cycle
+  /// to the cap. Default true.
+  bool nested_on_cycle = true;
   /// Nested schedule: cap on the one-change solves of a query, over all rebuilds.
   /// Default 1000.
   int max_solves = 1000;
@@ -160,9 +167,15 @@ class GreedyActiveSet final : public OnlineSolver {
 
   struct Query;  // the per-query quantities both schedules share
   void solve_interleaved(Query& q, OnlineResult& res) const;
-  void solve_nested(Query& q, OnlineResult& res) const;
+  /// \param max_rebuilds cap on the operator rebuilds (k_max, or what the
+  /// interleaved schedule left of it when it hands over on a cycle)
+  void solve_nested(Query& q, OnlineResult& res, int max_rebuilds) const;
   /// Every column's violation at the fresh pairing of the returned û is within τ.
   bool confirmed(const Eigen::VectorXd& violation) const;
+  /// Interleaved schedule: the point x where the next operators are built, and its
+  /// surface displacement u_s — û itself when `plain`, else Anderson-accelerated.
+  void next_rebuild_point(bool plain, const Eigen::VectorXd& u_hat, Eigen::VectorXd& x, fom::AndersonMixer& mixer,
+                          Eigen::VectorXd& u_s, Query& q) const;
 };
 
 /// \brief The threshold τ that GreedyActiveSet applies with `options` (defaulted to δ

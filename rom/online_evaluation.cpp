@@ -26,7 +26,7 @@ Registry& registry() {
   static Registry* r = [] {
     auto* reg = new Registry;  // never destroyed: registrars may outlive static destruction order
     reg->factories["greedy"] = [](const ReducedModel& model, const OnlineSolverOptions& options) {
-      check_extra_options(options, "greedy", {"schedule", "anderson_depth", "max_solves", "init"});
+      check_extra_options(options, "greedy", {"schedule", "anderson_depth", "max_solves", "init", "on_cycle"});
       return std::unique_ptr<OnlineSolver>(std::make_unique<GreedyActiveSet>(model, greedy_options(options)));
     };
     // The same solver with the nested operator-rebuild schedule (GreedySchedule::Nested).
