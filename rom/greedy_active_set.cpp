@@ -137,6 +137,13 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
       g.max_solves = greedy_int_option(key, value, 1);
     } else if (key == "init") {
       g.init = parse_warm_start("greedy", value);
+    } else if (key == "rebuild") {
+      if (value == "partial")
+        g.rebuild = OperatorRebuild::Partial;
+      else if (value == "full")
+        g.rebuild = OperatorRebuild::Full;
+      else
+        throw InputError("greedy option rebuild = '" + value + "' unknown; expected partial or full");
     } else if (key == "on_cycle") {
       if (value == "nested")
         g.nested_on_cycle = true;
@@ -289,7 +296,7 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
   // Ĉ_I, K̂⁻¹Ĉ_Iᵀ and S in storage that only grows: the leading |I| rows/columns are used.
   RowMajorMatrix c_hat_i;
   Eigen::MatrixXd w, schur;
-  SupportOperators ops;  // pairing, C_R and g_R at the previous iterate
+  SupportOperators ops(m_options.rebuild == OperatorRebuild::Partial);  // pairing, C_R and g_R at the previous iterate
   std::vector<int> active = q.start_columns, solved;
   std::vector<char> in_active(m, 0);
   for (int p : active) in_active[p] = 1;
@@ -454,7 +461,7 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds
   Eigen::VectorXd v_free;  // every column's violation at u_free, D_Rᵀ (A u_free + b)
   Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x = q.u_start, u_hat = q.u_start;
   Eigen::MatrixXd schur;
-  SupportOperators ops;  // pairing, C_R and g_R at the rebuild point x
+  SupportOperators ops(m_options.rebuild == OperatorRebuild::Partial);  // pairing, C_R and g_R at the rebuild point x
   Eigen::VectorXd u_s;
   std::vector<char> in_active(m, 0);
   std::vector<int> solved;

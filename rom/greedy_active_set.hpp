@@ -74,6 +74,16 @@ enum class GreedySchedule {
   Nested
 };
 
+/// \brief How the contact operators are rebuilt at a new iterate (see docs/rom.md).
+enum class OperatorRebuild {
+  /// Rows whose nodes moved too little since an earlier search to change master
+  /// segment skip the search of the whole master chain (SupportOperators with a
+  /// fom::SearchMemory). Same operators, hence the same iterates, as Full.
+  Partial,
+  /// Every support row searched along the whole master chain at every rebuild.
+  Full
+};
+
 /// \brief Where an online active-set iteration starts (see docs/rom.md, "Warm start").
 /// The stencil is ReducedModel::interpolation_stencil(μ): the training parameters
 /// bracketing μ (1D) or the corners of its enclosing grid cell, with multilinear weights.
@@ -123,6 +133,8 @@ struct GreedyOptions {
   WarmStart init = WarmStart::Cell;
   /// Operator-rebuild schedule. Default Interleaved (paper Alg. 1).
   GreedySchedule schedule = GreedySchedule::Interleaved;
+  /// How each rebuild searches the contact pairs. Default Partial.
+  OperatorRebuild rebuild = OperatorRebuild::Partial;
   /// Anderson depth of the rebuild point while the selection stays the same (0:
   /// plain substitution, as in the paper's Alg. 1). Default 5.
   int anderson_depth = 5;
@@ -192,7 +204,8 @@ Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
 /// step_tolerance, and the extra keys schedule = interleaved|nested, anderson_depth,
-/// max_solves, init = empty|cell|nearest|primal) into GreedyOptions. \throws InputError
+/// max_solves, init = empty|cell|nearest|primal, rebuild = partial|full,
+/// on_cycle = nested|continue) into GreedyOptions. \throws InputError
 /// for an unknown tau_scaling, schedule or init, or a malformed number.
 GreedyOptions greedy_options(const OnlineSolverOptions& options);
 
