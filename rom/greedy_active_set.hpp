@@ -30,6 +30,14 @@
 ///     constraint \f$ D_d^T (C(u) u - g(u)) \le \tau \f$ at its own pairing;
 ///     or after k_max = 50 iterations (converged = false; by default the best iterate
 ///     with λ̂ ≥ 0 is then returned, see GreedyOptions::best_iterate_on_failure).
+/// Beyond Alg. 1 (both on by default, off with anderson_depth = 0 and
+/// on_cycle = continue): while a step changes nothing, the point where the next
+/// operators are built is Anderson-accelerated (the pairing's fixed point may
+/// oscillate, like the FOM's); and when a step brings back a selection met before in
+/// the query, the query goes on with the nested schedule below.
+/// Each rebuild searches the contact pairs with a memory of the previous searches
+/// (GreedyOptions::rebuild, fom::SearchMemory): rows that cannot have changed master
+/// segment skip the search of the whole chain, with the same operators as a full search.
 /// Only Ĉ_I (|I| rows) is formed; the violation of all m columns is evaluated as
 /// \f$ D_d^T (C_s u_s - g) \f$, which equals \f$ \hat C\hat u - \hat g \f$. Every
 /// operation costs O(n_s r + n_c (r |I| + m) + r²|I|): nothing scales with the mesh
