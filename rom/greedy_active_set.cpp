@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <initializer_list>
 #include <ostream>
+#include <string>
 #include <utility>
 
 #include "fom/anderson.hpp"
@@ -21,6 +23,18 @@ int greedy_int_option(const std::string& key, const std::string& value, int mini
     throw InputError("greedy option " + key + " = '" + value + "' invalid; expected an integer >= " +
                      std::to_string(minimum));
   return static_cast<int>(v);
+}
+
+/// Greedy setting `key` = `value`, one of the named `choices`.
+template <class T>
+T greedy_choice(const std::string& key, const std::string& value,
+                std::initializer_list<std::pair<const char*, T>> choices) {
+  std::string names;
+  for (const auto& [name, v] : choices) {
+    if (value == name) return v;
+    names += (names.empty() ? "" : " or ") + std::string(name);
+  }
+  throw InputError("greedy option " + key + " = '" + value + "' unknown; expected " + names);
 }
 
 /// Alg. 1's elimination: position of the most negative multiplier, −1 if none is.
@@ -125,12 +139,8 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
   g.time_operators = options.time_operators;
   for (const auto& [key, value] : options.extra) {
     if (key == "schedule") {
-      if (value == "interleaved")
-        g.schedule = GreedySchedule::Interleaved;
-      else if (value == "nested")
-        g.schedule = GreedySchedule::Nested;
-      else
-        throw InputError("greedy schedule '" + value + "' unknown; expected interleaved or nested");
+      g.schedule = greedy_choice<GreedySchedule>(
+          key, value, {{"interleaved", GreedySchedule::Interleaved}, {"nested", GreedySchedule::Nested}});
     } else if (key == "anderson_depth") {
       g.anderson_depth = greedy_int_option(key, value, 0);
     } else if (key == "max_solves") {
@@ -138,19 +148,10 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
     } else if (key == "init") {
       g.init = parse_warm_start("greedy", value);
     } else if (key == "rebuild") {
-      if (value == "partial")
-        g.rebuild = OperatorRebuild::Partial;
-      else if (value == "full")
-        g.rebuild = OperatorRebuild::Full;
-      else
-        throw InputError("greedy option rebuild = '" + value + "' unknown; expected partial or full");
+      g.rebuild = greedy_choice<OperatorRebuild>(
+          key, value, {{"partial", OperatorRebuild::Partial}, {"full", OperatorRebuild::Full}});
     } else if (key == "on_cycle") {
-      if (value == "nested")
-        g.nested_on_cycle = true;
-      else if (value == "continue")
-        g.nested_on_cycle = false;
-      else
-        throw InputError("greedy option on_cycle = '" + value + "' unknown; expected nested or continue");
+      g.nested_on_cycle = greedy_choice<bool>(key, value, {{"nested", true}, {"continue", false}});
     }
   }
   return g;

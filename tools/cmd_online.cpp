@@ -195,7 +195,7 @@ CommandRegistrar reg("online", [](CLI::App& app) {
   add_integer(sub, "--max-iterations", args->max_iterations, "iteration cap k_max (default 50)", 1, 100000);
   sub->add_option("--option", args->options,
                   "method setting KEY=VALUE, repeatable: init=empty|cell|nearest|primal, schedule, anderson_depth, "
-                  "max_solves (greedy; see docs/rom.md); cpg_tolerance, cpg_max_size, inner_solve, init=empty|primal|cell "
+                  "max_solves, rebuild=partial|full, on_cycle=nested|continue (greedy; see docs/rom.md); cpg_tolerance, cpg_max_size, inner_solve, init=empty|primal|cell "
                   "(cpg); inner_solve, init (full-dictionary); basis, rank_l, seed, ... (convex-hull; see docs/convex_hull.md)");
   sub->add_flag("--validation", args->validation, "evaluate on the validation set (default without --param)");
   sub->add_option("--param", args->param, "one query V or V1,V2");

@@ -350,6 +350,27 @@ BOOST_AUTO_TEST_CASE(schedule_options_are_checked) {
   BOOST_CHECK_THROW(rom::greedy_options(o), InputError);
   o.extra["max_solves"] = "12x";
   BOOST_CHECK_THROW(rom::greedy_options(o), InputError);
+  // rebuild and on_cycle: documented defaults, both values, and a refusal naming the value.
+  rom::OnlineSolverOptions p;
+  BOOST_TEST((rom::greedy_options(p).rebuild == rom::OperatorRebuild::Partial));
+  BOOST_TEST(rom::greedy_options(p).nested_on_cycle);
+  BOOST_TEST(rom::greedy_options(p).anderson_depth == 5);
+  p.extra["rebuild"] = "full";
+  p.extra["on_cycle"] = "continue";
+  BOOST_TEST((rom::greedy_options(p).rebuild == rom::OperatorRebuild::Full));
+  BOOST_TEST(!rom::greedy_options(p).nested_on_cycle);
+  for (const char* key : {"rebuild", "on_cycle"}) {
+    rom::OnlineSolverOptions bad;
+    bad.extra[key] = "sometimes";
+    try {
+      (void)rom::greedy_options(bad);
+      BOOST_ERROR(key << " = sometimes accepted");
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      BOOST_TEST(what.find("'sometimes'") != std::string::npos, what);
+      BOOST_TEST(what.find('\n') == std::string::npos, what);
+    }
+  }
 }
 
 BOOST_AUTO_TEST_CASE(zero_pressure_dictionary_gives_the_unconstrained_solution) {
