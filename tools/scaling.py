@@ -201,31 +201,33 @@ def plot_ranks(mpi_rows, path):
     plt.close(fig)
 
 
+def table(header, rows, commands):
+    """A markdown table (header cells, rows of cells) followed by its commands."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(row) + " |" for row in rows]
+    return lines + ["", "Commands: " + "; ".join(f"`{c}`" for c in commands), ""]
+
+
 def markdown(results):
     lines = []
     if results.get("fom"):
-        lines += ["| problem | refine | dofs | contact rows | setup | one query | peak memory | contact force |",
-                  "|---|---|---|---|---|---|---|---|"]
-        for r in results["fom"]:
-            lines.append(f"| {r['problem']} | {r['refine']} | {r['dofs']:,} | {r['constraints']} | {r['setup_s']:.3g} s "
-                         f"| {1e3 * r['query_s']:.3g} ms | {r['peak_mb']:.0f} MB | {r['contact_force']:.7g} |")
-        lines += ["", "Commands: " + "; ".join(f"`/usr/bin/time -v {r['command']}`" for r in results["fom"]), ""]
+        lines += table(["problem", "refine", "dofs", "contact rows", "setup", "one query", "peak memory", "contact force"],
+                       [[r["problem"], str(r["refine"]), f"{r['dofs']:,}", str(r["constraints"]), f"{r['setup_s']:.3g} s",
+                         f"{1e3 * r['query_s']:.3g} ms", f"{r['peak_mb']:.0f} MB", f"{r['contact_force']:.7g}"]
+                        for r in results["fom"]],
+                       ["/usr/bin/time -v " + r["command"] for r in results["fom"]])
     if results.get("bench"):
         keys = [(k, lab) for k, lab in BENCH_METHODS if all(k in r for r in results["bench"])]
-        lines += ["| refine | dofs | " + " | ".join(lab for _, lab in keys) + " | FOM/greedy |",
-                  "|---|---|" + "---|" * (len(keys) + 1)]
-        for r in results["bench"]:
-            cells = [f"{1e3 * r[k]:.3g} ms" if k == "fom_active_set" else f"{1e6 * r[k]:.3g} µs" for k, _ in keys]
-            lines.append(f"| {r['refine']} | {r['dofs']:,} | " + " | ".join(cells) +
-                         f" | {r['fom_active_set'] / r['rom_greedy']:.0f}× |")
-        lines += ["", "Commands: " + "; ".join(f"`{r['command']}`" for r in results["bench"]), ""]
+        lines += table(["refine", "dofs"] + [lab for _, lab in keys] + ["FOM/greedy"],
+                       [[str(r["refine"]), f"{r['dofs']:,}"] +
+                        [f"{1e3 * r[k]:.3g} ms" if k == "fom_active_set" else f"{1e6 * r[k]:.3g} µs" for k, _ in keys] +
+                        [f"{r['fom_active_set'] / r['rom_greedy']:.0f}×"] for r in results["bench"]],
+                       [r["command"] for r in results["bench"]])
     if results.get("mpi"):
-        lines += ["| ranks | wall time | offline stage | rank 0's setup | bit-identical to serial |",
-                  "|---|---|---|---|---|"]
-        for r in results["mpi"]:
-            lines.append(f"| {r['ranks']} | {r['wall_s']:.2f} s | {r['offline_s']:.2f} s | {r['setup_s']:.2f} s | "
-                         f"{'yes' if r['identical'] else 'NO'} |")
-        lines += ["", "Commands: " + "; ".join(f"`{r['command']}`" for r in results["mpi"]), ""]
+        lines += table(["ranks", "wall time", "offline stage", "rank 0's setup", "bit-identical to serial"],
+                       [[str(r["ranks"]), f"{r['wall_s']:.2f} s", f"{r['offline_s']:.2f} s", f"{r['setup_s']:.2f} s",
+                         "yes" if r["identical"] else "NO"] for r in results["mpi"]],
+                       [r["command"] for r in results["mpi"]])
     return "\n".join(lines)
 
 
