@@ -11,6 +11,7 @@
 // parameters over the ranks; rank 0 gathers them and writes the same database.
 #include <unistd.h>
 
+#include <functional>
 #include <memory>
 #include <cstdio>
 #include <iomanip>
@@ -64,11 +65,12 @@ struct Ranks {
   bool root() const { return rank == 0; }
 };
 
-/// Writes the database on rank 0; every rank then agrees on the outcome, so that
-/// all of them exit with an error if the write failed.
-void write_on_root(const std::string& path, const rom::SnapshotDatabase& db, const Ranks& ranks) {
+/// Writes the database `make()` returns on rank 0; every rank then agrees on the
+/// outcome, so that all of them exit with an error if making or writing it failed.
+void write_on_root(const std::string& path, const std::function<const rom::SnapshotDatabase&()>& make,
+                   const Ranks& ranks) {
   try {
-    if (ranks.root()) rom::write_database(path, db);
+    if (ranks.root()) rom::write_database(path, make());
   } catch (...) {
 #ifdef CONTACTROM_HAVE_MPI
     if (ranks.size > 1) rom::mpi::all_ranks_ok(false);
@@ -80,13 +82,6 @@ void write_on_root(const std::string& path, const rom::SnapshotDatabase& db, con
     throw rom::mpi::RankFailure("rank 0 could not write the database");
 #endif
 }
-
-/// The database to append to, read on every rank (all refuse alike) and checked
-/// against the run before any snapshot is computed.
-struct AppendTarget {
-  rom::SnapshotDatabase db;
-  std::vector<fom::Param> missing;  // the run's parameters it does not hold yet
-};
 
 void run_offline(const OfflineArgs& a) {
 #ifdef CONTACTROM_HAVE_MPI
@@ -105,21 +100,23 @@ void run_offline(const OfflineArgs& a) {
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);
   const fom::SamplingPlan& plan = problem->definition().training;
-  AppendTarget target;
-  if (appending) target.db = rom::read_database(a.append);
+  // The database appended to is read on every rank (all refuse alike) and checked
+  // against the run before any snapshot is computed.
+  rom::SnapshotDatabase existing;
+  if (appending) existing = rom::read_database(a.append);
   // --append without --train/--level: the database's training set.
   const bool size_from_db = appending && !a.train && !a.level && plan.selector() != "list";
-  const int n = size_from_db ? target.db.training_size
+  const int n = size_from_db ? existing.training_size
                              : fom::resolve_training_size(plan, problem->name(), a.train, a.level, false);
   if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
   const std::vector<fom::Param> training = fom::training_set(*problem, n);
   std::vector<fom::Param> params = a.part.empty() ? training : training_part(training, a.part);
   if (appending) {
-    rom::check_appendable(target.db, a.append, *problem, plan.selector(), n);
-    params = rom::parameters_not_in(target.db, params);
+    rom::check_appendable(existing, a.append, *problem, plan.selector(), n);
+    params = rom::parameters_not_in(existing, params);
     if (params.empty()) {  // every rank knows it: none computes, the file is left as it is
       if (ranks.root()) std::cout << (a.json ? nlohmann::json{{"problem", problem->name()}, {"snapshots", 0},
-                                                              {"total_snapshots", target.db.num_snapshots()},
+                                                              {"total_snapshots", existing.num_snapshots()},
                                                               {"out", out}}.dump()
                                              : a.append + " already holds these snapshots; nothing to compute")
                                   << std::endl;
@@ -142,8 +139,13 @@ void run_offline(const OfflineArgs& a) {
   const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, params, kind, n, options);
 #endif
   bar.finish();
+  rom::SnapshotDatabase appended;
+  const auto result = [&]() -> const rom::SnapshotDatabase& {
+    if (appending) appended = rom::append_snapshots(existing, a.append, db, training);
+    return appending ? appended : db;
+  };
   if (!ranks.root()) {
-    write_on_root(out, db, ranks);
+    write_on_root(out, result, ranks);
     return;
   }
 
@@ -154,8 +156,8 @@ void run_offline(const OfflineArgs& a) {
     std::cerr << "contactrom: warning: snapshot " << j << " (" << param_text(*problem, db.parameter(j))
               << ") status " << to_string(db.status[j]) << "; stored with its status and left out of the ROM\n";
   }
-  const int stored = appending ? target.db.num_snapshots() : 0;
-  write_on_root(out, appending ? rom::append_snapshots(target.db, a.append, db, training) : db, ranks);
+  const int stored = appending ? existing.num_snapshots() : 0;
+  write_on_root(out, result, ranks);
 
   double fom_sum = 0.0;
   for (double t : db.time_s) fom_sum += t;
