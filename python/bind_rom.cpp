@@ -63,13 +63,13 @@ std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, doub
     r->model = std::make_unique<rom::ReducedModel>(*r->problem, *r->db, model_options);
     r->solver = rom::make_online_solver(method, *r->model, solver_options);
   }
-  if (r->model->primal_rank() == 0)
-    PyErr_WarnEx(PyExc_RuntimeWarning,
-                 ("delta " + fom::format_number(delta) +
-                  " keeps no POD mode (primal rank 0); the reduced solution is the lifting alone and no contact "
-                  "can be enforced; expected a delta well below 1 (paper: 1e-6 to 1e-10)")
+  if (r->model->primal_rank() == 0 &&
+      PyErr_WarnEx(PyExc_RuntimeWarning,
+                 ("ReducedModel: delta " + fom::format_number(delta) +
+                  " keeps no POD mode; the reduced displacement is the offset alone")
                      .c_str(),
-                 1);
+                 1) != 0)
+    throw py::error_already_set();  // the warning was turned into an error
   return r;
 }
 

@@ -68,6 +68,8 @@ def main():
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
     ax.semilogy(rows["mu"][:, 0], np.maximum(rows["primal_error"], 1e-17), ".-", label="primal (H1)")
     ax.semilogy(rows["mu"][:, 0], np.maximum(rows["dual_error"], 1e-17), ".-", label="dual (L2 on the contact arc)")
+    for k, d_train in enumerate(db.parameters[:, 0]):
+        ax.axvline(d_train, color="0.85", linewidth=0.8, zorder=0, label="training parameters" if k == 0 else None)
     ax.set_xlabel("d")
     ax.set_ylabel("relative error of the ROM")
     ax.legend()
@@ -77,8 +79,10 @@ def main():
 
     print(f"hertz: {args.train} snapshots, primal rank {rom.primal_rank}, dictionary {rom.dictionary_size}; "
           f"offline {t_offline:.2f} s")
-    print(f"{queries} queries in {t_online * 1e3:.1f} ms; max primal error {report['max_primal_error']:.2e}, "
-          f"max dual error {report['max_dual_error']:.2e}, not converged {report['nonconverged']}")
+    print(f"{queries} queries in {t_online * 1e3:.1f} ms; primal error mean {report['mean_primal_error']:.2e} "
+          f"max {report['max_primal_error']:.2e}, dual error mean {report['mean_dual_error']:.2e} "
+          f"max {report['max_dual_error']:.2e} (largest below the first training parameter); "
+          f"not converged {report['nonconverged']}")
     print(f"plots written to {args.out}/hertz_pressure.png and {args.out}/hertz_error.png")
     if report["nonconverged"] or report["fom_failures"]:
         raise SystemExit("some queries did not converge")
