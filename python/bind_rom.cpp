@@ -4,38 +4,11 @@
 #include <Python.h>
 
 #include "fom/errors.hpp"
-#include "fom/input_values.hpp"
 #include "python/bindings.hpp"
 #include "rom/offline.hpp"
 
 namespace contactrom::python {
 namespace {
-
-/// OnlineSolverOptions from a {key: value} dict: the settings every method shares
-/// by name, the others as method-specific text (checked by the method's factory).
-rom::OnlineSolverOptions online_options(const std::map<std::string, std::string>& values) {
-  rom::OnlineSolverOptions o;
-  for (const auto& [key, text] : values) {
-    const std::string what = "option " + key;
-    if (key == "tau")
-      o.tau = parse_number(text, what, Interval::at_least(0));
-    else if (key == "tau_scaling") {
-      if (text != "absolute" && text != "relative")
-        throw InputError(what + " = " + quoted(text) + " invalid; expected absolute or relative");
-      o.tau_scaling = text;
-    } else if (key == "max_iterations")
-      o.max_iterations = static_cast<int>(parse_integer(text, what, 1, 100000));
-    else if (key == "step_tolerance")
-      o.step_tolerance = parse_number(text, what, Interval::at_least(0));
-    else if (key == "time_operators") {
-      if (text != "true" && text != "false" && text != "1" && text != "0")
-        throw InputError(what + " = " + quoted(text) + " invalid; expected true or false");
-      o.time_operators = text == "true" || text == "1";
-    } else
-      o.extra[key] = text;
-  }
-  return o;
-}
 
 rom::LiftingKind lifting_kind(const std::string& text) {
   if (text == "harmonic") return rom::LiftingKind::Harmonic;
@@ -48,34 +21,41 @@ std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, doub
                                                   bool include_failed) {
   if (!(delta >= 0.0 && delta <= 1.0))
     throw InputError("delta = " + fom::format_number(delta) + " is outside [0, 1]; expected a POD tolerance such as 1e-8");
-  auto r = std::make_unique<ReducedModel>();
-  r->problem = database.problem;
-  r->db = database.db;
-  r->method = method;
-  for (const auto& [key, value] : options) r->options[py::str(key)] = option_text(value);
-  const rom::OnlineSolverOptions solver_options = online_options(r->options);
+  rom::check_online_method(method);
+  std::map<std::string, std::string> values;
+  for (const auto& [key, value] : options) values[py::str(key)] = option_text(value);
+  const rom::OnlineSolverOptions solver_options = rom::online_options_from_values(values);
   rom::ReducedModelOptions model_options;
   model_options.delta = delta;
   model_options.lifting = lifting_kind(lifting);
   model_options.include_failed_snapshots = include_failed;
+  auto r = std::make_unique<ReducedModel>();
+  r->db = database.db;
   {
     py::gil_scoped_release release;
-    r->model = std::make_unique<rom::ReducedModel>(*r->problem, *r->db, model_options);
-    r->solver = rom::make_online_solver(method, *r->model, solver_options);
+    r->rom = std::make_shared<rom::OnlineModel>(database.problem, *r->db, model_options, method, solver_options);
   }
-  if (r->model->primal_rank() == 0 &&
+  if (r->rom->model().primal_rank() == 0 &&
       PyErr_WarnEx(PyExc_RuntimeWarning,
-                 ("ReducedModel: delta " + fom::format_number(delta) +
-                  " keeps no POD mode; the reduced displacement is the offset alone")
-                     .c_str(),
-                 1) != 0)
+                   ("ReducedModel: delta " + fom::format_number(delta) +
+                    " keeps no POD mode; the reduced displacement is the offset alone")
+                       .c_str(),
+                   1) != 0)
     throw py::error_already_set();  // the warning was turned into an error
   return r;
 }
 
-py::dict summary_dict(const rom::EvaluationSummary& s, const ReducedModel& r, int num_params) {
+std::unique_ptr<ReducedModel> load_reduced_model(const std::string& path) {
+  auto r = std::make_unique<ReducedModel>();
+  py::gil_scoped_release release;
+  r->rom = std::make_shared<rom::OnlineModel>(rom::OnlineModel::load(path));
+  return r;
+}
+
+py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& problem) {
+  const int num_params = problem.num_params();
   py::dict d;
-  d["problem"] = r.problem->name();
+  d["problem"] = problem.name();
   d["method"] = s.method;
   d["delta"] = s.delta;
   d["dictionary_size"] = s.dictionary_size;
@@ -239,63 +219,87 @@ works in memory but is refused when read back from a file.)doc");
 
   py::class_<ReducedModel>(m, "ReducedModel", R"doc(
 POD basis, dual dictionary, reduced operators and an online method, built from a
-snapshot database. The object owns the problem and the database it needs.)doc")
+snapshot database or loaded from a reduced-model file (`contactrom reduce`). The
+object owns the problem (and the database) it needs.)doc")
       .def(py::init(&build_reduced_model), py::arg("db"), py::arg("delta") = 1e-8, py::arg("method") = "greedy",
            py::arg("options") = py::dict(), py::arg("lifting") = "harmonic",
            py::arg("include_failed_snapshots") = false)
-      .def_property_readonly("problem", [](const ReducedModel& r) { return std::const_pointer_cast<fom::Problem>(r.problem); })
-      .def_property_readonly("database", [](const ReducedModel& r) { return Database{r.db, r.problem}; })
-      .def_property_readonly("method", [](const ReducedModel& r) { return r.method; })
-      .def_property_readonly("options", [](const ReducedModel& r) { return r.options; })
-      .def_property_readonly("delta", [](const ReducedModel& r) { return r.model->delta(); })
-      .def_property_readonly("primal_rank", [](const ReducedModel& r) { return r.model->primal_rank(); })
-      .def_property_readonly("dictionary_size", [](const ReducedModel& r) { return r.model->dictionary_size(); })
-      .def_property_readonly("dual_basis_size", [](const ReducedModel& r) { return r.solver->dual_basis_size(); })
+      .def_static("load", &load_reduced_model, py::arg("path"),
+                  "Reads a reduced-model file (`contactrom reduce` or ReducedModel.save): no FOM, no meshing.")
+      .def(
+          "save",
+          [](const ReducedModel& r, const std::string& path) {
+            py::gil_scoped_release release;
+            r.rom->save(path);
+          },
+          py::arg("path"), "Writes the reduced-model file (atomically), readable by `contactrom query` and load.")
+      .def_property_readonly("problem",
+                             [](const ReducedModel& r) { return std::const_pointer_cast<fom::Problem>(r.rom->shared_problem()); })
       .def_property_readonly(
-          "basis", [](const ReducedModel& r) -> const Eigen::MatrixXd& { return r.model->basis(); },
+          "database",
+          [](const ReducedModel& r) -> py::object {
+            if (!r.db) return py::none();
+            return py::cast(Database{r.db, r.rom->shared_problem()});
+          },
+          "The snapshot database it was built from (None when loaded from a file).")
+      .def_property_readonly("method", [](const ReducedModel& r) { return r.rom->method(); })
+      .def_property_readonly("options", [](const ReducedModel& r) { return rom::online_option_values(r.rom->options()); },
+                             "The method's settings as text, as stored in the reduced-model file.")
+      .def_property_readonly("delta", [](const ReducedModel& r) { return r.rom->model().delta(); })
+      .def_property_readonly("primal_rank", [](const ReducedModel& r) { return r.rom->model().primal_rank(); })
+      .def_property_readonly("dictionary_size", [](const ReducedModel& r) { return r.rom->model().dictionary_size(); })
+      .def_property_readonly("dual_basis_size", [](const ReducedModel& r) { return r.rom->solver().dual_basis_size(); })
+      .def_property_readonly(
+          "basis", [](const ReducedModel& r) -> const Eigen::MatrixXd& { return r.rom->model().basis(); },
           py::return_value_policy::reference_internal, "POD basis Phi (n_dofs, r), read-only view.")
       .def_property_readonly(
-          "dictionary", [](const ReducedModel& r) -> const Eigen::MatrixXd& { return r.model->dictionary(); },
+          "dictionary", [](const ReducedModel& r) -> const Eigen::MatrixXd& { return r.rom->model().dictionary(); },
           py::return_value_policy::reference_internal, "Dual dictionary D (n_c, m), read-only view.")
       .def_property_readonly(
-          "singular_values", [](const ReducedModel& r) -> const Eigen::VectorXd& { return r.model->singular_values(); },
+          "singular_values",
+          [](const ReducedModel& r) -> const Eigen::VectorXd& { return r.rom->model().singular_values(); },
           py::return_value_policy::reference_internal)
-      .def_property_readonly("dictionary_snapshots", [](const ReducedModel& r) { return r.model->dictionary_snapshots(); },
+      .def_property_readonly("dictionary_snapshots",
+                             [](const ReducedModel& r) { return r.rom->model().dictionary_snapshots(); },
                              "Database snapshot index of each dictionary column.")
       .def(
           "solve",
           [](const ReducedModel& r, py::handle mu) {
-            const fom::Param p = to_param(*r.problem, mu);
+            const fom::Param p = to_param(r.rom->problem(), mu);
             py::gil_scoped_release release;
-            return r.solver->solve(p);
+            return r.rom->solver().solve(p);
           },
           py::arg("mu"), "One online query (GIL released): a RomSolution.")
       .def(
           "solve_all",
           [](const ReducedModel& r, py::handle params) {
-            const std::vector<fom::Param> ps = to_params(*r.problem, params);
+            const std::vector<fom::Param> ps = to_params(r.rom->problem(), params);
             std::vector<rom::OnlineResult> out;
             out.reserve(ps.size());
             py::gil_scoped_release release;
-            for (const fom::Param& p : ps) out.push_back(r.solver->solve(p));
+            for (const fom::Param& p : ps) out.push_back(r.rom->solver().solve(p));
             return out;
           },
           py::arg("params"), "Online queries at every row of params, in order (GIL released).")
       .def(
           "evaluate",
           [](const ReducedModel& r, py::object params, int threads, bool kkt) {
-            const std::vector<fom::Param> ps = params.is_none() ? rom::database_validation_set(*r.db, *r.problem)
-                                                                : to_params(*r.problem, params);
+            const fom::Problem& problem = r.rom->problem();
+            if (params.is_none() && !r.db)
+              throw InputError("evaluate() of a reduced model loaded from a file needs params; it has no database "
+                               "and so no validation set");
+            const std::vector<fom::Param> ps =
+                params.is_none() ? rom::database_validation_set(*r.db, problem) : to_params(problem, params);
             rom::EvaluationSummary s;
             {
               py::gil_scoped_release release;
-              const fom::ActiveSetSolver fom_solver(*r.problem);
+              const fom::ActiveSetSolver fom_solver(problem);
               const std::vector<fom::FomSolution> refs = rom::compute_references(fom_solver, ps, threads);
               rom::EvaluationOptions options;
               options.kkt = kkt;
-              s = rom::evaluate_online(*r.solver, ps, refs, options);
+              s = rom::evaluate_online(r.rom->solver(), ps, refs, options);
             }
-            return summary_dict(s, r, r.problem->num_params());
+            return summary_dict(s, problem);
           },
           py::arg("params") = py::none(), py::arg("threads") = 0, py::arg("kkt") = false, R"doc(
 Errors against the FOM over `params` (default: the database's validation set, as
@@ -303,9 +307,9 @@ Errors against the FOM over `params` (default: the database's validation set, as
 the per-parameter arrays (mu, primal_error, dual_error, sparsity, iterations,
 time_s, converged, status).)doc")
       .def("__repr__", [](const ReducedModel& r) {
-        return "<contactrom.ReducedModel '" + r.problem->name() + "' " + r.method + ": rank " +
-               std::to_string(r.model->primal_rank()) + ", dictionary " + std::to_string(r.model->dictionary_size()) +
-               ">";
+        return "<contactrom.ReducedModel '" + r.rom->problem().name() + "' " + r.rom->method() + ": rank " +
+               std::to_string(r.rom->model().primal_rank()) + ", dictionary " +
+               std::to_string(r.rom->model().dictionary_size()) + ">";
       });
 
   m.def("online_methods", &rom::online_solver_names, "Names of the registered online methods.");

@@ -4,10 +4,10 @@
 /// that own what the C++ classes only reference, parameter conversion and
 /// read-only numpy views of Eigen storage.
 ///
-/// Ownership: a fom::ActiveSetSolver, a rom::ReducedModel and an online solver
-/// keep references to their Problem (and model); the Python objects below hold
-/// shared pointers to everything they reference, so a Python user may drop the
-/// problem or the database and keep the reduced model.
+/// Ownership: a fom::ActiveSetSolver keeps a reference to its Problem and a
+/// rom::OnlineModel a shared pointer; the Python objects below hold shared pointers
+/// to everything they reference, so a Python user may drop the problem or the
+/// database and keep the solver or the reduced model.
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -24,6 +24,7 @@
 #include "fom/problem.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
+#include "rom/reduced_model_file.hpp"
 #include "rom/snapshot_database.hpp"
 
 namespace contactrom::python {
@@ -56,14 +57,11 @@ struct FullOrderSolver {
   fom::FomSolution solve(const fom::Param& mu) const;
 };
 
-/// \brief A reduced model with its online solver, owning the problem and database.
+/// \brief A reduced model with its online method (which owns its problem), and the
+/// database it was built from (null for a model loaded from a reduced-model file).
 struct ReducedModel {
-  ProblemPtr problem;
+  std::shared_ptr<const rom::OnlineModel> rom;
   std::shared_ptr<const rom::SnapshotDatabase> db;
-  std::unique_ptr<rom::ReducedModel> model;
-  std::unique_ptr<rom::OnlineSolver> solver;
-  std::string method;
-  std::map<std::string, std::string> options;  // as given, in text form
 };
 
 /// \brief μ from a Python number or sequence, checked as the CLI checks `--param`
