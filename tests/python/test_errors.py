@@ -58,3 +58,18 @@ def test_shape_errors_name_the_argument():
         contactrom.nnls(np.eye(3), np.ones(2))
     with pytest.raises(ValueError, match="non-finite"):
         contactrom.omp(np.array([[1.0, np.inf]]), np.ones(1))
+
+
+def test_missing_reduced_model(tmp_path):
+    path = str(tmp_path / "missing_rom.h5")
+    expected = cli_error("query", "--rom", path, "--param", "0.1")
+    with pytest.raises(ValueError) as e:
+        contactrom.ReducedModel.load(path)
+    assert message_of(e) == expected
+
+
+def test_database_is_not_a_reduced_model(hertz_db_path):
+    expected = cli_error("query", "--rom", str(hertz_db_path), "--param", "0.1")
+    with pytest.raises(ValueError) as e:
+        contactrom.ReducedModel.load(str(hertz_db_path))
+    assert message_of(e) == expected

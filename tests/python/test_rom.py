@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import contactrom
-from conftest import HERTZ_TRAIN, run_cli_json
+from conftest import HERTZ_TRAIN, run_cli, run_cli_json
 
 
 @pytest.fixture(scope="module")
@@ -110,3 +110,48 @@ def test_solve_all_equals_single_solves(rom):
     results = rom.solve_all(params)
     for mu, r in zip(params, results):
         assert r.selected == rom.solve(mu).selected
+
+
+QUERY_PARAMS = [0.0137, 0.1, 0.2999]
+
+
+def query_cli(tmp_path, rom_path):
+    csv = tmp_path / "params.csv"
+    csv.write_text("d\n" + "\n".join(repr(p) for p in QUERY_PARAMS) + "\n")
+    return run_cli_json("query", "--rom", str(rom_path), "--params", str(csv))["queries"]
+
+
+def assert_same_answers(model, queries):
+    assert len(queries) == len(QUERY_PARAMS)
+    for q, mu in zip(queries, QUERY_PARAMS):
+        r = model.solve(mu)
+        assert r.status == q["status"] and r.iterations == q["iterations"]
+        assert [model.dictionary_snapshots[c] for c in r.selected] == q["selected"]
+        assert np.allclose(r.coefficients, q["coefficients"], rtol=1e-12, atol=0.0)
+        assert model.problem.contact_force(r.lam) == pytest.approx(q["contact_force"], rel=1e-12)
+
+
+def test_saved_model_answers_as_cli_query(tmp_path, rom):
+    path = tmp_path / "rom.h5"
+    rom.save(str(path))
+    queries = query_cli(tmp_path, path)
+    assert_same_answers(rom, queries)
+    loaded = contactrom.ReducedModel.load(str(path))
+    assert loaded.database is None
+    assert (loaded.method, loaded.primal_rank, loaded.dictionary_size) == (rom.method, rom.primal_rank,
+                                                                          rom.dictionary_size)
+    assert_same_answers(loaded, queries)
+
+
+def test_cli_reduced_model_loads_in_python(tmp_path, hertz_db_path):
+    path = tmp_path / "cpg.h5"
+    run_cli("reduce", "--db", str(hertz_db_path), "--method", "cpg", "--option", "cpg_tolerance=0.01",
+            "--out", str(path))
+    loaded = contactrom.ReducedModel.load(str(path))
+    assert loaded.method == "cpg"
+    assert float(loaded.options["cpg_tolerance"]) == 0.01
+    assert_same_answers(loaded, query_cli(tmp_path, path))
+    with pytest.raises(ValueError, match="needs params"):
+        loaded.evaluate()
+    report = loaded.evaluate(QUERY_PARAMS, threads=1)
+    assert report["validation_size"] == len(QUERY_PARAMS)
