@@ -45,6 +45,25 @@ SparseResult run(Solver& solver, const std::function<Eigen::VectorXd()>& solve) 
   return r;
 }
 
+/// Binds FOCUSS or nnFOCUSS (same options, same call) as `name`.
+template <class Solver>
+void bind_focuss(py::module_& m, const char* name, const char* doc) {
+  m.def(
+      name,
+      [name](const Eigen::MatrixXd& d, const Eigen::VectorXd& x, int max_iterations, double tolerance,
+             double prune_tolerance) {
+        check_system(name, d, x, "D", "x");
+        rom::FocussOptions o;
+        o.max_iterations = max_iterations;
+        o.tolerance = tolerance;
+        o.prune_tolerance = prune_tolerance;
+        Solver solver(o);
+        return run(solver, [&] { return solver.compute(d).solve(x); });
+      },
+      py::arg("D"), py::arg("x"), py::arg("max_iterations") = 100, py::arg("tolerance") = 1e-10,
+      py::arg("prune_tolerance") = 1e-8, doc);
+}
+
 }  // namespace
 
 void bind_kernels(py::module_& m) {
@@ -82,33 +101,8 @@ void bind_kernels(py::module_& m) {
       },
       py::arg("D"), py::arg("x"), py::arg("max_atoms") = -1, py::arg("tolerance") = 1e-8,
       "Orthogonal matching pursuit: sparse alpha with D alpha ~ x (||x - D alpha|| <= tolerance ||x||).");
-  const auto focuss_options = [](int max_iterations, double tolerance, double prune_tolerance) {
-    rom::FocussOptions o;
-    o.max_iterations = max_iterations;
-    o.tolerance = tolerance;
-    o.prune_tolerance = prune_tolerance;
-    return o;
-  };
-  m.def(
-      "focuss",
-      [focuss_options](const Eigen::MatrixXd& d, const Eigen::VectorXd& x, int max_iterations, double tolerance,
-                       double prune_tolerance) {
-        check_system("focuss", d, x, "D", "x");
-        rom::Focuss solver(focuss_options(max_iterations, tolerance, prune_tolerance));
-        return run(solver, [&] { return solver.compute(d).solve(x); });
-      },
-      py::arg("D"), py::arg("x"), py::arg("max_iterations") = 100, py::arg("tolerance") = 1e-10,
-      py::arg("prune_tolerance") = 1e-8, "FOCUSS (re-weighted minimum norm) from the minimum-norm solution.");
-  m.def(
-      "nnfocuss",
-      [focuss_options](const Eigen::MatrixXd& d, const Eigen::VectorXd& x, int max_iterations, double tolerance,
-                       double prune_tolerance) {
-        check_system("nnfocuss", d, x, "D", "x");
-        rom::NnFocuss solver(focuss_options(max_iterations, tolerance, prune_tolerance));
-        return run(solver, [&] { return solver.compute(d).solve(x); });
-      },
-      py::arg("D"), py::arg("x"), py::arg("max_iterations") = 100, py::arg("tolerance") = 1e-10,
-      py::arg("prune_tolerance") = 1e-8, "nnFOCUSS (non-negative FOCUSS started from NNLS).");
+  bind_focuss<rom::Focuss>(m, "focuss", "FOCUSS (re-weighted minimum norm) from the minimum-norm solution.");
+  bind_focuss<rom::NnFocuss>(m, "nnfocuss", "nnFOCUSS (non-negative FOCUSS started from NNLS).");
 }
 
 }  // namespace contactrom::python
