@@ -26,10 +26,14 @@ fom::Param to_param(const fom::Problem& problem, py::handle value) {
     const double v = value.cast<double>();
     return checked_param(problem, &v, 1);
   }
+  const auto refuse = [&] {
+    return InputError("a parameter of '" + problem.name() + "' is a number or a sequence of " +
+                      std::to_string(problem.num_params()) + " numbers (" + problem.range_text() + ")");
+  };
+  if (py::isinstance<py::str>(value)) throw refuse();  // numpy would read the text
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
-  if (!a || a.ndim() != 1)
-    throw InputError("a parameter of '" + problem.name() + "' is a number or a sequence of " +
-                     std::to_string(problem.num_params()) + " numbers (" + problem.range_text() + ")");
+  if (a && a.ndim() == 0) return checked_param(problem, a.data(), 1);  // numpy scalars
+  if (!a || a.ndim() != 1) throw refuse();
   return checked_param(problem, a.data(), a.size());
 }
 

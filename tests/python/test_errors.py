@@ -30,6 +30,14 @@ def test_parameter_out_of_range(mu, text):
     assert message_of(e) == expected
 
 
+def test_parameter_forms_are_equivalent():
+    hertz = contactrom.problem("hertz")
+    for mu in (0.2, np.float64(0.2), np.array(0.2), [0.2], np.array([0.2])):
+        assert hertz.check_param(mu).tolist() == [0.2]
+    with pytest.raises(ValueError, match="is a number or a sequence"):
+        hertz.check_param("0.2")
+
+
 def test_missing_database(tmp_path):
     path = str(tmp_path / "missing.h5")
     expected = cli_error("online", "--db", path)
