@@ -185,6 +185,6 @@ BOOST_AUTO_TEST_CASE(cli_database_of_another_mesh_is_refused) {
   const auto r = run_command(exe + " online --db " + db + " --method greedy");
   BOOST_TEST(r.exit_code != 0);
   BOOST_TEST(lines(r.err) == 1);
-  BOOST_TEST(r.err.find("was built for mesh fingerprint 00000000deadbeef but the current hertz mesh is " +
+  BOOST_TEST(r.err.find("was built for mesh fingerprint 00000000deadbeef but the stored problem gives " +
                         hertz().fingerprint()) != std::string::npos);
 }
