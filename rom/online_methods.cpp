@@ -58,6 +58,11 @@ std::vector<OptionSpec> greedy_specs(bool with_schedule) {
                        {"interleaved", "nested"}));
   o.push_back(integer("anderson_depth", "5", "nested schedule: Anderson depth of the rebuild point (0: plain)", 0, 1e6));
   o.push_back(integer("max_solves", "1000", "nested schedule: cap on the one-change solves of a query", 1, 1e9));
+  o.push_back(choice("rebuild", "partial", "contact operators rebuilt on the changed rows only (partial) or all (full)",
+                     {"partial", "full"}));
+  if (with_schedule)
+    o.push_back(choice("on_cycle", "nested", "interleaved schedule: on a revisited selection switch to nested, or continue",
+                       {"nested", "continue"}));
   return o;
 }
 
@@ -342,6 +347,8 @@ long long parse_option_integer(const std::string& method, const std::string& key
   return parse_integer(text, method + " option " + key, std::numeric_limits<long long>::min(),
                        std::numeric_limits<long long>::max());
 }
+
+void check_online_method(const std::string& name) { (void)online_method(name); }
 
 std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const ReducedModel& model,
                                                  const OnlineSolverOptions& options) {

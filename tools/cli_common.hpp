@@ -3,11 +3,14 @@
 /// \brief Small helpers shared by the subcommands.
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "fom/input_values.hpp"
 #include "fom/kkt.hpp"
 #include "fom/problem.hpp"
+#include "rom/online_evaluation.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::cli {
@@ -67,6 +70,52 @@ inline void warn_if_no_primal_modes(const rom::ReducedModel& model) {
     std::cerr << "contactrom: warning: delta " << model.delta()
               << " keeps no POD mode (primal rank 0); the reduced solution is the lifting alone"
                  " and no contact can be enforced; expected a delta well below 1 (paper: 1e-6 to 1e-10)\n";
+}
+
+/// The options that choose a reduced model and its online method (`online`, `reduce`).
+struct MethodArgs {
+  std::string method = "greedy", tau_scaling = "absolute", lifting = "harmonic";
+  double delta = 1e-8, tau = -1.0;
+  int max_iterations = 50;
+  std::vector<std::string> options;  // KEY=VALUE method settings
+
+  /// The reduced-model settings (δ, lifting).
+  rom::ReducedModelOptions model_options() const {
+    rom::ReducedModelOptions o;
+    o.delta = delta;
+    o.lifting = lifting == "dirichlet" ? rom::LiftingKind::Dirichlet : rom::LiftingKind::Harmonic;
+    return o;
+  }
+  /// The online settings; \throws InputError for an --option without '='.
+  rom::OnlineSolverOptions solver_options() const {
+    // --option KEY=VALUE pairs and the named flags, checked against the method's
+    // declared options (rom/online_methods.hpp).
+    std::map<std::string, std::string> values;
+    for (const std::string& kv : options) {
+      auto [key, value] = rom::split_option(kv);
+      values[key] = value;
+    }
+    rom::OnlineSolverOptions o = rom::options_from_map(method, values);
+    if (!values.count("tau")) o.tau = tau;
+    if (!values.count("tau_scaling")) o.tau_scaling = tau_scaling;
+    if (!values.count("max_iterations")) o.max_iterations = max_iterations;
+    return o;
+  }
+};
+
+/// Adds --method, --delta, --tau, --tau-scaling, --lifting, --max-iterations, --option.
+inline void add_method_options(CLI::App* sub, MethodArgs& a) {
+  sub->add_option("--method", a.method, "online method (default greedy; listed below)");
+  sub->footer(rom::describe_online_methods());
+  add_number(sub, "--delta", a.delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
+  add_number(sub, "--tau", a.tau, "greedy penetration threshold (default: tau = delta)", Interval::at_least(0));
+  sub->add_option("--tau-scaling", a.tau_scaling, "absolute (default, paper) | relative")
+      ->check(CLI::IsMember({"absolute", "relative"}));
+  sub->add_option("--lifting", a.lifting,
+                  "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet")
+      ->check(CLI::IsMember({"harmonic", "dirichlet"}));
+  add_integer(sub, "--max-iterations", a.max_iterations, "iteration cap k_max (default 50)", 1, 100000);
+  sub->add_option("--option", a.options, "method setting KEY=VALUE, repeatable; each method's keys are listed below");
 }
 
 }  // namespace contactrom::cli
