@@ -24,7 +24,7 @@ std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, doub
   rom::check_online_method(method);
   std::map<std::string, std::string> values;
   for (const auto& [key, value] : options) values[py::str(key)] = option_text(value);
-  const rom::OnlineSolverOptions solver_options = rom::online_options_from_values(values);
+  const rom::OnlineSolverOptions solver_options = rom::options_from_map(method, values);
   rom::ReducedModelOptions model_options;
   model_options.delta = delta;
   model_options.lifting = lifting_kind(lifting);
@@ -243,7 +243,7 @@ object owns the problem (and the database) it needs.)doc")
           },
           "The snapshot database it was built from (None when loaded from a file).")
       .def_property_readonly("method", [](const ReducedModel& r) { return r.rom->method(); })
-      .def_property_readonly("options", [](const ReducedModel& r) { return rom::online_option_values(r.rom->options()); },
+      .def_property_readonly("options", [](const ReducedModel& r) { return rom::options_to_map(r.rom->method(), r.rom->options()); },
                              "The method's settings as text, as stored in the reduced-model file.")
       .def_property_readonly("delta", [](const ReducedModel& r) { return r.rom->model().delta(); })
       .def_property_readonly("primal_rank", [](const ReducedModel& r) { return r.rom->model().primal_rank(); })

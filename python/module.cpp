@@ -3,11 +3,9 @@
 // The pure-Python package `contactrom` (python/contactrom/) re-exports it.
 #include <cmath>
 
-#include "baselines/reduced_active_set.hpp"
 #include "fom/errors.hpp"
 #include "fom/input_values.hpp"
 #include "python/bindings.hpp"
-#include "rom/convex_hull.hpp"
 
 namespace contactrom::python {
 
@@ -110,10 +108,6 @@ PYBIND11_MODULE(_contactrom, m) {
       PyErr_SetString(PyExc_ValueError, e.what());
     }
   });
-
-  // The online methods outside contactrom::rom's own file are registered here once.
-  baselines::register_baseline_online_solvers();
-  rom::register_convex_hull_solver();
 
   python::bind_fom(m);
   python::bind_rom(m);

@@ -29,14 +29,6 @@ std::string format_number(double v) {
   return buf;
 }
 
-double parse_number(const std::string& key, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
-    throw InputError("online option " + key + " = '" + text + "' is not a number");
-  return v;
-}
-
 /// The column-major rows × cols matrix as a dataset of cols rows (one column of
 /// `m` per dataset row, as h5py users index them).
 void write_columns(hid_t f, hid_t dcpl, const char* name, const Eigen::MatrixXd& m) {
@@ -79,7 +71,7 @@ void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
   const int include_failed = d.options.include_failed_snapshots ? 1 : 0;
   hdf5::write_scalar_attribute(f, "include_failed_snapshots", H5T_STD_I32LE, H5T_NATIVE_INT, &include_failed);
   std::vector<std::string> keys, values;
-  for (const auto& [key, value] : online_option_values(rom.options())) keys.push_back(key), values.push_back(value);
+  for (const auto& [key, value] : options_to_map(rom.method(), rom.options())) keys.push_back(key), values.push_back(value);
   Handle options(H5Gcreate2(f, "options", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "group /options");
   hdf5::write_string_list(f, dcpl, "options/keys", keys);
   hdf5::write_string_list(f, dcpl, "options/values", values);
@@ -111,35 +103,6 @@ void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
 }
 
 }  // namespace
-
-std::map<std::string, std::string> online_option_values(const OnlineSolverOptions& options) {
-  std::map<std::string, std::string> out = options.extra;
-  if (options.tau >= 0.0) out["tau"] = format_number(options.tau);
-  out["tau_scaling"] = options.tau_scaling;
-  out["max_iterations"] = std::to_string(options.max_iterations);
-  out["step_tolerance"] = format_number(options.step_tolerance);
-  return out;
-}
-
-OnlineSolverOptions online_options_from_values(const std::map<std::string, std::string>& values) {
-  OnlineSolverOptions o;
-  for (const auto& [key, value] : values) {
-    if (key == "tau")
-      o.tau = parse_number(key, value);
-    else if (key == "tau_scaling")
-      o.tau_scaling = value;
-    else if (key == "max_iterations") {
-      const double v = parse_number(key, value);
-      if (v != std::floor(v) || v < 1 || v > 1e9)
-        throw InputError("online option max_iterations = '" + value + "' invalid; expected an integer >= 1");
-      o.max_iterations = static_cast<int>(v);
-    } else if (key == "step_tolerance")
-      o.step_tolerance = parse_number(key, value);
-    else
-      o.extra[key] = value;
-  }
-  return o;
-}
 
 OnlineModel::OnlineModel(std::shared_ptr<const fom::Problem> problem, std::unique_ptr<ReducedModel> model,
                          const std::string& method, const OnlineSolverOptions& options)
@@ -253,7 +216,7 @@ OnlineModel OnlineModel::load(const std::string& path) {
   }
   try {
     auto model = std::make_unique<ReducedModel>(*problem, std::move(d));
-    return OnlineModel(problem, std::move(model), method, online_options_from_values(option_values));
+    return OnlineModel(problem, std::move(model), method, options_from_map(method, option_values));
   } catch (const InputError& e) {
     throw InputError(label + ": " + e.what());
   }

@@ -23,6 +23,7 @@
 
 #include "fom/problem.hpp"
 #include "rom/online_evaluation.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
 
@@ -30,17 +31,6 @@ namespace contactrom::rom {
 
 /// \brief Version of the reduced-model file layout (attribute `format_version`).
 inline constexpr int kReducedModelFormatVersion = 1;
-
-/// \brief The settings of an online method as text, key → value: the shared
-/// settings (`tau` when set, `tau_scaling`, `max_iterations`, `step_tolerance`)
-/// and the method-specific ones (OnlineSolverOptions::extra). Numbers are written
-/// with 17 significant digits, so online_options_from_values gives them back exactly.
-std::map<std::string, std::string> online_option_values(const OnlineSolverOptions& options);
-
-/// \brief The inverse of online_option_values; unknown keys go to `extra` (the
-/// method refuses those it does not know when it is built).
-/// \throws InputError naming the key and the value if a shared setting is not a number.
-OnlineSolverOptions online_options_from_values(const std::map<std::string, std::string>& values);
 
 /// \brief A reduced model with its online method, ready to query; see the file comment.
 /// Immutable after construction; solve() is thread-safe.

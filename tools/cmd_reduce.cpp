@@ -41,7 +41,7 @@ void run_reduce(const ReduceArgs& a) {
   j["primal_rank"] = rom.model().primal_rank();
   j["dictionary_size"] = rom.model().dictionary_size();
   j["dual_basis_size"] = rom.solver().dual_basis_size();
-  j["options"] = rom::online_option_values(rom.options());
+  j["options"] = rom::options_to_map(rom.method(), rom.options());
   j["out"] = a.out;
   j["bytes"] = ec ? 0 : bytes;
   j["time_s"] = seconds;
