@@ -49,16 +49,20 @@ KktResiduals kkt_residuals(const Problem& problem, const Param& mu, const Eigen:
   const Eigen::VectorXd ctl = c.transpose() * lambda;
   const std::vector<int>& surf = contact.surface_dofs();
   for (size_t j = 0; j < surf.size(); ++j) ct(surf[j]) += ctl(j);
-  double r2 = 0.0, f2 = 0.0, ku2 = 0.0, ct2 = 0.0;
-  for (int i : problem.free_dofs()) {
-    const double r = ku(i) - f(i) + ct(i);
-    r2 += r * r, f2 += f(i) * f(i), ku2 += ku(i) * ku(i), ct2 += ct(i) * ct(i);
+  const std::vector<int>& free = problem.free_dofs();
+  const auto n_free = static_cast<Eigen::Index>(free.size());
+  Eigen::VectorXd r_free(n_free), f_free(n_free), ku_free(n_free), ct_free(n_free);
+  for (Eigen::Index j = 0; j < n_free; ++j) {
+    const int i = free[static_cast<size_t>(j)];
+    f_free(j) = f(i), ku_free(j) = ku(i), ct_free(j) = ct(i);
+    r_free(j) = ku(i) - f(i) + ct(i);
   }
 
   KktResiduals k;
   const double scale = problem.displacement_scale();
-  const double terms = std::sqrt(std::max({f2, ku2, ct2}));
-  k.stationarity = terms > 0.0 ? std::sqrt(r2) / terms : 0.0;
+  // stableNorm: squares of entries below 1e-154 would underflow to zero.
+  const double terms = std::max({f_free.stableNorm(), ku_free.stableNorm(), ct_free.stableNorm()});
+  k.stationarity = terms > 0.0 ? r_free.stableNorm() / terms : 0.0;
   k.penetration = std::max(0.0, cv.cwiseQuotient(contact.weights()).maxCoeff()) / scale;
   const double lmax = lambda.size() ? lambda.cwiseAbs().maxCoeff() : 0.0;
   k.negative_pressure = lmax > 0.0 ? std::max(0.0, -lambda.minCoeff()) / lmax : 0.0;
