@@ -55,8 +55,10 @@ FileWriter vtu_writer(const Problem& problem, const Param& mu, const Eigen::Vect
     for (int c = 0; c < ncell; ++c) out << ' ' << (mesh ? 9 : 3);
     out << "\n        </DataArray>\n      </Cells>\n      <PointData Vectors=\"displacement\">\n";
     Eigen::MatrixXd disp = Eigen::MatrixXd::Zero(np, 3), press = Eigen::MatrixXd::Zero(np, 1);
+    // The rope's one dof per node is its transverse deflection: the y component.
     for (int i = 0; i < np; ++i)
-      for (int d = 0; d < problem.dofs_per_node(); ++d) disp(i, d) = u(problem.dofs_per_node() * i + d);
+      if (problem.dofs_per_node() == 1) disp(i, 1) = u(i);
+      else for (int d = 0; d < problem.dofs_per_node(); ++d) disp(i, d) = u(problem.dofs_per_node() * i + d);
     // Constraint row s sits on the node of its first surface dof column.
     const std::vector<int>& surf = contact.surface_dofs();
     for (int s = 0; s < contact.num_constraints(); ++s)
@@ -84,13 +86,19 @@ FileWriter surface_csv_writer(const Problem& problem, const Eigen::VectorXd& u, 
     const ContactModel& contact = problem.contact();
     const Eigen::VectorXd gap = normal_gaps(problem, u);
     out << std::setprecision(std::numeric_limits<double>::max_digits10);
-    out << "x,y,gap,pressure\n";
+    out << "x,y,gap,pressure,u_x,u_y\n";
+    const std::vector<int>& surf = contact.surface_dofs();
+    const int per_node = problem.dofs_per_node();
     for (int s = 0; s < contact.num_constraints(); ++s) {
-      const double y = problem.mesh() ? contact.constraint_points()(1, s) : u(s);
+      // Reference coordinates (the rope lies on y = 0), then the node's displacement
+      // (the rope's is transverse: u_y).
+      const double y = problem.mesh() ? contact.constraint_points()(1, s) : 0.0;
       out << contact.constraint_points()(0, s) << ',' << y << ',';
       if (std::isfinite(gap(s))) out << gap(s);
       else out << "inf";
-      out << ',' << lambda(s) << '\n';
+      const int dof = surf[static_cast<size_t>(per_node * s)];
+      if (per_node == 1) out << ',' << lambda(s) << ",0," << u(dof) << '\n';
+      else out << ',' << lambda(s) << ',' << u(dof) << ',' << u(dof + 1) << '\n';
     }
   };
 }

@@ -54,14 +54,25 @@ Eigen::MatrixXd read_dense_csv(std::istream& in, const std::string& name) {
     const std::string content = trim(line);
     if (content.empty() || content[0] == '#') continue;
     std::size_t count = 0;
-    std::size_t start = 0;
-    while (true) {
-      const std::size_t comma = line.find(',', start);
-      const std::string field = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-      ++count;
-      values.push_back(parse_value(field, name, line_number, count));
-      if (comma == std::string::npos) break;
-      start = comma + 1;
+    if (content.find(',') == std::string::npos) {
+      // No comma: values separated by blanks (numpy.savetxt's default).
+      std::size_t start = 0;
+      while (start < content.size()) {
+        std::size_t end = start;
+        while (end < content.size() && !is_blank(content[end])) ++end;
+        values.push_back(parse_value(content.substr(start, end - start), name, line_number, ++count));
+        start = end;
+        while (start < content.size() && is_blank(content[start])) ++start;
+      }
+    } else {
+      std::size_t start = 0;
+      while (true) {
+        const std::size_t comma = line.find(',', start);
+        const std::string field = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        values.push_back(parse_value(field, name, line_number, ++count));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+      }
     }
     if (rows == 0) {
       columns = count;

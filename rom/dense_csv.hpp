@@ -3,8 +3,9 @@
 /// \brief Reading dense matrices and vectors from CSV files (the input format of
 /// `contactrom sparse`).
 ///
-/// Format: one matrix row per line, values separated by commas, optional spaces or
-/// tabs around each value, `\n` or `\r\n` line ends. Lines that are empty (or only
+/// Format: one matrix row per line, values separated by commas (optional spaces or
+/// tabs around each value) or, on a line without a comma, by spaces or tabs (the
+/// default of numpy.savetxt); `\n` or `\r\n` line ends. Lines that are empty (or only
 /// blanks) and lines whose first non-blank character is `#` are skipped. Every value
 /// must be a finite decimal number (as accepted by `std::strtod`, e.g. `1`, `-2.5`,
 /// `3e-7`); `nan`, `inf`, empty fields and trailing text are rejected.

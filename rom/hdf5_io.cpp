@@ -1,7 +1,12 @@
 #include "rom/hdf5_io.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
+
+#include "fom/atomic_file.hpp"
+#include "fom/errors.hpp"
 
 namespace contactrom::rom::hdf5 {
 namespace {
@@ -186,6 +191,90 @@ std::string file_image(hid_t file) {
   std::string image(static_cast<size_t>(size), '\0');
   if (H5Fget_file_image(file, image.data(), image.size()) != size) throw Failure("file image");
   return image;
+}
+
+namespace {
+
+/// Fixed-length, null-padded UTF-8 string type of `size` bytes (at least 1).
+/// Fixed-length strings only: libhdf5 1.10 can crash on corrupted variable-length ones.
+hid_t fixed_string_type(size_t size) {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  if (type < 0) return type;
+  H5Tset_size(type, std::max<size_t>(size, 1));
+  H5Tset_strpad(type, H5T_STR_NULLPAD);
+  H5Tset_cset(type, H5T_CSET_UTF8);
+  return type;
+}
+
+}  // namespace
+
+void write_string_list(hid_t loc, hid_t dcpl, const char* name, const std::vector<std::string>& items) {
+  const std::string what = dataset_what(name);
+  size_t width = 1;
+  for (const auto& item : items) width = std::max(width, item.size());
+  Handle type(fixed_string_type(width), H5Tclose, what);
+  const hsize_t dims[1] = {items.size()};
+  Handle space(H5Screate_simple(1, dims, nullptr), H5Sclose, what);
+  Handle set(H5Dcreate2(loc, name, type.id(), space.id(), H5P_DEFAULT, dcpl, H5P_DEFAULT), H5Dclose, what);
+  std::string buf(width * items.size(), '\0');
+  for (size_t i = 0; i < items.size(); ++i) buf.replace(i * width, items[i].size(), items[i]);
+  if (!items.empty()) check(H5Dwrite(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()), what);
+}
+
+std::vector<std::string> read_string_list(hid_t loc, const char* name, std::uint64_t max_bytes) {
+  const std::string what = dataset_what(name);
+  Handle set(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose, what);
+  Handle type(H5Dget_type(set.id()), H5Tclose, what);
+  if (H5Tget_class(type.id()) != H5T_STRING || H5Tis_variable_str(type.id()) != 0)
+    throw Refused(what + " is not a list of fixed-length strings");
+  Handle space(H5Dget_space(set.id()), H5Sclose, what);
+  if (H5Sget_simple_extent_ndims(space.id()) != 1) throw Refused(what + " is not one-dimensional");
+  hsize_t n = 0;
+  H5Sget_simple_extent_dims(space.id(), &n, nullptr);
+  const size_t width = H5Tget_size(type.id());
+  if (width == 0 || n > max_bytes || width > max_bytes / std::max<hsize_t>(n, 1))
+    throw Refused(what + " declares more bytes than the file holds");
+  std::string buf(width * n, '\0');
+  if (n > 0) check(H5Dread(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()), what);
+  std::vector<std::string> out;
+  for (hsize_t i = 0; i < n; ++i) {
+    std::string item = buf.substr(i * width, width);
+    item.resize(std::min(item.find('\0'), item.size()));
+    out.push_back(item);
+  }
+  return out;
+}
+
+void write_file(const std::string& path, const std::function<void(hid_t file, hid_t dcpl)>& fill) {
+  silence();
+  check_output_path(path);
+  // Built in memory: HDF5 never writes to the disk, so a full disk is our error to
+  // report, not a half-closed file left inside libhdf5.
+  std::string image;
+  {
+    Handle fcpl(H5Pcreate(H5P_FILE_CREATE), H5Pclose, "file creation properties");
+    check(H5Pset_obj_track_times(fcpl.id(), false), "file creation properties");
+    Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "dataset creation properties");
+    check(H5Pset_obj_track_times(dcpl.id(), false), "dataset creation properties");
+    Handle file(create_memory_file(path, fcpl.id()), H5Fclose, "file creation");
+    fill(file.id(), dcpl.id());
+    image = file_image(file.id());
+    file.close("file close");
+  }
+  write_file_atomically(path, [&image](std::ostream& out) { out.write(image.data(), static_cast<std::streamsize>(image.size())); });
+}
+
+hid_t open_file(const std::string& path, const std::string& label, const std::string& expected_writer) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError(label + " '" + path + "' not found");
+  if (fs::is_directory(path, ec)) throw InputError(label + " '" + path + "' is a directory, expected an HDF5 file");
+  silence();
+  if (H5Fis_hdf5(path.c_str()) <= 0)
+    throw InputError(label + " '" + path + "' is not an HDF5 file (expected one written by " + expected_writer + ")");
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file < 0) throw InputError(label + " '" + path + "' is truncated or corrupt (HDF5 cannot open it)");
+  return file;
 }
 
 }  // namespace contactrom::rom::hdf5

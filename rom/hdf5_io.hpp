@@ -23,6 +23,7 @@
 #include <hdf5.h>
 
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -118,5 +119,25 @@ hid_t create_memory_file(const std::string& label, hid_t fcpl);
 
 /// \brief The bytes of an open file (flushed first), as they would be on disk.
 std::string file_image(hid_t file);
+
+/// \brief Writes a 1-D dataset of fixed-length UTF-8 strings (one element per item).
+void write_string_list(hid_t loc, hid_t dcpl, const char* name, const std::vector<std::string>& items);
+
+/// \brief Reads a dataset written by write_string_list; refuses variable-length
+/// strings without reading them and lists declaring more than `max_bytes`.
+std::vector<std::string> read_string_list(hid_t loc, const char* name, std::uint64_t max_bytes);
+
+/// \brief Builds an HDF5 file in memory with `fill(file, dcpl)` and writes it to
+/// `path` atomically (fom/atomic_file.hpp). Object modification times are not
+/// stored, so the same content gives the same bytes.
+/// \throws Failure from `fill` or HDF5; InputError (from the atomic write) naming
+///   `path` if the target is refused or the disk is full. No partial file is left.
+void write_file(const std::string& path, const std::function<void(hid_t file, hid_t dcpl)>& fill);
+
+/// \brief Opens an existing HDF5 file read-only after checking that it exists, is
+/// not a folder and is HDF5. \param label what the file is ("database",
+/// "reduced model"), for the messages, e.g. "reduced model 'x.h5' not found".
+/// \throws InputError (one line naming `path`).
+hid_t open_file(const std::string& path, const std::string& label, const std::string& expected_writer);
 
 }  // namespace contactrom::rom::hdf5

@@ -92,12 +92,16 @@ std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const 
     const auto it = r.factories.find(name);
     if (it != r.factories.end()) factory = it->second;
   }
-  if (!factory) {
-    std::string known;
-    for (const std::string& n : online_solver_names()) known += (known.empty() ? "" : ", ") + n;
-    throw InputError("unknown online method '" + name + "'; expected one of: " + known);
-  }
+  if (!factory) check_online_method(name);
   return factory(model, options);
+}
+
+void check_online_method(const std::string& name) {
+  const std::vector<std::string> names = online_solver_names();
+  if (std::find(names.begin(), names.end(), name) != names.end()) return;
+  std::string known;
+  for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+  throw InputError("unknown online method '" + name + "'; expected one of: " + known);
 }
 
 std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& solver,

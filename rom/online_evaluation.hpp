@@ -134,6 +134,10 @@ struct OnlineSolverRegistrar {
 /// \brief Registered method names, sorted.
 std::vector<std::string> online_solver_names();
 
+/// \brief Refuses a method name that is not registered (before costly work).
+/// \throws InputError "unknown online method 'x'; expected one of: ...".
+void check_online_method(const std::string& name);
+
 /// \brief Refuses method-specific settings (OnlineSolverOptions::extra) that `method`
 /// does not know. \throws InputError "online method 'm' has no option 'k'; it knows: ...".
 void check_extra_options(const OnlineSolverOptions& options, const std::string& method,

@@ -88,18 +88,8 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
   for (int i = 0; i < nd; ++i)
     if (dirichlet[i]) m_phi.row(i).setZero();
 
-  const std::vector<int>& surf = problem.contact().surface_dofs();
-  const int ns = static_cast<int>(surf.size()), r = primal_rank();
-  m_snapshot_coords = m_phi.transpose() * primal;
-  build_parameter_grid();
-  m_phi_s.resize(ns, r);
-  for (int a = 0; a < ns; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
-  m_phi_s_rows = m_phi_s;
-  m_lift_s.resize(ns, nt);
-  for (int k = 0; k < nt; ++k)
-    for (int a = 0; a < ns; ++a) m_lift_s(a, k) = m_offset[k](surf[a]);
-
   // Affine reduced operators (file comment).
+  const int r = primal_rank();
   m_f_hat.resize(r, nt);
   for (int k = 0; k < nt; ++k) m_f_hat.col(k) = m_phi.transpose() * problem.external_load_terms()[k];
   for (int q = 0; q < problem.num_stiffness_terms(); ++q) {
@@ -111,7 +101,88 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
     for (int k = 0; k < nt; ++k) kl.col(k) = kphi.transpose() * m_offset[k];  // Φᵀ K_q L̃_k, K_q symmetric
     m_kl_hat.push_back(kl);
   }
-  if (problem.num_stiffness_terms() == 1) {
+  derive();
+  m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+ReducedModel::ReducedModel(const fom::Problem& problem, ReducedModelData data)
+    : m_problem(problem), m_options(data.options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const long n = problem.num_dofs(), nc = problem.contact().num_constraints(), r = data.basis.cols();
+  const long m = data.dictionary.cols(), nq = problem.num_stiffness_terms(), nt = problem.num_load_terms();
+  const auto require = [&](bool ok, const std::string& what, long got, long expected) {
+    if (!ok)
+      throw InputError("reduced model of '" + problem.name() + "': " + what + " has size " + std::to_string(got) +
+                       ", expected " + std::to_string(expected));
+  };
+  require(data.basis.rows() == n, "the basis' row count", data.basis.rows(), n);
+  require(r <= n, "the basis' column count", r, n);
+  require(data.singular_values.size() >= r, "the singular values", data.singular_values.size(), r);
+  require(static_cast<long>(data.offset_terms.size()) == nt, "the offset terms", data.offset_terms.size(), nt);
+  for (const auto& l : data.offset_terms) require(l.size() == n, "an offset term", l.size(), n);
+  require(static_cast<long>(data.stiffness_terms.size()) == nq, "the reduced stiffness terms",
+          data.stiffness_terms.size(), nq);
+  require(static_cast<long>(data.stiffness_offset_terms.size()) == nq, "the reduced stiffness-offset terms",
+          data.stiffness_offset_terms.size(), nq);
+  for (long q = 0; q < nq; ++q) {
+    require(data.stiffness_terms[q].rows() == r && data.stiffness_terms[q].cols() == r, "a reduced stiffness term",
+            data.stiffness_terms[q].size(), r * r);
+    require(data.stiffness_offset_terms[q].rows() == r && data.stiffness_offset_terms[q].cols() == nt,
+            "a reduced stiffness-offset term", data.stiffness_offset_terms[q].size(), r * nt);
+  }
+  require(data.load_terms.rows() == r && data.load_terms.cols() == nt, "the reduced load terms", data.load_terms.size(),
+          r * nt);
+  require(m > 0 && data.dictionary.rows() == nc, "the dictionary's row count", data.dictionary.rows(), nc);
+  require(static_cast<long>(data.dictionary_snapshots.size()) == m, "the dictionary snapshot list",
+          data.dictionary_snapshots.size(), m);
+  require(static_cast<long>(data.dictionary_parameters.size()) == m, "the dictionary parameter list",
+          data.dictionary_parameters.size(), m);
+  for (const auto& p : data.dictionary_parameters)
+    require(p.size() == problem.num_params(), "a dictionary parameter", p.size(), problem.num_params());
+  require(data.primal_snapshots.rows() == n && data.primal_snapshots.cols() == m, "the primal snapshots",
+          data.primal_snapshots.size(), n * m);
+  m_phi = std::move(data.basis);
+  m_sigma = std::move(data.singular_values);
+  m_offset = std::move(data.offset_terms);
+  m_k_hat = std::move(data.stiffness_terms);
+  m_f_hat = std::move(data.load_terms);
+  m_kl_hat = std::move(data.stiffness_offset_terms);
+  m_dict = std::move(data.dictionary);
+  m_dict_snapshots = std::move(data.dictionary_snapshots);
+  m_dict_params = std::move(data.dictionary_parameters);
+  m_primal = std::move(data.primal_snapshots);
+  derive();
+  m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+ReducedModelData ReducedModel::data() const {
+  ReducedModelData d;
+  d.options = m_options;
+  d.basis = m_phi;
+  d.singular_values = m_sigma;
+  d.offset_terms = m_offset;
+  d.stiffness_terms = m_k_hat;
+  d.load_terms = m_f_hat;
+  d.stiffness_offset_terms = m_kl_hat;
+  d.dictionary = m_dict;
+  d.dictionary_snapshots = m_dict_snapshots;
+  d.dictionary_parameters = m_dict_params;
+  d.primal_snapshots = m_primal;
+  return d;
+}
+
+void ReducedModel::derive() {
+  const std::vector<int>& surf = m_problem.contact().surface_dofs();
+  const int ns = static_cast<int>(surf.size()), r = primal_rank(), nt = static_cast<int>(m_offset.size());
+  m_snapshot_coords = m_phi.transpose() * m_primal;
+  build_parameter_grid();
+  m_phi_s.resize(ns, r);
+  for (int a = 0; a < ns; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
+  m_phi_s_rows = m_phi_s;
+  m_lift_s.resize(ns, nt);
+  for (int k = 0; k < nt; ++k)
+    for (int a = 0; a < ns; ++a) m_lift_s(a, k) = m_offset[k](surf[a]);
+  if (m_k_hat.size() == 1) {
     m_k_llt.compute(m_k_hat[0]);
     m_single_ok = m_k_llt.info() == Eigen::Success;
     if (m_single_ok) {
@@ -119,7 +190,6 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
       m_k_inv = (0.5 * (m_k_inv + m_k_inv.transpose())).eval();
     }
   }
-  m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 void ReducedModel::build_parameter_grid() {

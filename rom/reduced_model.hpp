@@ -51,6 +51,23 @@ struct ReducedModelOptions {
   LiftingKind lifting = LiftingKind::Harmonic;
 };
 
+/// \brief Everything a ReducedModel holds besides its problem — the offline product
+/// that a reduced-model file stores (rom/reduced_model_file.hpp). Sizes: n dofs,
+/// r modes, m dictionary columns, n_c constraint rows, Q stiffness terms, T load terms.
+struct ReducedModelData {
+  ReducedModelOptions options;
+  Eigen::MatrixXd basis;                   ///< Φ, n × r
+  Eigen::VectorXd singular_values;         ///< of the primal snapshot matrix, decreasing
+  std::vector<Eigen::VectorXd> offset_terms;    ///< L̃_k, T vectors of size n
+  std::vector<Eigen::MatrixXd> stiffness_terms; ///< Φᵀ K_q Φ, Q matrices r × r
+  Eigen::MatrixXd load_terms;                   ///< r × T, column k: Φᵀ f_ext,k
+  std::vector<Eigen::MatrixXd> stiffness_offset_terms;  ///< per q, r × T, column k: Φᵀ K_q L̃_k
+  Eigen::MatrixXd dictionary;              ///< D_d, n_c × m
+  std::vector<int> dictionary_snapshots;   ///< database snapshot index of each column
+  std::vector<fom::Param> dictionary_parameters;  ///< parameter of each column
+  Eigen::MatrixXd primal_snapshots;        ///< u − u_off of each column, n × m
+};
+
 /// \brief POD basis, dual dictionary and reduced operators; see the file comment.
 /// Immutable after construction and safe to share between threads.
 class ReducedModel {
@@ -60,6 +77,15 @@ class ReducedModel {
   /// \throws InputError if the database does not match the problem's sizes or
   ///   holds no usable snapshot.
   ReducedModel(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options = {});
+
+  /// \brief Rebuilds a model from its stored offline product (no POD, no FOM): the
+  /// contact-surface rows, the factor of Φᵀ K₀ Φ and the training grid are derived here.
+  /// The problem must outlive the model.
+  /// \throws InputError if a size of `data` does not match the problem or the others.
+  ReducedModel(const fom::Problem& problem, ReducedModelData data);
+
+  /// \brief A copy of the offline product (what save_reduced_model writes).
+  ReducedModelData data() const;
 
   const fom::Problem& problem() const { return m_problem; }
   const ReducedModelOptions& options() const { return m_options; }
@@ -110,6 +136,10 @@ class ReducedModel {
 
   /// Reduced stiffness terms \f$ \Phi^T K_q \Phi \f$ (r × r each).
   const std::vector<Eigen::MatrixXd>& reduced_stiffness_terms() const { return m_k_hat; }
+  /// Reduced load terms (r × T): column k is \f$ \Phi^T f_{ext,k} \f$.
+  const Eigen::MatrixXd& reduced_load_terms() const { return m_f_hat; }
+  /// Per stiffness term q (r × T): column k is \f$ \Phi^T K_q \tilde L_k \f$.
+  const std::vector<Eigen::MatrixXd>& reduced_stiffness_offset_terms() const { return m_kl_hat; }
   /// \f$ \hat K(\mu) = \sum_q \theta_q(\mu) \Phi^T K_q \Phi \f$.
   Eigen::MatrixXd reduced_stiffness(const fom::Param& mu) const;
   /// \f$ \hat f(\mu) = \Phi^T f(\mu) \f$ from the affine pieces.
@@ -153,6 +183,7 @@ class ReducedModel {
   std::vector<std::vector<double>> m_grid_values;
   std::vector<int> m_grid_columns;
   void build_parameter_grid();
+  void derive();  // surface rows, snapshot coordinates, grid, factor of Φᵀ K₀ Φ
   std::vector<Eigen::VectorXd> m_offset;  // L̃_k
   std::vector<Eigen::MatrixXd> m_k_hat;   // Φᵀ K_q Φ
   Eigen::MatrixXd m_f_hat;                // column k: Φᵀ f_ext,k

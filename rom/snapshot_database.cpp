@@ -12,6 +12,7 @@
 
 #include "fom/atomic_file.hpp"
 #include "rom/hdf5_io.hpp"
+#include "rom/problem_record.hpp"
 
 namespace contactrom::rom {
 namespace {
@@ -27,7 +28,6 @@ constexpr double kParameterMatchTolerance = 1e-12;
 // gets our one-line message instead), checks shapes, types and sizes before
 // reading, and translates failures into exceptions.
 using hdf5::Handle;
-using hdf5::check;
 using hdf5::write_dataset;
 using hdf5::write_scalar_attribute;
 using hdf5::write_string_attribute;
@@ -35,65 +35,6 @@ using hdf5::read_string_attribute;
 using hdf5::has_attribute;
 using Hdf5Failure = hdf5::Failure;
 
-void silence_hdf5() { hdf5::silence(); }
-
-/// Fixed-length, null-padded UTF-8 string type of `size` bytes (at least 1).
-/// Fixed-length strings only: libhdf5 1.10 can crash on corrupted variable-length ones.
-hid_t fixed_string_type(size_t size) {
-  const hid_t type = H5Tcopy(H5T_C_S1);
-  if (type < 0) return type;
-  H5Tset_size(type, std::max<size_t>(size, 1));
-  H5Tset_strpad(type, H5T_STR_NULLPAD);
-  H5Tset_cset(type, H5T_CSET_UTF8);
-  return type;
-}
-
-/// A 1-D dataset of fixed-length strings (one element per item).
-void write_string_list(hid_t loc, hid_t dcpl, const char* name, const std::vector<std::string>& items) {
-  const std::string what = std::string("dataset ") + name;
-  size_t width = 1;
-  for (const auto& item : items) width = std::max(width, item.size());
-  Handle type(fixed_string_type(width), H5Tclose, what);
-  const hsize_t dims[1] = {items.size()};
-  Handle space(H5Screate_simple(1, dims, nullptr), H5Sclose, what);
-  Handle set(H5Dcreate2(loc, name, type.id(), space.id(), H5P_DEFAULT, dcpl, H5P_DEFAULT), H5Dclose, what);
-  std::string buf(width * items.size(), '\0');
-  for (size_t i = 0; i < items.size(); ++i) buf.replace(i * width, items[i].size(), items[i]);
-  if (!items.empty()) check(H5Dwrite(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()), what);
-}
-
-/// Reads a 1-D dataset of fixed-length strings (refuses variable-length ones unread),
-/// at most `max_bytes` in all.
-std::vector<std::string> read_string_list(hid_t loc, const char* name, std::uint64_t max_bytes) {
-  const std::string what = std::string("dataset ") + name;
-  Handle set(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose, what);
-  Handle type(H5Dget_type(set.id()), H5Tclose, what);
-  if (H5Tget_class(type.id()) != H5T_STRING || H5Tis_variable_str(type.id()) != 0)
-    throw hdf5::Refused(what + " is not a list of fixed-length strings");
-  Handle space(H5Dget_space(set.id()), H5Sclose, what);
-  if (H5Sget_simple_extent_ndims(space.id()) != 1) throw hdf5::Refused(what + " is not one-dimensional");
-  hsize_t n = 0;
-  H5Sget_simple_extent_dims(space.id(), &n, nullptr);
-  const size_t width = H5Tget_size(type.id());
-  if (width == 0 || n > max_bytes || width > max_bytes / std::max<hsize_t>(n, 1))
-    throw hdf5::Refused(what + " declares more bytes than the file holds");
-  std::string buf(width * n, '\0');
-  if (n > 0) check(H5Dread(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()), what);
-  std::vector<std::string> out;
-  for (hsize_t i = 0; i < n; ++i) {
-    std::string item = buf.substr(i * width, width);
-    item.resize(std::min(item.find('\0'), item.size()));
-    out.push_back(item);
-  }
-  return out;
-}
-
-/// A rank-1 or rank-2 dataset of ints or doubles (shape and size checked by hdf5_io).
-template <typename T>
-void read_dataset(hid_t file, const char* name, std::vector<T>& out, hsize_t& rows, hsize_t& cols) {
-  if constexpr (std::is_same_v<T, int>) hdf5::read_int_dataset(file, name, out, rows, cols);
-  else hdf5::read_double_dataset(file, name, out, rows, cols);
-}
 
 /// Reads an n_snap × width dataset into the columns of a width × n_snap matrix.
 Eigen::MatrixXd read_matrix(hid_t file, const char* name, hsize_t expected_rows) {
@@ -121,6 +62,31 @@ std::vector<T> read_vector(hid_t file, const char* name, hsize_t expected) {
   if constexpr (std::is_same_v<T, int>) hdf5::read_int_dataset(file, name, out, rows, cols);
   else hdf5::read_double_dataset(file, name, out, rows, cols);
   return out;
+}
+
+/// The problem part of `db` as a record (and back).
+ProblemRecord problem_record(const SnapshotDatabase& db) {
+  ProblemRecord r;
+  r.name = db.problem;
+  r.fingerprint = db.mesh_fingerprint;
+  r.param_names = db.param_names;
+  r.text = db.problem_text;
+  r.mesh = db.mesh;
+  r.contact_points = db.contact_points;
+  r.contact_weights = db.contact_weights;
+  r.lifting_terms = db.lifting_terms;
+  return r;
+}
+
+void set_problem_record(SnapshotDatabase& db, ProblemRecord r) {
+  db.problem = std::move(r.name);
+  db.mesh_fingerprint = std::move(r.fingerprint);
+  db.param_names = std::move(r.param_names);
+  db.problem_text = std::move(r.text);
+  db.mesh = std::move(r.mesh);
+  db.contact_points = std::move(r.contact_points);
+  db.contact_weights = std::move(r.contact_weights);
+  db.lifting_terms = std::move(r.lifting_terms);
 }
 
 std::string format_value(double v) {
@@ -156,102 +122,6 @@ void validate_values(const SnapshotDatabase& db) {
     throw hdf5::Refused("attribute training_size is " + std::to_string(db.training_size) + ", expected >= 1");
 }
 
-std::string join(const std::vector<std::string>& items, const char* sep) {
-  std::string out;
-  for (size_t i = 0; i < items.size(); ++i) out += (i ? sep : "") + items[i];
-  return out;
-}
-
-std::vector<std::string> split(const std::string& text, char sep) {
-  std::vector<std::string> out;
-  if (text.empty()) return out;
-  size_t start = 0;
-  for (;;) {
-    const size_t end = text.find(sep, start);
-    out.push_back(text.substr(start, end - start));
-    if (end == std::string::npos) break;
-    start = end + 1;
-  }
-  return out;
-}
-
-/// The problem part of format 2: problem file text, mesh, contact rows, lifting.
-void write_problem(hid_t f, hid_t dcpl, const SnapshotDatabase& db) {
-  const hsize_t nc = static_cast<hsize_t>(db.contact_weights.size());
-  if (db.contact_points.cols() != db.contact_weights.size() || db.lifting_terms.rows() != db.primal.rows())
-    throw std::invalid_argument("write_database: inconsistent problem description");
-  if (!db.problem_text.empty()) write_string_list(f, dcpl, "problem_file", {db.problem_text});
-  Handle contact(H5Gcreate2(f, "contact", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "group /contact");
-  write_dataset(f, dcpl, "contact/points", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, nc, 2, db.contact_points.data());
-  write_dataset(f, dcpl, "contact/weights", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, nc, 0, db.contact_weights.data());
-  // n_dofs × n_terms column-major == row-major n_terms × n_dofs: one term per row.
-  write_dataset(f, dcpl, "lifting", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, static_cast<hsize_t>(db.lifting_terms.cols()),
-                static_cast<hsize_t>(db.lifting_terms.rows()), db.lifting_terms.data());
-  if (!db.mesh) return;
-  const fom::Mesh& m = *db.mesh;
-  Handle group(H5Gcreate2(f, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "group /mesh");
-  write_dataset(f, dcpl, "mesh/nodes", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, static_cast<hsize_t>(m.num_nodes()), 2,
-                m.nodes.data());
-  write_dataset(f, dcpl, "mesh/quads", H5T_STD_I32LE, H5T_NATIVE_INT, 2, static_cast<hsize_t>(m.num_quads()), 4,
-                m.quads.data());
-  write_dataset(f, dcpl, "mesh/quad_body", H5T_STD_I32LE, H5T_NATIVE_INT, 1, static_cast<hsize_t>(m.num_quads()), 0,
-                m.quad_body.data());
-  write_string_list(f, dcpl, "mesh/body_names", m.body_names);
-  std::vector<std::string> curves;
-  for (const auto& [name, nodes] : m.curve_nodes) curves.push_back(name);
-  write_string_list(f, dcpl, "mesh/curve_names", curves);
-  for (size_t i = 0; i < curves.size(); ++i) {
-    const auto& nodes = m.curve_nodes.at(curves[i]);
-    const auto& segs = m.segments.at(curves[i]);
-    const std::string base = "mesh/curve_" + std::to_string(i);
-    write_dataset(f, dcpl, (base + "_nodes").c_str(), H5T_STD_I32LE, H5T_NATIVE_INT, 1, nodes.size(), 0, nodes.data());
-    write_dataset(f, dcpl, (base + "_segments").c_str(), H5T_STD_I32LE, H5T_NATIVE_INT, 2, segs.size(), 2, segs.data());
-  }
-}
-
-/// Reads the mesh of format 2, checking every index against the node count.
-std::shared_ptr<const fom::Mesh> read_mesh(hid_t f) {
-  auto mesh = std::make_shared<fom::Mesh>();
-  std::vector<double> xy;
-  hsize_t rows = 0, cols = 0;
-  read_dataset(f, "mesh/nodes", xy, rows, cols);
-  if (cols != 2) throw Hdf5Failure("dataset /mesh/nodes does not have 2 columns");
-  for (double v : xy)
-    if (!std::isfinite(v)) throw Hdf5Failure("dataset /mesh/nodes holds a non-finite coordinate");
-  mesh->nodes = Eigen::Map<Eigen::Matrix2Xd>(xy.data(), 2, static_cast<Eigen::Index>(rows));
-  const int nn = static_cast<int>(rows);
-  auto check_ids = [&](const std::vector<int>& ids, const std::string& what) {
-    for (int id : ids)
-      if (id < 0 || id >= nn) throw Hdf5Failure("dataset /" + what + " refers to node " + std::to_string(id) +
-                                                ", expected 0.." + std::to_string(nn - 1));
-  };
-  std::vector<int> quads;
-  read_dataset(f, "mesh/quads", quads, rows, cols);
-  if (cols != 4) throw Hdf5Failure("dataset /mesh/quads does not have 4 columns");
-  check_ids(quads, "mesh/quads");
-  for (size_t q = 0; q + 3 < quads.size(); q += 4) mesh->quads.push_back({quads[q], quads[q + 1], quads[q + 2], quads[q + 3]});
-  mesh->quad_body = read_vector<int>(f, "mesh/quad_body", rows);
-  mesh->body_names = read_string_list(f, "mesh/body_names", hdf5::file_size(f));
-  for (int b : mesh->quad_body)
-    if (b < 0 || b >= static_cast<int>(mesh->body_names.size()))
-      throw Hdf5Failure("dataset /mesh/quad_body holds the body " + std::to_string(b) + " of " +
-                        std::to_string(mesh->body_names.size()));
-  const std::vector<std::string> curves = read_string_list(f, "mesh/curve_names", hdf5::file_size(f));
-  for (size_t i = 0; i < curves.size(); ++i) {
-    const std::string base = "mesh/curve_" + std::to_string(i);
-    std::vector<int> nodes, segs;
-    read_dataset(f, (base + "_nodes").c_str(), nodes, rows, cols);
-    read_dataset(f, (base + "_segments").c_str(), segs, rows, cols);
-    if (cols != 2 && !segs.empty()) throw Hdf5Failure("dataset /" + base + "_segments does not have 2 columns");
-    check_ids(nodes, base + "_nodes");
-    check_ids(segs, base + "_segments");
-    mesh->curve_nodes[curves[i]] = nodes;
-    auto& out = mesh->segments[curves[i]];
-    for (size_t k = 0; k + 1 < segs.size(); k += 2) out.push_back({segs[k], segs[k + 1]});
-  }
-  return mesh;
-}
-
 }  // namespace
 
 std::vector<int> SnapshotDatabase::successful_snapshots() const {
@@ -266,70 +136,46 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
   if (db.dual.cols() != db.primal.cols() || db.parameters.cols() != db.primal.cols() || db.status.size() != n ||
       db.iterations.size() != n || db.pairing_iterations.size() != n || db.time_s.size() != n)
     throw std::invalid_argument("write_database: inconsistent snapshot counts");
-  silence_hdf5();
-  check_output_path(path);
-  // The file is built in memory and written by write_file_atomically: HDF5 never
-  // writes to the disk, so a full disk is our error to report, not a half-closed
-  // file left inside libhdf5.
-  std::string image;
+  if (db.lifting_terms.rows() != db.primal.rows())
+    throw std::invalid_argument("write_database: lifting terms and snapshots differ in size");
   try {
-    // Object modification times are not stored, so that two runs on the same
-    // data give the same bytes (except the timing datasets).
-    Handle fcpl(H5Pcreate(H5P_FILE_CREATE), H5Pclose, "file creation properties");
-    check(H5Pset_obj_track_times(fcpl.id(), false), "file creation properties");
-    Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "dataset creation properties");
-    check(H5Pset_obj_track_times(dcpl.id(), false), "dataset creation properties");
-    Handle file(hdf5::create_memory_file(path, fcpl.id()), H5Fclose, "file creation");
-    const hid_t f = file.id();
+    hdf5::write_file(path, [&db](hid_t f, hid_t dcpl) {
+      const hsize_t n = static_cast<hsize_t>(db.num_snapshots());
+      const int version = kDatabaseFormatVersion;
+      write_scalar_attribute(f, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &version);
+      write_string_attribute(f, "created_by", db.created_by);
+      write_string_attribute(f, "training_kind", db.training_kind);
+      write_scalar_attribute(f, "training_size", H5T_STD_I32LE, H5T_NATIVE_INT, &db.training_size);
+      write_string_attribute(f, "status_names", "success,no_convergence,numerical_issue,invalid_input");
+      write_scalar_attribute(f, "setup_time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &db.setup_time_s);
+      write_scalar_attribute(f, "wall_time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &db.wall_time_s);
+      write_scalar_attribute(f, "threads", H5T_STD_I32LE, H5T_NATIVE_INT, &db.threads);
 
-    const int version = kDatabaseFormatVersion;
-    write_scalar_attribute(f, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &version);
-    write_string_attribute(f, "problem", db.problem);
-    write_string_attribute(f, "mesh_fingerprint", db.mesh_fingerprint);
-    write_string_attribute(f, "created_by", db.created_by);
-    write_string_attribute(f, "training_kind", db.training_kind);
-    write_scalar_attribute(f, "training_size", H5T_STD_I32LE, H5T_NATIVE_INT, &db.training_size);
-    write_string_attribute(f, "param_names", join(db.param_names, ","));
-    write_string_attribute(f, "status_names", "success,no_convergence,numerical_issue,invalid_input");
-    write_scalar_attribute(f, "setup_time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &db.setup_time_s);
-    write_scalar_attribute(f, "wall_time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &db.wall_time_s);
-    write_scalar_attribute(f, "threads", H5T_STD_I32LE, H5T_NATIVE_INT, &db.threads);
-
-    // Column-major width × n_snap == row-major n_snap × width: no transposition.
-    write_dataset(f, dcpl.id(), "parameters", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n,
-                  static_cast<hsize_t>(db.parameters.rows()), db.parameters.data());
-    write_dataset(f, dcpl.id(), "primal", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n, static_cast<hsize_t>(db.primal.rows()),
-                  db.primal.data());
-    write_dataset(f, dcpl.id(), "dual", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n, static_cast<hsize_t>(db.dual.rows()),
-                  db.dual.data());
-    std::vector<int> status(db.status.size());
-    for (size_t j = 0; j < status.size(); ++j) status[j] = static_cast<int>(db.status[j]);
-    write_dataset(f, dcpl.id(), "status", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, status.data());
-    write_dataset(f, dcpl.id(), "iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, db.iterations.data());
-    write_dataset(f, dcpl.id(), "pairing_iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0,
-                  db.pairing_iterations.data());
-    write_dataset(f, dcpl.id(), "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, n, 0, db.time_s.data());
-    write_problem(f, dcpl.id(), db);
-    image = hdf5::file_image(f);
-    file.close("file close");
+      // Column-major width × n_snap == row-major n_snap × width: no transposition.
+      write_dataset(f, dcpl, "parameters", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n,
+                    static_cast<hsize_t>(db.parameters.rows()), db.parameters.data());
+      write_dataset(f, dcpl, "primal", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n, static_cast<hsize_t>(db.primal.rows()),
+                    db.primal.data());
+      write_dataset(f, dcpl, "dual", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n, static_cast<hsize_t>(db.dual.rows()),
+                    db.dual.data());
+      std::vector<int> status(db.status.size());
+      for (size_t j = 0; j < status.size(); ++j) status[j] = static_cast<int>(db.status[j]);
+      write_dataset(f, dcpl, "status", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, status.data());
+      write_dataset(f, dcpl, "iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, db.iterations.data());
+      write_dataset(f, dcpl, "pairing_iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0,
+                    db.pairing_iterations.data());
+      write_dataset(f, dcpl, "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, n, 0, db.time_s.data());
+      write_problem_record(f, dcpl, problem_record(db));
+    });
   } catch (const Hdf5Failure& e) {
     throw InputError("cannot write database '" + path + "': HDF5 failed on " + e.what());
   }
-  write_file_atomically(path, [&image](std::ostream& out) { out.write(image.data(), static_cast<std::streamsize>(image.size())); });
 }
 
 SnapshotDatabase read_database(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError("database '" + path + "' not found");
-  if (fs::is_directory(path, ec)) throw InputError("database '" + path + "' is a directory, expected an HDF5 file");
-  silence_hdf5();
-  const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
-  if (is_hdf5 <= 0)
-    throw InputError("database '" + path + "' is not an HDF5 file (expected one written by contactrom offline)");
+  Handle file(hdf5::open_file(path, "database", "contactrom offline"), H5Fclose, "the file structure");
   SnapshotDatabase db;
   try {
-    Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, "the file structure");
     const hid_t f = file.id();
     if (!has_attribute(f, "format_version"))
       throw InputError("database '" + path + "' has no format_version attribute; not a contactrom database");
@@ -337,12 +183,9 @@ SnapshotDatabase read_database(const std::string& path) {
     if (version != kDatabaseFormatVersion)
       throw InputError("database '" + path + "' has format_version " + std::to_string(version) +
                        ", but this contactrom reads version " + std::to_string(kDatabaseFormatVersion) + "; rebuild it with contactrom offline");
-    db.problem = read_string_attribute(f, "problem");
-    db.mesh_fingerprint = read_string_attribute(f, "mesh_fingerprint");
     db.created_by = read_string_attribute(f, "created_by");
     db.training_kind = read_string_attribute(f, "training_kind");
     db.training_size = hdf5::read_int_attribute(f, "training_size");
-    db.param_names = split(read_string_attribute(f, "param_names"), ',');
     if (has_attribute(f, "setup_time_s"))
       db.setup_time_s = hdf5::read_double_attribute(f, "setup_time_s");
     if (has_attribute(f, "wall_time_s"))
@@ -364,31 +207,13 @@ SnapshotDatabase read_database(const std::string& path) {
         throw hdf5::Refused("dataset /status holds the unknown status code " + std::to_string(s));
       db.status.push_back(static_cast<Status>(s));
     }
+    set_problem_record(db, read_problem_record(f, static_cast<hsize_t>(db.dual.rows()),
+                                               static_cast<hsize_t>(db.primal.rows())));
     if (db.parameters.rows() != static_cast<Eigen::Index>(db.param_names.size()))
       throw hdf5::Refused("dataset /parameters has " + std::to_string(db.parameters.rows()) +
                         " columns but param_names lists " + std::to_string(db.param_names.size()));
     if (db.training_kind != "train" && db.training_kind != "level" && db.training_kind != "list")
       throw hdf5::Refused("attribute training_kind is '" + db.training_kind + "', expected 'train', 'level' or 'list'");
-    if (H5Lexists(f, "problem_file", H5P_DEFAULT) > 0) {
-      const std::vector<std::string> text = read_string_list(f, "problem_file", hdf5::file_size(f));
-      if (text.size() != 1) throw hdf5::Refused("dataset /problem_file does not hold one text");
-      db.problem_text = text[0];
-    }
-    if (H5Lexists(f, "mesh", H5P_DEFAULT) > 0) db.mesh = read_mesh(f);
-    const Eigen::MatrixXd points = read_matrix(f, "contact/points", static_cast<hsize_t>(db.dual.rows()));
-    if (points.rows() != 2) throw hdf5::Refused("dataset /contact/points does not have 2 columns");
-    db.contact_points = points;
-    const std::vector<double> weights =
-        read_vector<double>(f, "contact/weights", static_cast<hsize_t>(db.dual.rows()));
-    db.contact_weights = Eigen::Map<const Eigen::VectorXd>(weights.data(), static_cast<Eigen::Index>(weights.size()));
-    std::vector<double> lift;
-    hsize_t terms = 0, width = 0;
-    read_dataset(f, "lifting", lift, terms, width);
-    if (width != static_cast<hsize_t>(db.primal.rows()))
-      throw hdf5::Refused("dataset /lifting has " + std::to_string(width) + " columns, expected one per dof (" +
-                        std::to_string(db.primal.rows()) + ")");
-    db.lifting_terms = Eigen::Map<Eigen::MatrixXd>(lift.data(), static_cast<Eigen::Index>(width),
-                                                   static_cast<Eigen::Index>(terms));
     validate_values(db);
     file.close("file close");
   } catch (const hdf5::Refused& e) {
@@ -450,33 +275,13 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
 }
 
 void describe_problem(const fom::Problem& problem, SnapshotDatabase& db) {
-  db.problem = problem.name();
-  db.mesh_fingerprint = problem.fingerprint();
-  db.param_names = problem.param_names();
-  db.problem_text = problem.definition().builtin.empty() ? problem.definition().text : "";
-  db.mesh = problem.mesh() ? std::make_shared<const fom::Mesh>(*problem.mesh()) : nullptr;
-  db.contact_points = problem.contact().constraint_points();
-  db.contact_weights = problem.contact().weights();
-  db.lifting_terms.resize(problem.num_dofs(), problem.num_load_terms());
-  for (int k = 0; k < problem.num_load_terms(); ++k) db.lifting_terms.col(k) = problem.lifting_terms()[k];
+  set_problem_record(db, record_problem(problem));
 }
 
 std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, const std::string& path) {
-  std::unique_ptr<fom::Problem> problem;
-  if (db.problem_text.empty()) {
-    if (db.problem != "rope")
-      throw InputError("database '" + path + "' stores no problem file for problem '" + db.problem +
-                       "'; expected a database written by contactrom offline");
-    problem = fom::make_rope_problem();
-  } else {
-    if (!db.mesh) throw InputError("database '" + path + "' stores a problem file but no mesh (dataset /mesh)");
-    // Messages about the stored file name the database.
-    fom::ProblemDefinition def = fom::parse_problem_text(db.problem_text, path + ":/problem_file");
-    problem = fom::build_problem(std::move(def), *db.mesh);
-  }
+  auto problem = rebuild_problem(problem_record(db), "database '" + path + "'");
   check_database(db, *problem, path);
   return problem;
-
 }
 
 std::vector<fom::Param> database_training_set(const SnapshotDatabase& db, const fom::Problem& problem) {

@@ -8,6 +8,7 @@
 #include "fom/input_values.hpp"
 #include "fom/kkt.hpp"
 #include "fom/problem.hpp"
+#include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::cli {
@@ -67,6 +68,53 @@ inline void warn_if_no_primal_modes(const rom::ReducedModel& model) {
     std::cerr << "contactrom: warning: delta " << model.delta()
               << " keeps no POD mode (primal rank 0); the reduced solution is the lifting alone"
                  " and no contact can be enforced; expected a delta well below 1 (paper: 1e-6 to 1e-10)\n";
+}
+
+/// The options that choose a reduced model and its online method (`online`, `reduce`).
+struct MethodArgs {
+  std::string method = "greedy", tau_scaling = "absolute", lifting = "harmonic";
+  double delta = 1e-8, tau = -1.0;
+  int max_iterations = 50;
+  std::vector<std::string> options;  // KEY=VALUE method settings
+
+  /// The reduced-model settings (δ, lifting).
+  rom::ReducedModelOptions model_options() const {
+    rom::ReducedModelOptions o;
+    o.delta = delta;
+    o.lifting = lifting == "dirichlet" ? rom::LiftingKind::Dirichlet : rom::LiftingKind::Harmonic;
+    return o;
+  }
+  /// The online settings; \throws InputError for an --option without '='.
+  rom::OnlineSolverOptions solver_options() const {
+    rom::OnlineSolverOptions o;
+    o.tau = tau;
+    o.tau_scaling = tau_scaling;
+    o.max_iterations = max_iterations;
+    for (const std::string& kv : options) {
+      const size_t eq = kv.find('=');
+      if (eq == std::string::npos || eq == 0)
+        throw InputError("--option '" + kv + "' invalid; expected KEY=VALUE (e.g. cpg_tolerance=1e-2)");
+      o.extra[kv.substr(0, eq)] = kv.substr(eq + 1);
+    }
+    return o;
+  }
+};
+
+/// Adds --method, --delta, --tau, --tau-scaling, --lifting, --max-iterations, --option.
+inline void add_method_options(CLI::App* sub, MethodArgs& a) {
+  sub->add_option("--method", a.method, "online method (default greedy; see the error text for all)");
+  add_number(sub, "--delta", a.delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
+  add_number(sub, "--tau", a.tau, "greedy penetration threshold (default: tau = delta)", Interval::at_least(0));
+  sub->add_option("--tau-scaling", a.tau_scaling, "absolute (default, paper) | relative")
+      ->check(CLI::IsMember({"absolute", "relative"}));
+  sub->add_option("--lifting", a.lifting,
+                  "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet")
+      ->check(CLI::IsMember({"harmonic", "dirichlet"}));
+  add_integer(sub, "--max-iterations", a.max_iterations, "iteration cap k_max (default 50)", 1, 100000);
+  sub->add_option("--option", a.options,
+                  "method setting KEY=VALUE, repeatable: init=empty|cell|nearest|primal, schedule, anderson_depth, "
+                  "max_solves (greedy; see docs/rom.md); cpg_tolerance, cpg_max_size, inner_solve, init=empty|primal|cell "
+                  "(cpg); inner_solve, init (full-dictionary); basis, rank_l, seed, ... (convex-hull; see docs/convex_hull.md)");
 }
 
 }  // namespace contactrom::cli

@@ -1,7 +1,7 @@
 // contactrom fom --problem P --param V[,V2] [--solver active-set|ipopt] [--out DIR] [--json]
 // Solves one FOM query and prints a summary (or one JSON object with --json);
 // --out DIR writes DIR/<problem>.vtu (displacement, stress, pressure) and
-// DIR/<problem>_surface.csv (x, y, gap, pressure).
+// DIR/<problem>_surface.csv (x, y, gap, pressure, u_x, u_y).
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>

@@ -28,12 +28,10 @@
 namespace contactrom::cli {
 namespace {
 
-struct OnlineArgs {
-  std::string db, method = "greedy", param, out, tau_scaling = "absolute", lifting = "harmonic";
-  double delta = 1e-8, tau = -1.0;
-  int threads = 0, max_iterations = 50;
+struct OnlineArgs : MethodArgs {
+  std::string db, param, out;
+  int threads = 0;
   bool validation = false, json = false, kkt = false;
-  std::vector<std::string> options;  // KEY=VALUE method settings
 };
 
 nlohmann::json selected_json(const std::vector<int>& selected) { return selected; }
@@ -156,26 +154,10 @@ void run_online(const OnlineArgs& a) {
     throw InputError("--param and --validation exclude each other; give one");
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
-  rom::OnlineSolverOptions options;
-  options.tau = a.tau;
-  options.tau_scaling = a.tau_scaling;
-  options.max_iterations = a.max_iterations;
-  for (const std::string& kv : a.options) {
-    const size_t eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError("--option '" + kv + "' invalid; expected KEY=VALUE (e.g. cpg_tolerance=1e-2)");
-    options.extra[kv.substr(0, eq)] = kv.substr(eq + 1);
-  }
+  const rom::OnlineSolverOptions options = a.solver_options();
   // Validate the method name before the (more expensive) model construction.
-  const std::vector<std::string> names = rom::online_solver_names();
-  if (std::find(names.begin(), names.end(), a.method) == names.end()) {
-    std::string known;
-    for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-    throw InputError("unknown online method '" + a.method + "'; expected one of: " + known);
-  }
-  rom::ReducedModelOptions model_options;
-  model_options.delta = a.delta;
-  model_options.lifting = a.lifting == "dirichlet" ? rom::LiftingKind::Dirichlet : rom::LiftingKind::Harmonic;
+  rom::check_online_method(a.method);
+  const rom::ReducedModelOptions model_options = a.model_options();
   const rom::ReducedModel model(*problem, db, model_options);
   warn_if_no_primal_modes(model);
   const auto solver = rom::make_online_solver(a.method, model, options);
@@ -190,19 +172,7 @@ CommandRegistrar reg("online", [](CLI::App& app) {
   auto* sub = app.add_subcommand("online", "Evaluate a reduced model built from a snapshot database");
   sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
       ->check(non_empty_path())->required();
-  sub->add_option("--method", args->method, "online method (default greedy; see the error text for all)");
-  add_number(sub, "--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
-  add_number(sub, "--tau", args->tau, "greedy penetration threshold (default: tau = delta)", Interval::at_least(0));
-  sub->add_option("--tau-scaling", args->tau_scaling, "absolute (default, paper) | relative")
-      ->check(CLI::IsMember({"absolute", "relative"}));
-  sub->add_option("--lifting", args->lifting,
-                  "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet")
-      ->check(CLI::IsMember({"harmonic", "dirichlet"}));
-  add_integer(sub, "--max-iterations", args->max_iterations, "iteration cap k_max (default 50)", 1, 100000);
-  sub->add_option("--option", args->options,
-                  "method setting KEY=VALUE, repeatable: init=empty|cell|nearest|primal, schedule, anderson_depth, "
-                  "max_solves (greedy; see docs/rom.md); cpg_tolerance, cpg_max_size, inner_solve, init=empty|primal|cell "
-                  "(cpg); inner_solve, init (full-dictionary); basis, rank_l, seed, ... (convex-hull; see docs/convex_hull.md)");
+  add_method_options(sub, *args);
   sub->add_flag("--validation", args->validation, "evaluate on the validation set (default without --param)");
   sub->add_option("--param", args->param, "one query V or V1,V2");
   sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)")

@@ -185,6 +185,6 @@ BOOST_AUTO_TEST_CASE(cli_fom_ipopt_writes_the_field_files) {
   BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
   BOOST_TEST(std::filesystem::exists(dir + "/rope.vtu"));
   BOOST_TEST(std::filesystem::exists(dir + "/rope_surface.csv"));
-  BOOST_TEST(test::slurp(dir + "/rope_surface.csv").rfind("x,y,gap,pressure\n", 0) == 0);
+  BOOST_TEST(test::slurp(dir + "/rope_surface.csv").rfind("x,y,gap,pressure,u_x,u_y\n", 0) == 0);
   std::filesystem::remove_all(std::filesystem::path(dir).parent_path());
 }

@@ -2,6 +2,9 @@
 // (one-line error naming the value, non-zero exit, no partial files).
 #define BOOST_TEST_MODULE fom_cli
 #include <boost/test/unit_test.hpp>
+
+#include <cmath>
+#include <sstream>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -37,9 +40,40 @@ BOOST_AUTO_TEST_CASE(out_writes_vtu_and_surface_csv) {
   BOOST_TEST(vtu.find("Name=\"contact_pressure\"") != std::string::npos);
   BOOST_TEST(vtu.find("Name=\"stress\"") != std::string::npos);
   const std::string csv = contactrom::test::slurp(dir + "/ironing_surface.csv");
-  BOOST_TEST(csv.rfind("x,y,gap,pressure\n", 0) == 0);
+  BOOST_TEST(csv.rfind("x,y,gap,pressure,u_x,u_y\n", 0) == 0);
   BOOST_TEST(lines(csv) == 1 + rows);  // header + one row per slave node
   BOOST_TEST(rows > 20);
+  fs::remove_all(fs::path(dir).parent_path());
+}
+
+BOOST_AUTO_TEST_CASE(rope_surface_csv_has_reference_coordinates_and_transverse_deflection) {
+  // The rope lies on y = 0; its deflection is u_y, and where the pressure is positive
+  // the rope rests on the obstacle psi(x) = -0.2 (sin(pi x) - sin(3 pi x)) - 0.5.
+  const std::string dir = contactrom::test::temp_dir() + "/rope";
+  const auto r = run_command(exe + " fom --problem rope --param 20 --out " + dir);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  std::istringstream csv(contactrom::test::slurp(dir + "/rope_surface.csv"));
+  std::string line;
+  std::getline(csv, line);
+  BOOST_TEST(line == "x,y,gap,pressure,u_x,u_y");
+  int in_contact = 0;
+  while (std::getline(csv, line)) {
+    double x, y, gap, p, ux, uy;
+    char c;
+    std::istringstream row(line);
+    row >> x >> c >> y >> c >> gap >> c >> p >> c >> ux >> c >> uy;
+    BOOST_TEST_REQUIRE(!row.fail(), line);
+    BOOST_TEST(y == 0.0);
+    BOOST_TEST(ux == 0.0);
+    if (p > 0.0) {
+      ++in_contact;
+      const double pi = std::acos(-1.0);
+      BOOST_TEST(std::abs(uy - (-0.2 * (std::sin(pi * x) - std::sin(3 * pi * x)) - 0.5)) <= 1e-9, line);
+    }
+  }
+  BOOST_TEST(in_contact > 10);
+  const std::string vtu = contactrom::test::slurp(dir + "/rope.vtu");
+  BOOST_TEST(vtu.find("Name=\"displacement\"") != std::string::npos);
   fs::remove_all(fs::path(dir).parent_path());
 }
 

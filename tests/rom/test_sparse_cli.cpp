@@ -133,6 +133,18 @@ BOOST_AUTO_TEST_CASE(csv_reader_accepts_blanks_comments_and_crlf) {
   BOOST_TEST(m(1, 0) == 4.0);
 }
 
+BOOST_AUTO_TEST_CASE(csv_reader_accepts_numpy_savetxt_default_blank_separated_files) {
+  // numpy.savetxt(f, a) writes "%.18e" values separated by one space.
+  std::istringstream in("1.000000000000000000e+00 2.500000000000000000e+00\n\t-3e-1\t 4\n");
+  const MatrixXd m = contactrom::rom::read_dense_csv(in, "savetxt.txt");
+  BOOST_TEST(m.rows() == 2);
+  BOOST_TEST(m.cols() == 2);
+  BOOST_TEST(m(0, 1) == 2.5);
+  BOOST_TEST(m(1, 0) == -0.3);
+  std::istringstream ragged("1 2\n3\n");
+  BOOST_CHECK_THROW(contactrom::rom::read_dense_csv(ragged, "r.txt"), InputError);
+}
+
 BOOST_AUTO_TEST_CASE(csv_reader_errors_name_file_line_and_column) {
   const auto message_of = [](const std::string& text) {
     std::istringstream in(text);

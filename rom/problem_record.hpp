@@ -1,0 +1,52 @@
+#pragma once
+/// \file problem_record.hpp
+/// \brief The problem part of the files contactrom writes (snapshot databases and
+/// reduced models): the problem file's text, the mesh, the contact rows and the
+/// lifting terms — enough to rebuild the fom::Problem without the .toml and .geo
+/// files and without gmsh. Layout in docs/database_format.md ("The problem").
+#include <hdf5.h>
+
+#include <Eigen/Dense>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fom/mesh.hpp"
+#include "fom/problem.hpp"
+
+namespace contactrom::rom {
+
+/// \brief What a file stores of the problem it was built for.
+struct ProblemRecord {
+  std::string name;         ///< problem name (attribute `problem`)
+  std::string fingerprint;  ///< Problem::fingerprint() (attribute `mesh_fingerprint`)
+  std::vector<std::string> param_names;   ///< attribute `param_names` (comma-separated)
+  /// Text of the problem file ("" for `rope`, which is built in).
+  std::string text;
+  std::shared_ptr<const fom::Mesh> mesh;  ///< the (refined) mesh; null for `rope`
+  Eigen::Matrix2Xd contact_points;        ///< reference coordinates of the constraint rows (2 × n_c)
+  Eigen::VectorXd contact_weights;        ///< tributary lengths of the constraint rows
+  Eigen::MatrixXd lifting_terms;          ///< n_dofs × n_terms: the lifting basis L_k
+};
+
+/// \brief The record of `problem`.
+ProblemRecord record_problem(const fom::Problem& problem);
+
+/// \brief Writes the attributes `problem`, `mesh_fingerprint`, `param_names` on `file`
+/// and the datasets /problem_file, /contact/points, /contact/weights, /lifting, /mesh/….
+/// \throws hdf5::Failure
+void write_problem_record(hid_t file, hid_t dcpl, const ProblemRecord& record);
+
+/// \brief Reads what write_problem_record wrote, checking the contact datasets
+/// against `num_constraints` rows, the lifting against `num_dofs`, and every mesh
+/// index against the node count. \throws hdf5::Failure or hdf5::Refused
+ProblemRecord read_problem_record(hid_t file, hsize_t num_constraints, hsize_t num_dofs);
+
+/// \brief Rebuilds the problem from a record (problem-file text and mesh, no gmsh;
+/// `rope` by name) and checks that it is the recorded discretisation (fingerprint,
+/// numbers of dofs, constraints and parameters).
+/// \param label how messages name the file, e.g. "database 'x.h5'"
+/// \throws InputError naming `label`.
+std::unique_ptr<fom::Problem> rebuild_problem(const ProblemRecord& record, const std::string& label);
+
+}  // namespace contactrom::rom

@@ -1,0 +1,321 @@
+#include "rom/reduced_model_file.hpp"
+
+#include <hdf5.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "fom/atomic_file.hpp"
+#include "fom/errors.hpp"
+#include "fom/kkt.hpp"
+#include "rom/dense_csv.hpp"
+#include "rom/hdf5_io.hpp"
+#include "rom/problem_record.hpp"
+
+namespace contactrom::rom {
+namespace {
+
+using hdf5::Handle;
+
+/// Value of attribute `kind`: tells a reduced model from a database.
+constexpr const char* kKind = "contactrom reduced model";
+
+std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+double parse_number(const std::string& key, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
+    throw InputError("online option " + key + " = '" + text + "' is not a number");
+  return v;
+}
+
+/// The column-major rows × cols matrix as a dataset of cols rows (one column of
+/// `m` per dataset row, as h5py users index them).
+void write_columns(hid_t f, hid_t dcpl, const char* name, const Eigen::MatrixXd& m) {
+  hdf5::write_dataset(f, dcpl, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, static_cast<hsize_t>(m.cols()),
+                      static_cast<hsize_t>(m.rows()), m.data());
+}
+
+/// Shape (rows, cols) of a rank-2 dataset. \throws hdf5::Refused for another rank.
+std::pair<hsize_t, hsize_t> shape2(hid_t f, const char* name) {
+  const std::vector<hsize_t> dims = hdf5::dataset_shape(f, name);
+  if (dims.size() != 2) throw hdf5::Refused(std::string("dataset /") + name + " is not two-dimensional");
+  return {dims[0], dims[1]};
+}
+
+/// Reads what write_columns wrote: a dataset of `cols` rows of `rows` finite numbers.
+Eigen::MatrixXd read_columns(hid_t f, const char* name, hsize_t rows, hsize_t cols) {
+  const auto [r, c] = shape2(f, name);
+  if (r != cols || c != rows)
+    throw hdf5::Refused(std::string("dataset /") + name + " has shape (" + std::to_string(r) + ", " +
+                        std::to_string(c) + "), expected (" + std::to_string(cols) + ", " + std::to_string(rows) + ")");
+  std::vector<double> buf;
+  hsize_t a = 0, b = 0;
+  hdf5::read_double_dataset(f, name, buf, a, b);
+  for (double v : buf)
+    if (!std::isfinite(v)) throw hdf5::Refused(std::string("dataset /") + name + " holds a non-finite number");
+  return Eigen::Map<Eigen::MatrixXd>(buf.data(), static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols));
+}
+
+std::string lifting_name(LiftingKind kind) { return kind == LiftingKind::Dirichlet ? "dirichlet" : "harmonic"; }
+
+void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
+  const ReducedModelData d = rom.model().data();
+  const int version = kReducedModelFormatVersion;
+  hdf5::write_string_attribute(f, "kind", kKind);
+  hdf5::write_scalar_attribute(f, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &version);
+  hdf5::write_string_attribute(f, "created_by", std::string("contactrom ") + CONTACTROM_VERSION);
+  hdf5::write_string_attribute(f, "method", rom.method());
+  hdf5::write_scalar_attribute(f, "delta", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &d.options.delta);
+  hdf5::write_string_attribute(f, "lifting", lifting_name(d.options.lifting));
+  const int include_failed = d.options.include_failed_snapshots ? 1 : 0;
+  hdf5::write_scalar_attribute(f, "include_failed_snapshots", H5T_STD_I32LE, H5T_NATIVE_INT, &include_failed);
+  std::vector<std::string> keys, values;
+  for (const auto& [key, value] : online_option_values(rom.options())) keys.push_back(key), values.push_back(value);
+  Handle options(H5Gcreate2(f, "options", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "group /options");
+  hdf5::write_string_list(f, dcpl, "options/keys", keys);
+  hdf5::write_string_list(f, dcpl, "options/values", values);
+
+  write_columns(f, dcpl, "basis", d.basis);
+  write_columns(f, dcpl, "surface_basis", rom.model().surface_basis());
+  const std::vector<int>& surf = rom.problem().contact().surface_dofs();
+  hdf5::write_dataset(f, dcpl, "surface_dofs", H5T_STD_I32LE, H5T_NATIVE_INT, 1, surf.size(), 0, surf.data());
+  hdf5::write_dataset(f, dcpl, "singular_values", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1,
+                      static_cast<hsize_t>(d.singular_values.size()), 0, d.singular_values.data());
+  Eigen::MatrixXd offset(rom.problem().num_dofs(), static_cast<Eigen::Index>(d.offset_terms.size()));
+  for (size_t k = 0; k < d.offset_terms.size(); ++k) offset.col(static_cast<Eigen::Index>(k)) = d.offset_terms[k];
+  write_columns(f, dcpl, "offset", offset);
+  Handle reduced(H5Gcreate2(f, "reduced", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "group /reduced");
+  write_columns(f, dcpl, "reduced/load", d.load_terms);
+  for (size_t q = 0; q < d.stiffness_terms.size(); ++q) {
+    write_columns(f, dcpl, ("reduced/stiffness_" + std::to_string(q)).c_str(), d.stiffness_terms[q]);
+    write_columns(f, dcpl, ("reduced/stiffness_offset_" + std::to_string(q)).c_str(), d.stiffness_offset_terms[q]);
+  }
+  write_columns(f, dcpl, "dictionary", d.dictionary);
+  hdf5::write_dataset(f, dcpl, "dictionary_snapshots", H5T_STD_I32LE, H5T_NATIVE_INT, 1,
+                      d.dictionary_snapshots.size(), 0, d.dictionary_snapshots.data());
+  Eigen::MatrixXd params(rom.problem().num_params(), static_cast<Eigen::Index>(d.dictionary_parameters.size()));
+  for (size_t c = 0; c < d.dictionary_parameters.size(); ++c)
+    params.col(static_cast<Eigen::Index>(c)) = d.dictionary_parameters[c];
+  write_columns(f, dcpl, "dictionary_parameters", params);
+  write_columns(f, dcpl, "primal_snapshots", d.primal_snapshots);
+  write_problem_record(f, dcpl, record_problem(rom.problem()));
+}
+
+}  // namespace
+
+std::map<std::string, std::string> online_option_values(const OnlineSolverOptions& options) {
+  std::map<std::string, std::string> out = options.extra;
+  if (options.tau >= 0.0) out["tau"] = format_number(options.tau);
+  out["tau_scaling"] = options.tau_scaling;
+  out["max_iterations"] = std::to_string(options.max_iterations);
+  out["step_tolerance"] = format_number(options.step_tolerance);
+  return out;
+}
+
+OnlineSolverOptions online_options_from_values(const std::map<std::string, std::string>& values) {
+  OnlineSolverOptions o;
+  for (const auto& [key, value] : values) {
+    if (key == "tau")
+      o.tau = parse_number(key, value);
+    else if (key == "tau_scaling")
+      o.tau_scaling = value;
+    else if (key == "max_iterations") {
+      const double v = parse_number(key, value);
+      if (v != std::floor(v) || v < 1 || v > 1e9)
+        throw InputError("online option max_iterations = '" + value + "' invalid; expected an integer >= 1");
+      o.max_iterations = static_cast<int>(v);
+    } else if (key == "step_tolerance")
+      o.step_tolerance = parse_number(key, value);
+    else
+      o.extra[key] = value;
+  }
+  return o;
+}
+
+OnlineModel::OnlineModel(std::shared_ptr<const fom::Problem> problem, std::unique_ptr<ReducedModel> model,
+                         const std::string& method, const OnlineSolverOptions& options)
+    : m_problem(std::move(problem)), m_model(std::move(model)), m_method(method), m_options(options) {
+  m_solver = make_online_solver(m_method, *m_model, m_options);
+}
+
+OnlineModel::OnlineModel(std::shared_ptr<const fom::Problem> problem, const SnapshotDatabase& db,
+                         const ReducedModelOptions& model_options, const std::string& method,
+                         const OnlineSolverOptions& options)
+    : m_problem(std::move(problem)), m_method(method), m_options(options) {
+  // The method name first: building the model costs a POD.
+  check_online_method(method);
+  m_model = std::make_unique<ReducedModel>(*m_problem, db, model_options);
+  m_solver = make_online_solver(m_method, *m_model, m_options);
+}
+
+OnlineResult OnlineModel::solve(const fom::Param& mu) const {
+  m_problem->check_param(mu);
+  return m_solver->solve(mu);
+}
+
+void OnlineModel::save(const std::string& path) const {
+  try {
+    hdf5::write_file(path, [this](hid_t f, hid_t dcpl) { write_model(f, dcpl, *this); });
+  } catch (const hdf5::Failure& e) {
+    throw InputError("cannot write reduced model '" + path + "': HDF5 failed on " + e.what());
+  }
+}
+
+OnlineModel OnlineModel::load(const std::string& path) {
+  const std::string label = "reduced model '" + path + "'";
+  Handle file(hdf5::open_file(path, "reduced model", "contactrom reduce"), H5Fclose, "the file structure");
+  const hid_t f = file.id();
+  ReducedModelData d;
+  ProblemRecord record;
+  std::string method;
+  std::map<std::string, std::string> option_values;
+  try {
+    if (!hdf5::has_attribute(f, "kind") || hdf5::read_string_attribute(f, "kind") != kKind)
+      throw InputError(label + " is not a contactrom reduced model (attribute kind is not '" + kKind +
+                       "'; a snapshot database is read with --db, not --rom)");
+    const int version = hdf5::read_int_attribute(f, "format_version");
+    if (version != kReducedModelFormatVersion)
+      throw InputError(label + " has format_version " + std::to_string(version) + ", but this contactrom reads version " +
+                       std::to_string(kReducedModelFormatVersion) + "; rebuild it with contactrom reduce");
+    method = hdf5::read_string_attribute(f, "method");
+    d.options.delta = hdf5::read_double_attribute(f, "delta");
+    if (!(d.options.delta >= 0.0) || !std::isfinite(d.options.delta))
+      throw hdf5::Refused("attribute delta is " + format_number(d.options.delta) + ", expected a number >= 0");
+    const std::string lifting = hdf5::read_string_attribute(f, "lifting");
+    if (lifting != "harmonic" && lifting != "dirichlet")
+      throw hdf5::Refused("attribute lifting is '" + lifting + "', expected 'harmonic' or 'dirichlet'");
+    d.options.lifting = lifting == "dirichlet" ? LiftingKind::Dirichlet : LiftingKind::Harmonic;
+    d.options.include_failed_snapshots = hdf5::read_int_attribute(f, "include_failed_snapshots") != 0;
+    const std::vector<std::string> keys = hdf5::read_string_list(f, "options/keys", hdf5::file_size(f));
+    const std::vector<std::string> values = hdf5::read_string_list(f, "options/values", hdf5::file_size(f));
+    if (keys.size() != values.size())
+      throw hdf5::Refused("datasets /options/keys and /options/values differ in length");
+    for (size_t i = 0; i < keys.size(); ++i) option_values[keys[i]] = values[i];
+
+    const auto [r, n] = shape2(f, "basis");
+    const auto [m, nc] = shape2(f, "dictionary");
+    d.basis = read_columns(f, "basis", n, r);
+    d.dictionary = read_columns(f, "dictionary", nc, m);
+    std::vector<double> sigma;
+    hsize_t rows = 0, cols = 0;
+    hdf5::read_double_dataset(f, "singular_values", sigma, rows, cols);
+    if (cols != 1 || rows < r) throw hdf5::Refused("dataset /singular_values holds fewer values than modes");
+    d.singular_values = Eigen::Map<Eigen::VectorXd>(sigma.data(), static_cast<Eigen::Index>(rows));
+    const auto [nt, n_offset] = shape2(f, "offset");
+    const Eigen::MatrixXd offset = read_columns(f, "offset", n, nt);
+    for (hsize_t k = 0; k < nt; ++k) d.offset_terms.push_back(offset.col(static_cast<Eigen::Index>(k)));
+    d.load_terms = read_columns(f, "reduced/load", r, nt);
+    for (int q = 0;; ++q) {
+      const std::string name = "reduced/stiffness_" + std::to_string(q);
+      if (H5Lexists(f, name.c_str(), H5P_DEFAULT) <= 0) break;
+      d.stiffness_terms.push_back(read_columns(f, name.c_str(), r, r));
+      d.stiffness_offset_terms.push_back(
+          read_columns(f, ("reduced/stiffness_offset_" + std::to_string(q)).c_str(), r, nt));
+    }
+    hdf5::read_int_dataset(f, "dictionary_snapshots", d.dictionary_snapshots, rows, cols);
+    if (rows != m || cols != 1) throw hdf5::Refused("dataset /dictionary_snapshots does not hold one index per column");
+    for (int j : d.dictionary_snapshots)
+      if (j < 0) throw hdf5::Refused("dataset /dictionary_snapshots holds the negative index " + std::to_string(j));
+    const auto [mp, np] = shape2(f, "dictionary_parameters");
+    const Eigen::MatrixXd params = read_columns(f, "dictionary_parameters", np, m);
+    for (hsize_t c = 0; c < m; ++c) d.dictionary_parameters.push_back(params.col(static_cast<Eigen::Index>(c)));
+    d.primal_snapshots = read_columns(f, "primal_snapshots", n, m);
+    const double scale = std::max(1.0, d.dictionary.size() ? d.dictionary.cwiseAbs().maxCoeff() : 0.0);
+    if (d.dictionary.size() && d.dictionary.minCoeff() < -1e-9 * scale)
+      throw hdf5::Refused("dataset /dictionary holds a negative pressure");
+    record = read_problem_record(f, nc, n);
+    // The surface rows are stored for readers of the file; the model takes them from the basis.
+    const auto [r_s, n_s] = shape2(f, "surface_basis");
+    if (r_s != r) throw hdf5::Refused("dataset /surface_basis does not hold one row per mode");
+    (void)mp, (void)n_offset, (void)n_s;
+    file.close("file close");
+  } catch (const hdf5::Refused& e) {
+    throw InputError(label + " is not a valid contactrom reduced model: " + e.what());
+  } catch (const hdf5::Failure& e) {
+    throw InputError(label + " is truncated or corrupt (HDF5 cannot read " + e.what() + ")");
+  }
+  std::shared_ptr<const fom::Problem> problem = rebuild_problem(record, label);
+  for (const fom::Param& p : d.dictionary_parameters) {
+    try {
+      problem->check_param(p);
+    } catch (const InputError& e) {
+      throw InputError(label + " dataset /dictionary_parameters: " + e.what());
+    }
+  }
+  try {
+    auto model = std::make_unique<ReducedModel>(*problem, std::move(d));
+    return OnlineModel(problem, std::move(model), method, online_options_from_values(option_values));
+  } catch (const InputError& e) {
+    throw InputError(label + ": " + e.what());
+  }
+}
+
+std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::Problem& problem) {
+  std::ifstream in(path);
+  if (!in) throw InputError("parameter file '" + path + "' cannot be opened");
+  std::stringstream text;
+  text << in.rdbuf();
+  // An optional header naming the components becomes a comment (line numbers kept).
+  std::string all = text.str(), header;
+  for (const std::string& name : problem.param_names()) header += (header.empty() ? "" : ",") + name;
+  size_t start = 0;
+  while (start < all.size()) {
+    size_t end = all.find('\n', start);
+    if (end == std::string::npos) end = all.size();
+    std::string line = all.substr(start, end - start);
+    std::string compact;
+    for (char c : line)
+      if (c != ' ' && c != '\t' && c != '\r') compact += c;
+    if (compact.empty() || compact[0] == '#') {
+      start = end + 1;
+      continue;
+    }
+    if (compact == header) all[start] = '#';
+    break;
+  }
+  std::istringstream lines(all);
+  const Eigen::MatrixXd values = read_dense_csv(lines, "parameter file '" + path + "'");
+  if (values.cols() != problem.num_params())
+    throw InputError("parameter file '" + path + "' has " + std::to_string(values.cols()) + " values per line, but " +
+                     problem.name() + " has " + std::to_string(problem.num_params()) + " parameters (" + header + ")");
+  std::vector<fom::Param> out;
+  for (Eigen::Index i = 0; i < values.rows(); ++i) {
+    const fom::Param mu = values.row(i).transpose();
+    try {
+      problem.check_param(mu);
+    } catch (const InputError& e) {
+      throw InputError("parameter file '" + path + "' data row " + std::to_string(i + 1) + ": " + e.what());
+    }
+    out.push_back(mu);
+  }
+  return out;
+}
+
+void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results) {
+  write_file_atomically(path, [&](std::ostream& out) {
+    for (const std::string& name : rom.problem().param_names()) out << name << ',';
+    out << "status,converged,iterations,sparsity,contact_force,time_s,selected,coefficients\n";
+    for (const OnlineResult& res : results) {
+      for (int k = 0; k < res.mu.size(); ++k) out << format_number(res.mu(k)) << ',';
+      out << to_string(res.status) << ',' << (res.converged ? 1 : 0) << ',' << res.iterations << ','
+          << res.selected.size() << ',' << format_number(fom::contact_force(rom.problem(), res.lambda)) << ','
+          << format_number(res.time_s) << ',';
+      for (size_t j = 0; j < res.selected.size(); ++j)
+        out << (j ? " " : "") << rom.model().dictionary_snapshots()[static_cast<size_t>(res.selected[j])];
+      out << ',';
+      for (Eigen::Index j = 0; j < res.coefficients.size(); ++j) out << (j ? " " : "") << format_number(res.coefficients(j));
+      out << '\n';
+    }
+  });
+}
+
+}  // namespace contactrom::rom

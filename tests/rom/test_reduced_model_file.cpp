@@ -1,0 +1,237 @@
+// The reduced-model file (rom/reduced_model_file.hpp, `reduce`, `query`): a saved
+// and loaded model answers every query exactly as the model it was saved from
+// (same selections, bitwise the same coefficients and fields), for each online
+// method; `query` from the CLI gives the same answers as the library; damaged or
+// wrong files are refused with one line naming the file.
+#define BOOST_TEST_MODULE rom_reduced_model_file
+#include <boost/test/unit_test.hpp>
+
+#include <hdf5.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "baselines/reduced_active_set.hpp"
+#include "common/run_command.hpp"
+#include "fom/problem.hpp"
+#include "rom/convex_hull.hpp"
+#include "rom/offline.hpp"
+#include "rom/reduced_model_file.hpp"
+
+namespace fs = std::filesystem;
+using contactrom::InputError;
+using contactrom::fom::Param;
+using contactrom::rom::OnlineModel;
+using contactrom::rom::OnlineResult;
+using contactrom::test::run_command;
+
+namespace {
+
+const std::string exe = CONTACTROM_EXE;
+
+struct WorkDir {
+  std::string path = contactrom::test::temp_dir();
+  ~WorkDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+const std::string& work_dir() {
+  static const WorkDir dir;
+  return dir.path;
+}
+
+std::shared_ptr<const contactrom::fom::Problem> hertz() {
+  static std::shared_ptr<const contactrom::fom::Problem> p = contactrom::fom::make_problem("hertz");
+  return p;
+}
+
+/// hertz with 10 training snapshots, also written to work_dir()/hertz10.h5.
+const contactrom::rom::SnapshotDatabase& hertz_db() {
+  static const contactrom::rom::SnapshotDatabase db = [] {
+    auto d = contactrom::rom::generate_snapshots(*hertz(), 10);
+    contactrom::rom::write_database(work_dir() + "/hertz10.h5", d);
+    return d;
+  }();
+  return db;
+}
+
+/// Queries inside the range, between and at training parameters.
+std::vector<Param> queries() {
+  std::vector<Param> out;
+  for (double d : {0.0123, 0.05, 0.1, 0.1789, 0.25, 0.3}) out.push_back(Param::Constant(1, d));
+  return out;
+}
+
+void check_same_answers(const OnlineModel& a, const OnlineModel& b) {
+  BOOST_TEST(a.model().primal_rank() == b.model().primal_rank());
+  BOOST_TEST(a.model().dictionary_size() == b.model().dictionary_size());
+  for (const Param& mu : queries()) {
+    const OnlineResult x = a.solve(mu), y = b.solve(mu);
+    BOOST_TEST(x.selected == y.selected);
+    BOOST_TEST(x.iterations == y.iterations);
+    BOOST_TEST(x.status == y.status);
+    BOOST_TEST((x.coefficients - y.coefficients).cwiseAbs().maxCoeff() == 0.0);
+    BOOST_TEST((x.u - y.u).cwiseAbs().maxCoeff() == 0.0);
+    BOOST_TEST((x.lambda - y.lambda).cwiseAbs().maxCoeff() == 0.0);
+  }
+}
+
+/// Overwrites element 0 of a double dataset of an HDF5 file.
+void poke(const std::string& path, const char* dataset, double value) {
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  BOOST_REQUIRE(f >= 0);
+  const hid_t d = H5Dopen2(f, dataset, H5P_DEFAULT);
+  BOOST_REQUIRE(d >= 0);
+  const hid_t space = H5Dget_space(d);
+  const hsize_t start[2] = {0, 0}, count[2] = {1, 1};
+  H5Sselect_hyperslab(space, H5S_SELECT_SET, start, nullptr, count, nullptr);
+  const hsize_t one[1] = {1};
+  const hid_t mem = H5Screate_simple(1, one, nullptr);
+  BOOST_REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, &value) >= 0);
+  H5Sclose(mem), H5Sclose(space), H5Dclose(d), H5Fclose(f);
+}
+
+std::string one_line_error(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(saved_model_answers_like_the_original_for_every_method) {
+  contactrom::baselines::register_baseline_online_solvers();
+  contactrom::rom::register_convex_hull_solver();
+  contactrom::rom::ReducedModelOptions model_options;
+  model_options.delta = 1e-8;
+  for (const std::string method : {"greedy", "cpg", "convex-hull"}) {
+    BOOST_TEST_CONTEXT("method " << method) {
+      contactrom::rom::OnlineSolverOptions options;
+      if (method == "greedy") options.extra["init"] = "empty";  // a non-default setting must survive the file
+      const OnlineModel original(hertz(), hertz_db(), model_options, method, options);
+      const std::string path = work_dir() + "/hertz10_" + method + ".h5";
+      original.save(path);
+      const OnlineModel loaded = OnlineModel::load(path);
+      BOOST_TEST(loaded.method() == method);
+      BOOST_TEST(contactrom::rom::online_option_values(loaded.options()) ==
+                 contactrom::rom::online_option_values(original.options()));
+      check_same_answers(original, loaded);
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(loaded_model_reproduces_training_snapshots) {
+  // The property the offline stage promises: at a training parameter the ROM gives
+  // back (to the POD tolerance) the FOM snapshot it was built from.
+  const std::string path = work_dir() + "/hertz10_greedy_train.h5";
+  OnlineModel(hertz(), hertz_db(), {}, "greedy").save(path);
+  const OnlineModel rom = OnlineModel::load(path);
+  const auto& db = hertz_db();
+  for (int j : {0, 4, 9}) {
+    const OnlineResult res = rom.solve(db.parameter(j));
+    BOOST_TEST(res.status == contactrom::Status::Success);
+    const Eigen::VectorXd u = db.primal.col(j) + hertz()->lifting(db.parameter(j));
+    BOOST_TEST((res.u - u).norm() <= 1e-3 * u.norm());
+    BOOST_TEST((res.lambda - db.dual.col(j)).norm() <= 1e-3 * db.dual.col(j).norm());
+  }
+}
+
+BOOST_AUTO_TEST_CASE(cli_reduce_then_query_matches_the_library) {
+  (void)hertz_db();
+  const std::string db = work_dir() + "/hertz10.h5", rom_path = work_dir() + "/cli_greedy.h5";
+  const auto reduce = run_command(exe + " reduce --db " + db + " --method greedy --delta 1e-8 --out " + rom_path + " --json");
+  BOOST_REQUIRE_MESSAGE(reduce.exit_code == 0, reduce.err);
+  {
+    std::ofstream csv(work_dir() + "/queries.csv");
+    csv << "# hertz queries\nd\n0.0123\n0.1789\n0.3\n";
+  }
+  const std::string out = work_dir() + "/answers.csv";
+  const auto query = run_command(exe + " query --rom " + rom_path + " --params " + work_dir() + "/queries.csv --out " +
+                                 out + " --json");
+  BOOST_REQUIRE_MESSAGE(query.exit_code == 0, query.err);
+  const nlohmann::json j = nlohmann::json::parse(query.out);
+  BOOST_REQUIRE(j["queries"].size() == 3u);
+  const OnlineModel library(hertz(), hertz_db(), {}, "greedy");
+  const std::vector<double> ds = {0.0123, 0.1789, 0.3};
+  for (size_t i = 0; i < ds.size(); ++i) {
+    const OnlineResult res = library.solve(Param::Constant(1, ds[i]));
+    BOOST_TEST(j["queries"][i]["iterations"].get<int>() == res.iterations);
+    BOOST_TEST(j["queries"][i]["contact_force"].get<double>() ==
+               contactrom::fom::contact_force(*hertz(), res.lambda));
+    std::vector<int> selected;
+    for (int c : res.selected) selected.push_back(library.model().dictionary_snapshots()[static_cast<size_t>(c)]);
+    BOOST_TEST(j["queries"][i]["selected"].get<std::vector<int>>() == selected);
+  }
+  BOOST_TEST(fs::exists(out));
+  BOOST_TEST(contactrom::test::slurp(out).find("d,status,converged") == 0u);
+}
+
+BOOST_AUTO_TEST_CASE(damaged_or_wrong_files_are_refused_with_one_line) {
+  const std::string good = work_dir() + "/hertz10_good.h5";
+  OnlineModel(hertz(), hertz_db(), {}, "greedy").save(good);
+
+  BOOST_TEST(one_line_error([] { OnlineModel::load(work_dir() + "/missing.h5"); }).find("not found") !=
+             std::string::npos);
+  // A snapshot database is not a reduced model.
+  const std::string db_error = one_line_error([] { OnlineModel::load(work_dir() + "/hertz10.h5"); });
+  BOOST_TEST(db_error.find("not a contactrom reduced model") != std::string::npos, db_error);
+  // Truncated.
+  const std::string cut = work_dir() + "/cut.h5";
+  fs::copy_file(good, cut, fs::copy_options::overwrite_existing);
+  fs::resize_file(cut, fs::file_size(good) / 2);
+  const std::string cut_error = one_line_error([&] { OnlineModel::load(cut); });
+  BOOST_TEST(cut_error.find(cut) != std::string::npos, cut_error);
+  // A non-finite number in the reduced operators.
+  const std::string nan = work_dir() + "/nan.h5";
+  fs::copy_file(good, nan, fs::copy_options::overwrite_existing);
+  poke(nan, "reduced/stiffness_0", std::nan(""));
+  const std::string nan_error = one_line_error([&] { OnlineModel::load(nan); });
+  BOOST_TEST(nan_error.find("non-finite") != std::string::npos, nan_error);
+  // A dictionary parameter outside the problem's range.
+  const std::string out_of_range = work_dir() + "/range.h5";
+  fs::copy_file(good, out_of_range, fs::copy_options::overwrite_existing);
+  poke(out_of_range, "dictionary_parameters", 7.0);
+  const std::string range_error = one_line_error([&] { OnlineModel::load(out_of_range); });
+  BOOST_TEST(range_error.find("dictionary_parameters") != std::string::npos, range_error);
+  for (const std::string* e : {&db_error, &cut_error, &nan_error, &range_error})
+    BOOST_TEST(e->find('\n') == std::string::npos);
+
+  // The CLI: exit 2, one line, no output file.
+  const std::string out = work_dir() + "/never.csv";
+  const auto r = run_command(exe + " query --rom " + nan + " --param 0.1 --out " + out);
+  BOOST_TEST(r.exit_code == 2);
+  BOOST_TEST(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  BOOST_TEST(!fs::exists(out));
+  const auto bad_param = run_command(exe + " query --rom " + good + " --param 0.5");
+  BOOST_TEST(bad_param.exit_code == 2);
+  BOOST_TEST(bad_param.err.find("0.5") != std::string::npos, bad_param.err);
+}
+
+BOOST_AUTO_TEST_CASE(parameter_csv_is_checked_row_by_row) {
+  const std::string path = work_dir() + "/params.csv";
+  {
+    std::ofstream f(path);
+    f << "d\n0.1\n# comment\n\n0.2\n";
+  }
+  const auto params = contactrom::rom::read_parameter_csv(path, *hertz());
+  BOOST_REQUIRE(params.size() == 2u);
+  BOOST_TEST(params[1](0) == 0.2);
+  {
+    std::ofstream f(path);
+    f << "0.1\n0.4\n";
+  }
+  const std::string e = one_line_error([&] { contactrom::rom::read_parameter_csv(path, *hertz()); });
+  BOOST_TEST(e.find("data row 2") != std::string::npos, e);
+  {
+    std::ofstream f(path);
+    f << "0.1,0.2\n";
+  }
+  const std::string e2 = one_line_error([&] { contactrom::rom::read_parameter_csv(path, *hertz()); });
+  BOOST_TEST(e2.find("2 values per line") != std::string::npos, e2);
+}
