@@ -83,6 +83,10 @@ NodeToSegmentContact::NodeToSegmentContact(const Eigen::Matrix2Xd& nodes, const 
       pair.master_surface.push_back(it->second);
       pair.master_x.col(static_cast<Eigen::Index>(j)) = nodes.col(node);
     }
+    double length = 0.0;
+    for (Eigen::Index j = 0; j + 1 < pair.master_x.cols(); ++j)
+      length += (pair.master_x.col(j + 1) - pair.master_x.col(j)).norm();
+    pair.margin = 0.5 * length / static_cast<double>(pair.master_x.cols() - 1);
     m_pairs.push_back(std::move(pair));
   }
   for (int node : surface_nodes) m_surface_dofs.insert(m_surface_dofs.end(), {2 * node, 2 * node + 1});
@@ -104,9 +108,27 @@ int NodeToSegmentContact::pair_of_row(int row) const { return m_row_pair[static_
 
 void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
                                        const Pairing* hint, Pairing& p) const {
+  search_all(u_surface, rows, hint, nullptr, p);
+}
+
+void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
+                                       const Pairing* hint, SearchMemory& memory, Pairing& p) const {
+  const int ns = static_cast<int>(m_slave.size());
+  if (static_cast<int>(memory.centre.size()) != ns) {
+    memory.centre.assign(ns, -1);
+    memory.clearance.assign(ns, 0.0);
+    memory.slave_reference.resize(2, ns);
+    memory.master_reference.assign(m_pairs.size(), Eigen::Matrix2Xd());
+    memory.recorded.assign(m_pairs.size(), 0);
+  }
+  search_all(u_surface, rows, hint, &memory, p);
+}
+
+void NodeToSegmentContact::search_all(const Eigen::VectorXd& u_surface, const std::vector<int>* rows,
+                                      const Pairing* hint, SearchMemory* memory, Pairing& p) const {
   if (hint == &p) {  // the hint is read while p is written
     const Pairing copy = *hint;
-    search_rows(u_surface, rows, &copy, p);
+    search_all(u_surface, rows, &copy, memory, p);
     return;
   }
   const int ns = static_cast<int>(m_slave.size());
@@ -115,19 +137,23 @@ void NodeToSegmentContact::search_rows(const Eigen::VectorXd& u_surface, const s
   p.normal.setZero(2, ns);
   // The listed rows are ascending, so each pair's rows are one contiguous run of them.
   size_t r = 0;
-  for (const Pair& pair : m_pairs) {
+  for (size_t q = 0; q < m_pairs.size(); ++q) {
+    const Pair& pair = m_pairs[q];
+    const int pq = static_cast<int>(q);
     if (!rows) {
-      search_pair(pair, u_surface, nullptr, pair.row_end - pair.row_begin, hint, p);
+      search_pair(pair, u_surface, nullptr, pair.row_end - pair.row_begin, hint, p, memory, pq);
       continue;
     }
     const size_t first = r;
     while (r < rows->size() && (*rows)[r] < pair.row_end) ++r;
-    if (r > first) search_pair(pair, u_surface, rows->data() + first, static_cast<int>(r - first), hint, p);
+    if (r > first)
+      search_pair(pair, u_surface, rows->data() + first, static_cast<int>(r - first), hint, p, memory, pq);
   }
 }
 
 void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& u_surface, const int* rows,
-                                       int nrows, const Pairing* hint, Pairing& p) const {
+                                       int nrows, const Pairing* hint, Pairing& p, SearchMemory* memory,
+                                       int pair_index) const {
   const int nm = static_cast<int>(pair.master.size());
   // Per-thread scratch arrays: a search takes a few microseconds inside the online
   // loops, where allocating them on every call would be a visible share.
@@ -135,88 +161,191 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
     Eigen::Matrix2Xd xm, node_normal, seg_t, mid, block_c;
     Eigen::VectorXd inv_len2, half, block_r;
   } scratch;
-  Eigen::Matrix2Xd& xm = scratch.xm;
-  xm = pair.master_x;
-  for (int j = 0; j < nm; ++j) xm.col(j) += u_surface.segment<2>(2 * pair.master_surface[static_cast<size_t>(j)]);
-  // Segment data for the distances: tangent t, midpoint, 1/|t|² and the radius of a
-  // circle about the midpoint holding the segment (½(|t_x|+|t_y|) ≥ ½|t|, no root).
+  // Deformed master nodes and, for the distances, per segment: tangent t, midpoint,
+  // 1/|t|² and the radius of a circle about the midpoint holding the segment
+  // (½(|t_x|+|t_y|) ≥ ½|t|, no root); `prepare` fills segments j0 … j1−1.
   const int nseg = std::max(nm - 1, 0);
+  Eigen::Matrix2Xd& xm = scratch.xm;
   Eigen::Matrix2Xd& seg_t = scratch.seg_t;
   Eigen::Matrix2Xd& mid = scratch.mid;
   Eigen::VectorXd& inv_len2 = scratch.inv_len2;
   Eigen::VectorXd& half = scratch.half;
+  xm.resize(2, nm);
   seg_t.resize(2, nseg);
   mid.resize(2, nseg);
   inv_len2.resize(nseg);
   half.resize(nseg);
-  for (int j = 0; j < nseg; ++j) {
-    const Eigen::Vector2d t = xm.col(j + 1) - xm.col(j);
-    seg_t.col(j) = t;
-    mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
-    inv_len2(j) = 1.0 / t.squaredNorm();
-    half(j) = 0.5 * (std::abs(t.x()) + std::abs(t.y()));
-  }
-  // Bounding circles of blocks of m_block consecutive segments (centre, radius):
-  // a block is skipped when its circle is farther than the best distance found.
-  const int nblock = (nseg + m_block - 1) / m_block;
-  Eigen::Matrix2Xd& block_c = scratch.block_c;
-  Eigen::VectorXd& block_r = scratch.block_r;
-  block_c.resize(2, nblock);
-  block_r.resize(nblock);
-  for (int b = 0; b < nblock; ++b) {
-    const int j0 = b * m_block, j1 = std::min(nseg, j0 + m_block);  // vertices j0..j1
-    block_c.col(b) = xm.middleCols(j0, j1 - j0 + 1).rowwise().mean();
-    double r2 = 0.0;
-    for (int j = j0; j <= j1; ++j) r2 = std::max(r2, (xm.col(j) - block_c.col(b)).squaredNorm());
-    block_r(b) = std::sqrt(r2);
+  auto prepare = [&](int j0, int j1) {
+    for (int j = j0; j <= std::min(j1, nm - 1); ++j)
+      xm.col(j) = pair.master_x.col(j) + u_surface.segment<2>(2 * pair.master_surface[static_cast<size_t>(j)]);
+    for (int j = j0; j < j1; ++j) {
+      const Eigen::Vector2d t = xm.col(j + 1) - xm.col(j);
+      seg_t.col(j) = t;
+      mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
+      inv_len2(j) = 1.0 / t.squaredNorm();
+      half(j) = 0.5 * (std::abs(t.x()) + std::abs(t.y()));
+    }
+  };
+
+  // Closest point of slave position (px, py) on segment j, kept when closer than
+  // the best so far; ties (a slave node exactly at a master node) go to the lower
+  // segment index.
+  struct Best {
+    double dist2 = std::numeric_limits<double>::max(), root = std::numeric_limits<double>::max();
+    int seg = -1;
+    double xi = 0.0, raw = 0.0;
+  };
+  auto try_segment = [&](double px, double py, int j, Best& best) {
+    const double dx = px - xm(0, j), dy = py - xm(1, j), tx = seg_t(0, j), ty = seg_t(1, j);
+    const double raw = (dx * tx + dy * ty) * inv_len2(j);
+    const double xi = raw < 0.0 ? 0.0 : (raw > 1.0 ? 1.0 : raw);
+    const double ex = dx - xi * tx, ey = dy - xi * ty;
+    const double dist2 = ex * ex + ey * ey;
+    if (dist2 < best.dist2 * (1.0 - 1e-14) || (best.seg >= 0 && dist2 <= best.dist2 * (1.0 + 1e-14) && j < best.seg))
+      best = {dist2, std::sqrt(dist2), j, xi, raw};
+    return dist2;
+  };
+  auto slave_position = [&](int k) {
+    return Eigen::Vector2d(m_slave_x(0, k) + u_surface(2 * k), m_slave_x(1, k) + u_surface(2 * k + 1));
+  };
+  int lowest = nseg, highest = -1;
+  // Stores row k's closest segment in the pairing.
+  auto pair_row = [&](int k, const Best& best) {
+    // A projection beyond either end of the master chain is no contact pair.
+    if (best.seg < 0 || (best.seg == 0 && best.raw < 0.0) || (best.seg == nm - 2 && best.raw > 1.0)) return;
+    p.segment[k] = best.seg;
+    p.xi[k] = best.xi;
+    lowest = std::min(lowest, best.seg);
+    highest = std::max(highest, best.seg);
+  };
+
+  // With a record of an earlier search: every row settled among its recorded
+  // segment and the neighbours, or the whole pair searched again below.
+  bool settled = memory && memory->recorded[static_cast<size_t>(pair_index)] && nseg > 0;
+  if (settled) {
+    const Eigen::Matrix2Xd& ref = memory->master_reference[static_cast<size_t>(pair_index)];
+    double b2 = 0.0;  // largest master-node movement since the record, squared
+    for (int j = 0; j < nm; ++j)
+      b2 = std::max(b2, (u_surface.segment<2>(2 * pair.master_surface[static_cast<size_t>(j)]) - ref.col(j)).squaredNorm());
+    const double b = std::sqrt(b2);
+    // Only the segments the recorded ones and their neighbours reach (the normals
+    // below use one more on each side).
+    int c_min = nseg, c_max = -1;
+    for (int r = 0; r < nrows; ++r) {
+      const int c = memory->centre[static_cast<size_t>(rows ? rows[r] : pair.row_begin + r)];
+      if (c >= 0) c_min = std::min(c_min, c), c_max = std::max(c_max, c);
+    }
+    if (c_max >= 0) prepare(std::max(c_min - 2, 0), std::min(c_max + 3, nseg));
+    for (int r = 0; r < nrows && settled; ++r) {
+      const int k = rows ? rows[r] : pair.row_begin + r, c = memory->centre[static_cast<size_t>(k)];
+      if (c < 0) {
+        settled = false;
+        break;
+      }
+      const Eigen::Vector2d x = slave_position(k);
+      Best best;
+      try_segment(x.x(), x.y(), c, best);
+      if (c > 0) try_segment(x.x(), x.y(), c - 1, best);
+      if (c + 1 < nseg) try_segment(x.x(), x.y(), c + 1, best);
+      const double a = (u_surface.segment<2>(2 * k) - memory->slave_reference.col(k)).norm();
+      settled = memory->clearance[static_cast<size_t>(k)] - a - b > best.root * (1.0 + 1e-12);
+
+      if (settled) pair_row(k, best);
+    }
+    if (settled) {
+      memory->certified += nrows;
+    } else {  // start again, in full
+      lowest = nseg, highest = -1;
+      for (int r = 0; r < nrows; ++r) p.segment[rows ? rows[r] : pair.row_begin + r] = -1;
+    }
   }
 
-  // Exact closest segment per slave node. Squared distances only; the segment of
-  // the previous slave node is tried first (neighbouring slave nodes have
-  // neighbouring pairs), then every block whose circle may hold a closer point,
-  // then within it every segment whose circle (centre mid, radius half) may.
-  // Ties (a slave node exactly at a master node) go to the lower segment index.
-  int guess = 0, lowest = nseg, highest = -1;
-  for (int r = 0; r < nrows; ++r) {
-    const int k = rows ? rows[r] : pair.row_begin + r;
-    const double px = m_slave_x(0, k) + u_surface(2 * k), py = m_slave_x(1, k) + u_surface(2 * k + 1);
-    double best = std::numeric_limits<double>::max(), best_root = std::numeric_limits<double>::max();
-    int best_seg = -1;
-    double best_xi = 0.0, best_raw = 0.0;
-    auto try_segment = [&](int j) {
-      const double dx = px - xm(0, j), dy = py - xm(1, j), tx = seg_t(0, j), ty = seg_t(1, j);
-      const double raw = (dx * tx + dy * ty) * inv_len2(j);
-      const double xi = raw < 0.0 ? 0.0 : (raw > 1.0 ? 1.0 : raw);
-      const double ex = dx - xi * tx, ey = dy - xi * ty;
-      const double dist2 = ex * ex + ey * ey;
-      if (dist2 < best * (1.0 - 1e-14) || (best_seg >= 0 && dist2 <= best * (1.0 + 1e-14) && j < best_seg))
-        best = dist2, best_root = std::sqrt(dist2), best_seg = j, best_xi = xi, best_raw = raw;
-    };
-    if (hint && hint->segment.size() == p.segment.size() && hint->segment[k] >= 0) guess = hint->segment[k];
-    if (nseg > 0) {
-      // The guess and its neighbours first: a good first distance prunes the rest.
-      try_segment(guess);
-      if (guess > 0) try_segment(guess - 1);
-      if (guess + 1 < nseg) try_segment(guess + 1);
-    }
+  if (!settled) {
+    prepare(0, nseg);
+    // Bounding circles of blocks of m_block consecutive segments (centre, radius):
+    // a block is skipped when its circle is farther than the best distance found
+    // (plus the margin when recording, so that skipped segments are known to be
+    // at least that much farther).
+    const int nblock = (nseg + m_block - 1) / m_block;
+    Eigen::Matrix2Xd& block_c = scratch.block_c;
+    Eigen::VectorXd& block_r = scratch.block_r;
+    block_c.resize(2, nblock);
+    block_r.resize(nblock);
     for (int b = 0; b < nblock; ++b) {
-      const double bx = px - block_c(0, b), by = py - block_c(1, b), reach = best_root + block_r(b);
-      if (bx * bx + by * by > reach * reach * (1.0 + 1e-12)) continue;
-      const int j1 = std::min(nseg, (b + 1) * m_block);
-      for (int j = b * m_block; j < j1; ++j) {
-        if (j >= guess - 1 && j <= guess + 1) continue;
-        const double mx = px - mid(0, j), my = py - mid(1, j), sreach = best_root + half(j);
-        if (mx * mx + my * my > sreach * sreach * (1.0 + 1e-12)) continue;
-        try_segment(j);
-      }
+      const int j0 = b * m_block, j1 = std::min(nseg, j0 + m_block);  // vertices j0..j1
+      block_c.col(b) = xm.middleCols(j0, j1 - j0 + 1).rowwise().mean();
+      double r2 = 0.0;
+      for (int j = j0; j <= j1; ++j) r2 = std::max(r2, (xm.col(j) - block_c.col(b)).squaredNorm());
+      block_r(b) = std::sqrt(r2);
     }
-    if (best_seg >= 0) guess = best_seg;
-    // A projection beyond either end of the master chain is no contact pair.
-    if (best_seg < 0 || (best_seg == 0 && best_raw < 0.0) || (best_seg == nm - 2 && best_raw > 1.0)) continue;
-    p.segment[k] = best_seg;
-    p.xi[k] = best_xi;
-    lowest = std::min(lowest, best_seg);
-    highest = std::max(highest, best_seg);
+    const double margin = memory ? pair.margin : 0.0;
+    if (memory)  // rows of the pair left out of this search lose their record
+      std::fill(memory->centre.begin() + pair.row_begin, memory->centre.begin() + pair.row_end, -1);
+    // The four nearest segments tried, by squared distance (for the clearance: at
+    // least one of them is not the closest segment or one of its two neighbours).
+    constexpr int kept = 4;
+    int tried_seg[kept];
+    double tried_d2[kept];
+
+    // Exact closest segment per slave node. Squared distances only; the segment of
+    // the previous slave node is tried first (neighbouring slave nodes have
+    // neighbouring pairs), then every block whose circle may hold a closer point,
+    // then within it every segment whose circle (centre mid, radius half) may.
+    int guess = 0;
+    for (int r = 0; r < nrows; ++r) {
+      const int k = rows ? rows[r] : pair.row_begin + r;
+      const Eigen::Vector2d x = slave_position(k);
+      const double px = x.x(), py = x.y();
+      Best best;
+      int ntried = 0;
+      auto visit = [&](int j) {
+        double d2 = try_segment(px, py, j, best);
+        if (!memory) return;
+        for (int t = 0; t < std::min(ntried, kept); ++t)  // insertion into the sorted four
+          if (d2 < tried_d2[t]) std::swap(d2, tried_d2[t]), std::swap(j, tried_seg[t]);
+        if (ntried < kept) tried_seg[ntried] = j, tried_d2[ntried] = d2;
+        ++ntried;
+      };
+      if (hint && hint->segment.size() == p.segment.size() && hint->segment[k] >= 0) guess = hint->segment[k];
+      if (nseg > 0) {
+        // The guess and its neighbours first: a good first distance prunes the rest.
+        visit(guess);
+        if (guess > 0) visit(guess - 1);
+        if (guess + 1 < nseg) visit(guess + 1);
+      }
+      for (int b = 0; b < nblock; ++b) {
+        const double bx = px - block_c(0, b), by = py - block_c(1, b), reach = best.root + margin + block_r(b);
+        if (bx * bx + by * by > reach * reach * (1.0 + 1e-12)) continue;
+        const int j1 = std::min(nseg, (b + 1) * m_block);
+        for (int j = b * m_block; j < j1; ++j) {
+          if (j >= guess - 1 && j <= guess + 1) continue;
+          const double mx = px - mid(0, j), my = py - mid(1, j), sreach = best.root + margin + half(j);
+          if (mx * mx + my * my > sreach * sreach * (1.0 + 1e-12)) continue;
+          visit(j);
+        }
+      }
+      if (best.seg >= 0) guess = best.seg;
+      pair_row(k, best);
+      if (!memory) continue;
+      // Clearance: skipped segments are farther than best + margin (the pruning
+      // above used a best that was at least the final one); tried ones are known.
+      double clearance = best.root + margin;
+      for (int t = 0; t < std::min(ntried, kept); ++t)
+        if (std::abs(tried_seg[t] - best.seg) > 1) {
+          clearance = std::min(clearance, std::sqrt(tried_d2[t]));
+          break;
+        }
+      memory->centre[static_cast<size_t>(k)] = best.seg;
+      memory->clearance[static_cast<size_t>(k)] = clearance;
+      memory->slave_reference.col(k) = u_surface.segment<2>(2 * k);
+    }
+    if (memory) {
+      Eigen::Matrix2Xd& ref = memory->master_reference[static_cast<size_t>(pair_index)];
+      ref.resize(2, nm);
+      for (int j = 0; j < nm; ++j) ref.col(j) = u_surface.segment<2>(2 * pair.master_surface[static_cast<size_t>(j)]);
+      memory->recorded[static_cast<size_t>(pair_index)] = 1;
+      memory->searched += nrows;
+    }
   }
   if (highest < 0) return;
 

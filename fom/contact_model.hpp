@@ -36,6 +36,22 @@ struct Pairing {
   bool same_as(const Pairing& other, double tol) const;
 };
 
+/// \brief What a search leaves for the next one at a nearby displacement (one per
+/// caller, e.g. per online query): per row, the closest segment found and a lower
+/// bound of the distance to every segment that is not that one or a neighbour of
+/// it, with the displacement they were found at. While the nodes have moved less
+/// than that clearance allows, the closest segment is still among the three, and
+/// the search tries only those: its result is the full search's (see
+/// NodeToSegmentContact::search_rows). Empty: nothing recorded.
+struct SearchMemory {
+  std::vector<int> centre;           ///< per row: closest segment at the reference (−1: none)
+  std::vector<double> clearance;     ///< per row: lower bound of the distance to the other segments
+  Eigen::Matrix2Xd slave_reference;  ///< per row: displacement of its node at the reference
+  std::vector<Eigen::Matrix2Xd> master_reference;  ///< per pair: displacements of its master nodes
+  std::vector<char> recorded;        ///< per pair: whether the above hold for its rows
+  int certified = 0, searched = 0;   ///< rows settled by the memory / by a full search, so far
+};
+
 /// \brief Abstract contact model; see the file comment.
 class ContactModel {
  public:
@@ -69,6 +85,15 @@ class ContactModel {
   /// not allocate). `hint` must not be `&out`.
   virtual void search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows, const Pairing* hint,
                            Pairing& out) const = 0;
+  /// \brief Same result, using and updating `memory` of the previous searches by the
+  /// same caller with the same `rows`, so that rows whose nodes moved little since
+  /// are settled without the search of the whole master chain. The default
+  /// ignores the memory.
+  virtual void search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows, const Pairing* hint,
+                           SearchMemory& memory, Pairing& out) const {
+    (void)memory;
+    search_rows(u_surface, rows, hint, out);
+  }
 
   /// \brief Constraint operator for a pairing: C (n_c x surface dofs) and g (n_c).
   virtual void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const = 0;
@@ -111,6 +136,15 @@ class NodeToSegmentContact final : public ContactModel {
   using ContactModel::search_rows;
   void search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows, const Pairing* hint,
                    Pairing& out) const override;
+  /// With a memory: a full search records, per row, its closest segment j and a
+  /// clearance c (a lower bound of the distance to the segments outside j ± 1; the
+  /// search prunes with a margin of half the mean master segment length so that c
+  /// is useful). The next search first tries j ± 1 only; the slave node has moved
+  /// by a and no master node by more than b since, so every other segment is at
+  /// least c − a − b away: if that exceeds the distance found, the row is settled.
+  /// Otherwise the pair is searched in full (and recorded anew).
+  void search_rows(const Eigen::VectorXd& u_surface, const std::vector<int>* rows, const Pairing* hint,
+                   SearchMemory& memory, Pairing& out) const override;
   void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const override;
   void assemble_rows(const Pairing& pairing, const std::vector<int>& rows, ConstraintMatrix& c,
                      Eigen::VectorXd& g) const override;
@@ -127,10 +161,14 @@ class NodeToSegmentContact final : public ContactModel {
     std::vector<int> master;            // master node ids, chain order
     std::vector<int> master_surface;    // surface node index of each master node
     Eigen::Matrix2Xd master_x;          // reference coordinates
+    double margin = 0.0;                // pruning margin of a recorded search: half the mean segment length
   };
   /// Search of one pair's rows (all of them when rows is nullptr).
   void search_pair(const Pair& pair, const Eigen::VectorXd& u_surface, const int* rows, int nrows,
-                   const Pairing* hint, Pairing& p) const;
+                   const Pairing* hint, Pairing& p, SearchMemory* memory, int pair_index) const;
+  /// Both search_rows: every pair's run of the listed rows.
+  void search_all(const Eigen::VectorXd& u_surface, const std::vector<int>* rows, const Pairing* hint,
+                  SearchMemory* memory, Pairing& p) const;
   /// The six (column, value) entries of row k and g_k; returns false for an unpaired row.
   bool row_entries(const Pairing& p, int k, int (&cols)[6], double (&vals)[6], double& g) const;
 

@@ -28,6 +28,29 @@ void check_compatible(const SnapshotDatabase& a, const std::string& name_a, cons
            std::to_string(b.num_dofs()) + "x" + std::to_string(b.num_constraints()));
 }
 
+/// Index of `mu` in `params` (exact match: both come from the same training set), or −1.
+int index_of(const std::vector<fom::Param>& params, const fom::Param& mu) {
+  for (size_t i = 0; i < params.size(); ++i)
+    if (params[i] == mu) return static_cast<int>(i);
+  return -1;
+}
+
+/// The snapshots of `db` in the order `order` (a permutation of its columns).
+SnapshotDatabase reordered(const SnapshotDatabase& db, const std::vector<int>& order) {
+  SnapshotDatabase out = db;
+  for (size_t j = 0; j < order.size(); ++j) {
+    const int k = order[j];
+    out.parameters.col(j) = db.parameters.col(k);
+    out.primal.col(j) = db.primal.col(k);
+    out.dual.col(j) = db.dual.col(k);
+    out.status[j] = db.status[k];
+    out.iterations[j] = db.iterations[k];
+    out.pairing_iterations[j] = db.pairing_iterations[k];
+    out.time_s[j] = db.time_s[k];
+  }
+  return out;
+}
+
 }  // namespace
 
 std::pair<int, int> part_range(int n, int k, int parts) {
@@ -77,6 +100,47 @@ SnapshotDatabase merge_databases(const std::vector<SnapshotDatabase>& databases,
     out.threads = std::max(out.threads, db.threads);
   }
   return out;
+}
+
+void check_appendable(const SnapshotDatabase& db, const std::string& path, const fom::Problem& problem,
+                      const std::string& training_kind, int training_size) {
+  check_database_problem(db, problem, path);
+  if (db.training_kind != training_kind || db.training_size != training_size)
+    throw InputError("cannot append to '" + path + "': its training set " + db.training_kind + " " +
+                     std::to_string(db.training_size) + " differs from " + training_kind + " " +
+                     std::to_string(training_size) + "; expected the same --train or --level");
+  const std::vector<fom::Param> training = fom::training_set(problem, training_size);
+  for (int j = 0; j < db.num_snapshots(); ++j)
+    if (index_of(training, db.parameter(j)) < 0)
+      throw InputError("cannot append to '" + path + "': its snapshot " + std::to_string(j) +
+                       " is not at a parameter of its training set; expected a database written by contactrom offline");
+}
+
+std::vector<fom::Param> parameters_not_in(const SnapshotDatabase& db, const std::vector<fom::Param>& params) {
+  std::vector<fom::Param> missing;
+  for (const fom::Param& mu : params) {
+    bool stored = false;
+    for (int j = 0; j < db.num_snapshots() && !stored; ++j) stored = db.parameters.col(j) == mu;
+    if (!stored) missing.push_back(mu);
+  }
+  return missing;
+}
+
+SnapshotDatabase append_snapshots(const SnapshotDatabase& db, const std::string& name, const SnapshotDatabase& added,
+                                  const std::vector<fom::Param>& training) {
+  const SnapshotDatabase merged = merge_databases({db, added}, {name, "the new snapshots"});
+  // Columns sorted by their position in the training set.
+  std::vector<std::pair<int, int>> position(merged.num_snapshots());
+  for (int j = 0; j < merged.num_snapshots(); ++j) {
+    position[j] = {index_of(training, merged.parameter(j)), j};
+    if (position[j].first < 0)
+      throw InputError("cannot append to '" + name + "': snapshot " + std::to_string(j) +
+                       " is not at a parameter of the training set");
+  }
+  std::sort(position.begin(), position.end());
+  std::vector<int> order;
+  for (const auto& p : position) order.push_back(p.second);
+  return reordered(merged, order);
 }
 
 }  // namespace contactrom::rom

@@ -2,12 +2,13 @@
 /// \file database_merge.hpp
 /// \brief Merging snapshot databases of the same problem, so that an offline run
 /// can be split over several jobs (`contactrom offline --part k/K`) and put back
-/// together (`contactrom merge`).
+/// together (`contactrom merge`), or completed in place (`contactrom offline --append`).
 ///
 /// \code
 ///   contactrom offline --problem hertz --train 120 --part 1/2 --out a.h5
 ///   contactrom offline --problem hertz --train 120 --part 2/2 --out b.h5
 ///   contactrom merge a.h5 b.h5 --out hertz120.h5     # the arrays of the whole run
+///   contactrom offline --problem hertz --train 120 --append a.h5   # the same, in a.h5
 /// \endcode
 #include <string>
 #include <vector>
@@ -28,5 +29,25 @@ std::pair<int, int> part_range(int n, int k, int parts);
 ///   fingerprint, parameter names, training options (kind and size), numbers of dofs
 ///   or constraints, or if a parameter appears twice.
 SnapshotDatabase merge_databases(const std::vector<SnapshotDatabase>& databases, const std::vector<std::string>& names);
+
+/// \brief Checks, before any snapshot is computed, that snapshots of `problem` for
+/// the training set (`training_kind`, `training_size`) can be appended to `db`
+/// (read from `path`): same problem, mesh fingerprint and sizes (check_database's
+/// checks), same training set, and every stored parameter in that training set.
+/// \throws InputError naming `path`, the value and what was expected.
+void check_appendable(const SnapshotDatabase& db, const std::string& path, const fom::Problem& problem,
+                      const std::string& training_kind, int training_size);
+
+/// \brief The parameters of `params` for which `db` holds no snapshot, in their order.
+std::vector<fom::Param> parameters_not_in(const SnapshotDatabase& db, const std::vector<fom::Param>& params);
+
+/// \brief `db` with the snapshots of `added`, all sorted into the order of
+/// `training` (the whole training set), so that appending the parts of a run in
+/// any order gives the arrays of the whole run. The timing fields combine as in
+/// merge_databases.
+/// \param name the file `db` was read from, for error messages
+/// \throws InputError as merge_databases, or if a snapshot's parameter is not in `training`.
+SnapshotDatabase append_snapshots(const SnapshotDatabase& db, const std::string& name, const SnapshotDatabase& added,
+                                  const std::vector<fom::Param>& training);
 
 }  // namespace contactrom::rom

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <initializer_list>
 #include <ostream>
+#include <string>
 #include <utility>
 
 #include "fom/anderson.hpp"
@@ -21,6 +23,18 @@ int greedy_int_option(const std::string& key, const std::string& value, int mini
     throw InputError("greedy option " + key + " = '" + value + "' invalid; expected an integer >= " +
                      std::to_string(minimum));
   return static_cast<int>(v);
+}
+
+/// Greedy setting `key` = `value`, one of the named `choices`.
+template <class T>
+T greedy_choice(const std::string& key, const std::string& value,
+                std::initializer_list<std::pair<const char*, T>> choices) {
+  std::string names;
+  for (const auto& [name, v] : choices) {
+    if (value == name) return v;
+    names += (names.empty() ? "" : " or ") + std::string(name);
+  }
+  throw InputError("greedy option " + key + " = '" + value + "' unknown; expected " + names);
 }
 
 /// Alg. 1's elimination: position of the most negative multiplier, −1 if none is.
@@ -40,6 +54,38 @@ int most_violated(const Eigen::VectorXd& violation, const std::vector<char>& in_
   for (int p = 0; p < violation.size(); ++p)
     if (!in_active[static_cast<size_t>(p)] && violation(p) > best) best = violation(p), at = p;
   return at;
+}
+
+/// Selections met one after the other (each stored sorted), to detect a cycle of
+/// one-change steps. Its storage only grows, so clearing it does not free.
+class SelectionHistory {
+ public:
+  void clear() { m_seen.clear(), m_start.assign(1, 0); }
+  bool empty() const { return m_start.size() == 1; }
+  /// Whether `selection` (any order) was met since the last clear(); records it if not.
+  template <class Columns, class Index>
+  bool revisits(const Columns& selection, Index index) {
+    m_key.clear();
+    for (const auto& c : selection) m_key.push_back(index(c));
+    std::sort(m_key.begin(), m_key.end());
+    for (size_t e = 0; e + 1 < m_start.size(); ++e)
+      if (std::equal(m_key.begin(), m_key.end(), m_seen.begin() + m_start[e], m_seen.begin() + m_start[e + 1]))
+        return true;
+    m_seen.insert(m_seen.end(), m_key.begin(), m_key.end());
+    m_start.push_back(static_cast<int>(m_seen.size()));
+    return false;
+  }
+
+ private:
+  std::vector<int> m_seen, m_start{0}, m_key;
+};
+
+/// Records a one-change step from selection `before` to `after`; true when `after`
+/// was met before (a cycle).
+bool revisits(SelectionHistory& seen, const std::vector<int>& before, const std::vector<int>& after) {
+  const auto same = [](int p) { return p; };
+  if (seen.empty()) (void)seen.revisits(before, same);
+  return seen.revisits(after, same);
 }
 
 }  // namespace
@@ -93,18 +139,19 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
   g.time_operators = options.time_operators;
   for (const auto& [key, value] : options.extra) {
     if (key == "schedule") {
-      if (value == "interleaved")
-        g.schedule = GreedySchedule::Interleaved;
-      else if (value == "nested")
-        g.schedule = GreedySchedule::Nested;
-      else
-        throw InputError("greedy schedule '" + value + "' unknown; expected interleaved or nested");
+      g.schedule = greedy_choice<GreedySchedule>(
+          key, value, {{"interleaved", GreedySchedule::Interleaved}, {"nested", GreedySchedule::Nested}});
     } else if (key == "anderson_depth") {
       g.anderson_depth = greedy_int_option(key, value, 0);
     } else if (key == "max_solves") {
       g.max_solves = greedy_int_option(key, value, 1);
     } else if (key == "init") {
       g.init = parse_warm_start("greedy", value);
+    } else if (key == "rebuild") {
+      g.rebuild = greedy_choice<OperatorRebuild>(
+          key, value, {{"partial", OperatorRebuild::Partial}, {"full", OperatorRebuild::Full}});
+    } else if (key == "on_cycle") {
+      g.nested_on_cycle = greedy_choice<bool>(key, value, {{"nested", true}, {"continue", false}});
     }
   }
   return g;
@@ -195,7 +242,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   warm_start_point(m_model, m_options.init, mu, q.u_free, q.start_columns, q.u_start);
 
   if (m_options.schedule == GreedySchedule::Nested)
-    solve_nested(q, res);
+    solve_nested(q, res, m_options.max_iterations);
   else
     solve_interleaved(q, res);
 
@@ -246,19 +293,24 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
   const int r = m_model.primal_rank(), m = m_model.dictionary_size();
   const Eigen::VectorXd &u_free = q.u_free, &lift_s = q.lift_s;
 
-  Eigen::VectorXd u_hat = q.u_start, u_prev, lambda_i, v, violation, rhs;
+  Eigen::VectorXd u_hat = q.u_start, lambda_i, v, violation, rhs;
   // Ĉ_I, K̂⁻¹Ĉ_Iᵀ and S in storage that only grows: the leading |I| rows/columns are used.
   RowMajorMatrix c_hat_i;
   Eigen::MatrixXd w, schur;
-  SupportOperators ops;  // pairing, C_R and g_R at the previous iterate
+  SupportOperators ops(m_options.rebuild == OperatorRebuild::Partial);  // pairing, C_R and g_R at the previous iterate
   std::vector<int> active = q.start_columns, solved;
   std::vector<char> in_active(m, 0);
   for (int p : active) in_active[p] = 1;
   // Surface displacement of the current iterate, u_s = Φ_s û + u_off,s: the only
   // place the primal enters the contact operators.
   Eigen::VectorXd u_s = phi_s * u_hat + lift_s;
+  // Where the operators are built (x = û^{k−1} in Alg. 1), and the Anderson mixer
+  // of that point while the selection stays the same.
+  Eigen::VectorXd x = u_hat;
+  fom::AndersonMixer mixer(m_options.anderson_depth);
 
   bool pending = false;  // converged in the sense of Alg. 1, to be confirmed
+  SelectionHistory seen;  // selections of the query so far
   for (int k = 0; k <= m_options.max_iterations; ++k) {
     // 1. Contact operators at the previous iterate, from the surface rows only.
     q.operators.start();
@@ -289,7 +341,6 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
     q.operators.stop();
 
     // 2. Saddle-point system by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ.
-    u_prev = u_hat;
     if (na == 0) {
       u_hat = u_free;
       lambda_i.resize(0);
@@ -339,7 +390,7 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
     }
 
     // 4. Converged when the active set is stable and û no longer moves.
-    const double step = (u_hat - u_prev).norm(), size = u_hat.norm();
+    const double step = (u_hat - x).norm(), size = u_hat.norm();
     if (m_options.trace) {
       *m_options.trace << "greedy k=" << k + 1 << " |I|=" << na << " min(lambda)=" << (na ? lambda_i.minCoeff() : 0.0)
                        << " max(violation)=" << max_violation << " step=" << step / std::max(size, 1e-300) << " -> ";
@@ -352,12 +403,43 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
       *m_options.trace << "\n";
     }
     if (!changed && step <= m_options.step_tolerance * size) pending = true;
+    next_rebuild_point(changed || pending, u_hat, x, mixer, u_s, q);
+    if (changed && m_options.nested_on_cycle && k + 1 < m_options.max_iterations && revisits(seen, solved, active)) {
+      // A selection came back: one change per rebuild is cycling (each rebuild
+      // moves the operators under the steps, paper §4.1). The nested schedule
+      // settles the steps on frozen operators first; it goes on from here.
+      if (m_options.trace) *m_options.trace << "greedy: selection revisited, nested schedule from here\n";
+      q.u_start = u_hat;
+      q.start_columns = active;
+      const int done = res.iterations;
+      solve_nested(q, res, m_options.max_iterations - k - 1);
+      res.iterations += done;
+      return;
+    }
   }
 
   q.finish(!res.converged && res.status == Status::Success, u_hat, lambda_i, solved);
 }
 
-void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
+void GreedyActiveSet::next_rebuild_point(bool plain, const Eigen::VectorXd& u_hat, Eigen::VectorXd& x,
+                                         fom::AndersonMixer& mixer, Eigen::VectorXd& u_s, Query& q) const {
+  // The selection is unchanged and û still moves: the operators' fixed point in x
+  // is smooth there, and plain substitution may oscillate (the pairing's own
+  // fixed point, like the FOM's); Anderson acceleration extrapolates it. A
+  // changed selection restarts the history; a settled û is confirmed at itself.
+  if (plain) {
+    mixer = fom::AndersonMixer(m_options.anderson_depth);
+    x = u_hat;
+    return;
+  }
+  x = mixer.next(x, u_hat);
+  q.operators.start();
+  u_s.noalias() = m_model.surface_basis() * x;
+  u_s += q.lift_s;
+  q.operators.stop();
+}
+
+void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds) const {
   const fom::ContactModel& contact = m_model.problem().contact();
   const Eigen::MatrixXd& phi_s = m_model.surface_basis();
   const RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
@@ -380,11 +462,11 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
   Eigen::VectorXd v_free;  // every column's violation at u_free, D_Rᵀ (A u_free + b)
   Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x = q.u_start, u_hat = q.u_start;
   Eigen::MatrixXd schur;
-  SupportOperators ops;  // pairing, C_R and g_R at the rebuild point x
+  SupportOperators ops(m_options.rebuild == OperatorRebuild::Partial);  // pairing, C_R and g_R at the rebuild point x
   Eigen::VectorXd u_s;
   std::vector<char> in_active(m, 0);
-  std::vector<int> solved, key;
-  std::vector<int> seen, seen_start;  // selections met on the current operators, one after the other
+  std::vector<int> solved;
+  SelectionHistory seen;  // selections met on the current operators
   fom::AndersonMixer mixer(m_options.anderson_depth);
   for (int p : q.start_columns) {  // filled by make_column once the operators exist
     in_active[p] = 1;
@@ -422,7 +504,7 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
       }
       pending = false;
     }
-    if (rebuild == m_options.max_iterations || solves >= m_options.max_solves) break;
+    if (rebuild >= max_rebuilds || solves >= m_options.max_solves) break;
     q.operators.start();
     m_support.gap_operator(ops.c, ops.g, phi_s_rows, lift_s, a, b);  // A = C_R Φ_s, b = C_R u_off,s − g_R
     q.operators.stop();
@@ -435,7 +517,6 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
     //      selection comes back (cycle) or the solve cap is reached.
     bool changed = false;
     seen.clear();
-    seen_start.assign(1, 0);
     while (solves < m_options.max_solves) {
       const int na = static_cast<int>(cols.size());
       u_hat = u_free;
@@ -498,15 +579,8 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res) const {
         break;
       }
       changed = true;
-      key.clear();
-      for (const auto& col : cols) key.push_back(col.p);
-      std::sort(key.begin(), key.end());
-      bool cycle = false;  // this selection was met before on these operators
-      for (size_t e = 0; e + 1 < seen_start.size() && !cycle; ++e)
-        cycle = std::equal(key.begin(), key.end(), seen.begin() + seen_start[e], seen.begin() + seen_start[e + 1]);
-      if (cycle) break;  // rebuild the operators
-      seen.insert(seen.end(), key.begin(), key.end());
-      seen_start.push_back(static_cast<int>(seen.size()));
+      // This selection was met before on these operators: rebuild them.
+      if (seen.revisits(cols, [](const Column& col) { return col.p; })) break;
     }
     if (res.status != Status::Success) break;
 

@@ -30,6 +30,14 @@
 ///     constraint \f$ D_d^T (C(u) u - g(u)) \le \tau \f$ at its own pairing;
 ///     or after k_max = 50 iterations (converged = false; by default the best iterate
 ///     with λ̂ ≥ 0 is then returned, see GreedyOptions::best_iterate_on_failure).
+/// Beyond Alg. 1 (both on by default, off with anderson_depth = 0 and
+/// on_cycle = continue): while a step changes nothing, the point where the next
+/// operators are built is Anderson-accelerated (the pairing's fixed point may
+/// oscillate, like the FOM's); and when a step brings back a selection met before in
+/// the query, the query goes on with the nested schedule below.
+/// Each rebuild searches the contact pairs with a memory of the previous searches
+/// (GreedyOptions::rebuild, fom::SearchMemory): rows that cannot have changed master
+/// segment skip the search of the whole chain, with the same operators as a full search.
 /// Only Ĉ_I (|I| rows) is formed; the violation of all m columns is evaluated as
 /// \f$ D_d^T (C_s u_s - g) \f$, which equals \f$ \hat C\hat u - \hat g \f$. Every
 /// operation costs O(n_s r + n_c (r |I| + m) + r²|I|): nothing scales with the mesh
@@ -49,6 +57,7 @@
 /// k_max counts the rebuilds, GreedyOptions::max_solves the one-change steps.
 #include <iosfwd>
 
+#include "fom/anderson.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/support_rows.hpp"
@@ -71,6 +80,16 @@ enum class GreedySchedule {
   /// Anderson-accelerated while the selection stays the same. Same selection
   /// rules, threshold and convergence test; k_max counts the rebuilds.
   Nested
+};
+
+/// \brief How the contact operators are rebuilt at a new iterate (see docs/rom.md).
+enum class OperatorRebuild {
+  /// Rows whose nodes moved too little since an earlier search to change master
+  /// segment skip the search of the whole master chain (SupportOperators with a
+  /// fom::SearchMemory). Same operators, hence the same iterates, as Full.
+  Partial,
+  /// Every support row searched along the whole master chain at every rebuild.
+  Full
 };
 
 /// \brief Where an online active-set iteration starts (see docs/rom.md, "Warm start").
@@ -122,8 +141,16 @@ struct GreedyOptions {
   WarmStart init = WarmStart::Cell;
   /// Operator-rebuild schedule. Default Interleaved (paper Alg. 1).
   GreedySchedule schedule = GreedySchedule::Interleaved;
-  /// Nested schedule: Anderson depth of the rebuild point (0: plain). Default 5.
+  /// How each rebuild searches the contact pairs. Default Partial.
+  OperatorRebuild rebuild = OperatorRebuild::Partial;
+  /// Anderson depth of the rebuild point while the selection stays the same (0:
+  /// plain substitution, as in the paper's Alg. 1). Default 5.
   int anderson_depth = 5;
+  /// Interleaved schedule: when a one-change step brings back a selection already
+  /// met in the query, go on with the nested schedule (from the current û and
+  /// selection, with the rebuilds left). false: the paper's Alg. 1, which may cycle
+  /// to the cap. Default true.
+  bool nested_on_cycle = true;
   /// Nested schedule: cap on the one-change solves of a query, over all rebuilds.
   /// Default 1000.
   int max_solves = 1000;
@@ -160,9 +187,15 @@ class GreedyActiveSet final : public OnlineSolver {
 
   struct Query;  // the per-query quantities both schedules share
   void solve_interleaved(Query& q, OnlineResult& res) const;
-  void solve_nested(Query& q, OnlineResult& res) const;
+  /// \param max_rebuilds cap on the operator rebuilds (k_max, or what the
+  /// interleaved schedule left of it when it hands over on a cycle)
+  void solve_nested(Query& q, OnlineResult& res, int max_rebuilds) const;
   /// Every column's violation at the fresh pairing of the returned û is within τ.
   bool confirmed(const Eigen::VectorXd& violation) const;
+  /// Interleaved schedule: the point x where the next operators are built, and its
+  /// surface displacement u_s — û itself when `plain`, else Anderson-accelerated.
+  void next_rebuild_point(bool plain, const Eigen::VectorXd& u_hat, Eigen::VectorXd& x, fom::AndersonMixer& mixer,
+                          Eigen::VectorXd& u_s, Query& q) const;
 };
 
 /// \brief The threshold τ that GreedyActiveSet applies with `options` (defaulted to δ
@@ -179,7 +212,8 @@ Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
 /// step_tolerance, and the extra keys schedule = interleaved|nested, anderson_depth,
-/// max_solves, init = empty|cell|nearest|primal) into GreedyOptions. \throws InputError
+/// max_solves, init = empty|cell|nearest|primal, rebuild = partial|full,
+/// on_cycle = nested|continue) into GreedyOptions. \throws InputError
 /// for an unknown tau_scaling, schedule or init, or a malformed number.
 GreedyOptions greedy_options(const OnlineSolverOptions& options);
 

@@ -26,12 +26,12 @@ Registry& registry() {
   static Registry* r = [] {
     auto* reg = new Registry;  // never destroyed: registrars may outlive static destruction order
     reg->factories["greedy"] = [](const ReducedModel& model, const OnlineSolverOptions& options) {
-      check_extra_options(options, "greedy", {"schedule", "anderson_depth", "max_solves", "init"});
+      check_extra_options(options, "greedy", {"schedule", "anderson_depth", "max_solves", "init", "on_cycle", "rebuild"});
       return std::unique_ptr<OnlineSolver>(std::make_unique<GreedyActiveSet>(model, greedy_options(options)));
     };
     // The same solver with the nested operator-rebuild schedule (GreedySchedule::Nested).
     reg->factories["greedy-nested"] = [](const ReducedModel& model, const OnlineSolverOptions& options) {
-      check_extra_options(options, "greedy-nested", {"anderson_depth", "max_solves", "init"});
+      check_extra_options(options, "greedy-nested", {"anderson_depth", "max_solves", "init", "rebuild"});
       GreedyOptions g = greedy_options(options);
       g.schedule = GreedySchedule::Nested;
       return std::unique_ptr<OnlineSolver>(std::make_unique<GreedyActiveSet>(model, g));

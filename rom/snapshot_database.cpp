@@ -225,6 +225,15 @@ SnapshotDatabase read_database(const std::string& path) {
 }
 
 void check_database(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path) {
+  check_database_problem(db, problem, path);
+  const std::string selector = problem.definition().training.selector();
+  if (db.training_kind != selector)
+    throw InputError("database '" + path + "' selects its training set by '" + db.training_kind + "', but " +
+                     problem.name() + " uses '" + selector + "'");
+  check_training_set(db, problem, path);
+}
+
+void check_database_problem(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path) {
   if (db.problem != problem.name())
     throw InputError("database '" + path + "' was built for problem '" + db.problem + "', not '" + problem.name() + "'");
   if (db.mesh_fingerprint != problem.fingerprint())
@@ -238,11 +247,6 @@ void check_database(const SnapshotDatabase& db, const fom::Problem& problem, con
                      std::to_string(db.parameters.rows()) + " parameters, but " + problem.name() + " has " +
                      std::to_string(problem.num_dofs()) + ", " + std::to_string(problem.contact().num_constraints()) +
                      " and " + std::to_string(problem.num_params()));
-  const std::string selector = problem.definition().training.selector();
-  if (db.training_kind != selector)
-    throw InputError("database '" + path + "' selects its training set by '" + db.training_kind + "', but " +
-                     problem.name() + " uses '" + selector + "'");
-  check_training_set(db, problem, path);
 }
 
 void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path) {

@@ -93,6 +93,11 @@ SnapshotDatabase read_database(const std::string& path);
 ///   current hertz mesh is B".
 void check_database(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path);
 
+/// \brief The first part of check_database: same problem name, mesh fingerprint and
+/// numbers of dofs, constraints and parameters, whatever snapshots `db` holds.
+/// \throws InputError as check_database.
+void check_database_problem(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path);
+
 /// \brief Rebuilds the problem from the database alone (problem-file text and mesh;
 /// `rope` by name) and checks that it matches (check_database).
 /// \throws InputError naming `path` if the stored problem cannot be rebuilt.

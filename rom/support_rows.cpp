@@ -94,7 +94,10 @@ double SupportRows::reduced_row(int p, const fom::ConstraintMatrix& c_r, const E
 
 void SupportOperators::rebuild(const fom::ContactModel& contact, const SupportRows& support,
                                const Eigen::VectorXd& u_surface) {
-  contact.search_rows(u_surface, &support.rows, &pairing, m_next);  // an empty hint is ignored
+  if (m_partial)  // an empty hint is ignored
+    contact.search_rows(u_surface, &support.rows, &pairing, m_memory, m_next);
+  else
+    contact.search_rows(u_surface, &support.rows, &pairing, m_next);
   std::swap(pairing, m_next);
   contact.assemble_rows(pairing, support.rows, c, g);
 }

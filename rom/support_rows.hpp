@@ -48,14 +48,24 @@ struct SupportRows {
 /// place by the online loops: the pairing (the previous one seeds the next search)
 /// and C_R, g_R, in storage reused from one rebuild to the next.
 struct SupportOperators {
+  /// \param partial search with a memory of the previous rebuilds (fom::SearchMemory):
+  /// rows whose nodes moved too little to change segment are settled without the
+  /// search of the whole master chain. Same operators either way; false searches
+  /// every row in full at every rebuild.
+  explicit SupportOperators(bool partial = true) : m_partial(partial) {}
   fom::Pairing pairing;     ///< of the last rebuild (empty before the first)
   fom::ConstraintMatrix c;  ///< C_R
   Eigen::VectorXd g;        ///< g_R
   /// Searches the support rows at u_s, seeded by the current pairing, and assembles
   /// C_R and g_R there.
   void rebuild(const fom::ContactModel& contact, const SupportRows& support, const Eigen::VectorXd& u_surface);
+  /// Rows settled by the memory and rows searched in full, over the rebuilds so far.
+  int certified_rows() const { return m_memory.certified; }
+  int searched_rows() const { return m_memory.searched; }
 
  private:
+  bool m_partial;
+  fom::SearchMemory m_memory;
   fom::Pairing m_next;  // the search writes here, then it becomes `pairing`
 };
 

@@ -113,7 +113,7 @@ inline void add_method_options(CLI::App* sub, MethodArgs& a) {
   add_integer(sub, "--max-iterations", a.max_iterations, "iteration cap k_max (default 50)", 1, 100000);
   sub->add_option("--option", a.options,
                   "method setting KEY=VALUE, repeatable: init=empty|cell|nearest|primal, schedule, anderson_depth, "
-                  "max_solves (greedy; see docs/rom.md); cpg_tolerance, cpg_max_size, inner_solve, init=empty|primal|cell "
+                  "max_solves, rebuild=partial|full, on_cycle=nested|continue (greedy; see docs/rom.md); cpg_tolerance, cpg_max_size, inner_solve, init=empty|primal|cell "
                   "(cpg); inner_solve, init (full-dictionary); basis, rank_l, seed, ... (convex-hull; see docs/convex_hull.md)");
 }
 

@@ -56,6 +56,7 @@ void run_fom(const FomArgs& a) {
   j["iterations"] = sol.iterations;
   j["pairing_iterations"] = sol.pairing_iterations;
   j["active"] = sol.active;
+  j["dofs"] = problem->num_dofs();
   j["constraints"] = problem->contact().num_constraints();
   j["time_s"] = sol.time_s;
   j["setup_time_s"] = setup;

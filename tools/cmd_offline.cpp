@@ -1,13 +1,17 @@
-// contactrom offline --problem P (--train N | --level n) --out DB.h5 [--threads T] [--part k/K] [--progress] [--json]
+// contactrom offline --problem P (--train N | --level n) (--out DB.h5 | --append DB.h5) [--threads T] [--part k/K]
+//                    [--progress] [--json]
 // Computes the FOM snapshots at the training parameters in parallel (one shared
 // factorisation, no warm start, deterministic) and writes them to an HDF5
-// database (docs/database_format.md). A progress bar is drawn on stderr when it
+// database (docs/database_format.md). With --append, only the parameters the
+// database does not hold yet are computed, and the database is rewritten (atomically)
+// with all its snapshots in training order. A progress bar is drawn on stderr when it
 // is a terminal (or with --progress); snapshots that did not converge are
 // reported on stderr and stored with their status.
 //   mpirun -np N contactrom offline ...   (built with CONTACTROM_MPI) distributes the
 // parameters over the ranks; rank 0 gathers them and writes the same database.
 #include <unistd.h>
 
+#include <functional>
 #include <memory>
 #include <cstdio>
 #include <iomanip>
@@ -29,7 +33,7 @@ namespace contactrom::cli {
 namespace {
 
 struct OfflineArgs {
-  std::string problem, out;
+  std::string problem, out, append;
   int train = 0, level = 0, threads = 0, refine = 0;
   std::string part;  // "k/K": only the k-th of K contiguous parts of the training set
   bool progress = false, json = false;
@@ -61,11 +65,12 @@ struct Ranks {
   bool root() const { return rank == 0; }
 };
 
-/// Writes the database on rank 0; every rank then agrees on the outcome, so that
-/// all of them exit with an error if the write failed.
-void write_on_root(const std::string& path, const rom::SnapshotDatabase& db, const Ranks& ranks) {
+/// Writes the database `make()` returns on rank 0; every rank then agrees on the
+/// outcome, so that all of them exit with an error if making or writing it failed.
+void write_on_root(const std::string& path, const std::function<const rom::SnapshotDatabase&()>& make,
+                   const Ranks& ranks) {
   try {
-    if (ranks.root()) rom::write_database(path, db);
+    if (ranks.root()) rom::write_database(path, make());
   } catch (...) {
 #ifdef CONTACTROM_HAVE_MPI
     if (ranks.size > 1) rom::mpi::all_ranks_ok(false);
@@ -87,15 +92,37 @@ void run_offline(const OfflineArgs& a) {
 #else
   const Ranks ranks;
 #endif
-  check_output_path(a.out);  // before the snapshots are computed (every rank: all refuse alike)
+  if (a.out.empty() == a.append.empty()) throw InputError("offline needs one of --out DB.h5 and --append DB.h5");
+  const bool appending = !a.append.empty();
+  const std::string& out = appending ? a.append : a.out;
+  check_output_path(out);  // before the snapshots are computed (every rank: all refuse alike)
   fom::ProblemOptions popt;
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);
   const fom::SamplingPlan& plan = problem->definition().training;
-  const int n = fom::resolve_training_size(plan, problem->name(), a.train, a.level, false);
+  // The database appended to is read on every rank (all refuse alike) and checked
+  // against the run before any snapshot is computed.
+  rom::SnapshotDatabase existing;
+  if (appending) existing = rom::read_database(a.append);
+  // --append without --train/--level: the database's training set.
+  const bool size_from_db = appending && !a.train && !a.level && plan.selector() != "list";
+  const int n = size_from_db ? existing.training_size
+                             : fom::resolve_training_size(plan, problem->name(), a.train, a.level, false);
   if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
-  std::vector<fom::Param> params = fom::training_set(*problem, n);
-  if (!a.part.empty()) params = training_part(params, a.part);
+  const std::vector<fom::Param> training = fom::training_set(*problem, n);
+  std::vector<fom::Param> params = a.part.empty() ? training : training_part(training, a.part);
+  if (appending) {
+    rom::check_appendable(existing, a.append, *problem, plan.selector(), n);
+    params = rom::parameters_not_in(existing, params);
+    if (params.empty()) {  // every rank knows it: none computes, the file is left as it is
+      if (ranks.root()) std::cout << (a.json ? nlohmann::json{{"problem", problem->name()}, {"snapshots", 0},
+                                                              {"total_snapshots", existing.num_snapshots()},
+                                                              {"out", out}}.dump()
+                                             : a.append + " already holds these snapshots; nothing to compute")
+                                  << std::endl;
+      return;
+    }
+  }
 
   const std::string label =
       "offline " + problem->name() + (ranks.size > 1 ? " (rank 0 of " + std::to_string(ranks.size) + ")" : "");
@@ -112,8 +139,13 @@ void run_offline(const OfflineArgs& a) {
   const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, params, kind, n, options);
 #endif
   bar.finish();
+  rom::SnapshotDatabase appended;
+  const auto result = [&]() -> const rom::SnapshotDatabase& {
+    if (appending) appended = rom::append_snapshots(existing, a.append, db, training);
+    return appending ? appended : db;
+  };
   if (!ranks.root()) {
-    write_on_root(a.out, db, ranks);
+    write_on_root(out, result, ranks);
     return;
   }
 
@@ -124,7 +156,8 @@ void run_offline(const OfflineArgs& a) {
     std::cerr << "contactrom: warning: snapshot " << j << " (" << param_text(*problem, db.parameter(j))
               << ") status " << to_string(db.status[j]) << "; stored with its status and left out of the ROM\n";
   }
-  write_on_root(a.out, db, ranks);
+  const int stored = appending ? existing.num_snapshots() : 0;
+  write_on_root(out, result, ranks);
 
   double fom_sum = 0.0;
   for (double t : db.time_s) fom_sum += t;
@@ -133,13 +166,14 @@ void run_offline(const OfflineArgs& a) {
     j["problem"] = problem->name();
     j[db.training_kind] = n;
     j["snapshots"] = db.num_snapshots();
+    if (appending) j["total_snapshots"] = stored + db.num_snapshots();
     j["failed"] = failed;
     j["threads"] = db.threads;
     j["ranks"] = ranks.size;
     j["wall_time_s"] = db.wall_time_s;
     j["setup_time_s"] = db.setup_time_s;
     j["mean_fom_time_s"] = db.num_snapshots() ? fom_sum / db.num_snapshots() : 0.0;
-    j["out"] = a.out;
+    j["out"] = out;
     std::cout << j.dump() << std::endl;
     return;
   }
@@ -147,8 +181,12 @@ void run_offline(const OfflineArgs& a) {
             << n << "), " << failed << " failed, " << db.threads << " threads"
             << (ranks.size > 1 ? " on " + std::to_string(ranks.size) + " MPI ranks" : std::string()) << "\n"
             << std::setprecision(3) << "wall time " << db.wall_time_s << " s (factorisation " << db.setup_time_s
-            << " s, mean FOM query " << (db.num_snapshots() ? 1e3 * fom_sum / db.num_snapshots() : 0.0) << " ms)\n"
-            << "database written to " << a.out << "\n";
+            << " s, mean FOM query " << (db.num_snapshots() ? 1e3 * fom_sum / db.num_snapshots() : 0.0) << " ms)\n";
+  if (appending)
+    std::cout << "appended to " << out << " (" << stored << " snapshots before, " << stored + db.num_snapshots()
+              << " now)\n";
+  else
+    std::cout << "database written to " << out << "\n";
 }
 
 CommandRegistrar reg("offline", [](CLI::App& app) {
@@ -161,7 +199,12 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
                             "training level n, for problems with nested training (ironing: 2^n+1 points)", 0, 20);
   add_integer(sub, "--refine", args->refine, "extra uniform mesh refinements (each splits every quad in four)", 0, 6);
   train->excludes(level);
-  sub->add_option("--out", args->out, "output database (.h5)")->check(non_empty_path())->required();
+  auto* out = sub->add_option("--out", args->out, "output database (.h5)")->check(non_empty_path());
+  sub->add_option("--append", args->append,
+                  "existing database (.h5) of the same problem and training set: compute the parameters it does not "
+                  "hold yet and rewrite it with all its snapshots, in training order")
+      ->check(non_empty_path())
+      ->excludes(out);
   add_integer(sub, "--threads", args->threads, "worker threads (default: hardware concurrency)", 1, 1024);
   sub->add_option("--part", args->part,
                   "k/K: only the k-th of K contiguous parts of the training set (join the parts with merge)");

@@ -11,6 +11,7 @@ cd "$(dirname "$0")/.."
 packages=(build-essential cmake ninja-build pkg-config libeigen3-dev libsuitesparse-dev
           coinor-libipopt-dev gmsh libgmsh-dev libboost-test-dev libhdf5-dev libcli11-dev
           nlohmann-json3-dev libtomlplusplus-dev python3 python3-numpy python3-scipy python3-matplotlib python3-h5py
+          pybind11-dev python3-pybind11 python3-pytest  # the Python module (build/python) and its tests
           libopenmpi-dev openmpi-bin)  # MPI: CONTACTROM_MPI, mpirun ... offline (tests run mpirun as root)
 missing=()
 for p in "${packages[@]}"; do

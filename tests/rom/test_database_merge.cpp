@@ -5,10 +5,9 @@
 #include <boost/test/unit_test.hpp>
 
 #include <algorithm>
-#include <cstring>
 #include <filesystem>
 
-#include "common/run_command.hpp"
+#include "common/database_checks.hpp"
 #include "fom/problem.hpp"
 #include "rom/database_merge.hpp"
 #include "rom/offline.hpp"
@@ -18,49 +17,16 @@ using contactrom::InputError;
 using contactrom::rom::merge_databases;
 using contactrom::rom::part_range;
 using contactrom::rom::SnapshotDatabase;
+using contactrom::test::check_same_snapshots;
+using contactrom::test::hertz;
 using contactrom::test::run_command;
+using contactrom::test::work_dir;
 
 namespace {
 
 const std::string exe = CONTACTROM_EXE;
 
 int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
-
-bool bitwise_equal(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return a.rows() == b.rows() && a.cols() == b.cols() &&
-         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0;
-}
-
-void check_same_snapshots(const SnapshotDatabase& a, const SnapshotDatabase& b) {
-  BOOST_TEST(a.problem == b.problem);
-  BOOST_TEST(a.mesh_fingerprint == b.mesh_fingerprint);
-  BOOST_TEST(a.training_kind == b.training_kind);
-  BOOST_TEST(a.training_size == b.training_size);
-  BOOST_TEST(bitwise_equal(a.parameters, b.parameters));
-  BOOST_TEST(bitwise_equal(a.primal, b.primal));
-  BOOST_TEST(bitwise_equal(a.dual, b.dual));
-  BOOST_TEST(a.status == b.status);
-  BOOST_TEST(a.iterations == b.iterations);
-  BOOST_TEST(a.pairing_iterations == b.pairing_iterations);
-}
-
-const contactrom::fom::Problem& hertz() {
-  static auto p = contactrom::fom::make_problem("hertz");
-  return *p;
-}
-
-struct WorkDir {
-  std::string path = contactrom::test::temp_dir();
-  ~WorkDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
-
-const std::string& work_dir() {
-  static const WorkDir dir;
-  return dir.path;
-}
 
 }  // namespace
 
@@ -142,4 +108,52 @@ BOOST_AUTO_TEST_CASE(cli_offline_parts_merge_into_the_whole_run) {
   BOOST_TEST(r.exit_code == 2);
   BOOST_TEST(r.err.find("3/2") != std::string::npos, r.err);
   BOOST_TEST(!fs::exists(dir + "/bad.h5"));
+}
+
+BOOST_AUTO_TEST_CASE(cli_offline_append_completes_a_part_into_the_whole_run) {
+  const std::string dir = work_dir();
+  auto r = run_command(exe + " offline --problem hertz --train 9 --threads 1 --out " + dir + "/whole9.h5");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  const SnapshotDatabase whole = contactrom::rom::read_database(dir + "/whole9.h5");
+
+  // The second half appended to the first, and the first appended to the second:
+  // both are the whole run, in training order.
+  for (const auto& [first, second] : {std::pair<int, int>{1, 2}, std::pair<int, int>{2, 1}}) {
+    const std::string db = dir + "/append" + std::to_string(first) + ".h5";
+    r = run_command(exe + " offline --problem hertz --train 9 --threads 1 --part " + std::to_string(first) +
+                    "/2 --out " + db);
+    BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+    const int before = contactrom::rom::read_database(db).num_snapshots();
+    r = run_command(exe + " offline --problem hertz --train 9 --threads 1 --part " + std::to_string(second) +
+                    "/2 --append " + db + " --json");
+    BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+    BOOST_TEST(lines(r.out) == 1);
+    BOOST_TEST(r.out.find("\"snapshots\":" + std::to_string(9 - before)) != std::string::npos, r.out);
+    check_same_snapshots(whole, contactrom::rom::read_database(db));
+  }
+
+  // Without --part and --train, the parameters the database lacks (here none).
+  const std::string db = dir + "/append1.h5";
+  r = run_command(exe + " offline --problem hertz --threads 1 --append " + db + " --json");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  BOOST_TEST(r.out.find("\"snapshots\":0") != std::string::npos, r.out);
+  check_same_snapshots(whole, contactrom::rom::read_database(db));
+}
+
+BOOST_AUTO_TEST_CASE(cli_offline_append_to_another_database_is_refused_and_leaves_it_intact) {
+  const std::string dir = work_dir();
+  const std::string db = dir + "/part_of_7.h5";
+  auto r = run_command(exe + " offline --problem hertz --train 7 --threads 1 --part 1/2 --out " + db);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  const std::string before = contactrom::test::slurp(db);
+  for (const std::string& args : std::vector<std::string>{"--problem ironing --level 3", "--problem hertz --refine 1 --train 7",
+                                 "--problem hertz --train 8", "--problem hertz --train 7 --out " + dir + "/x.h5"}) {
+    r = run_command(exe + " offline " + args + " --threads 1 --append " + db);
+    BOOST_TEST_CONTEXT(args) {
+      BOOST_TEST(r.exit_code == 2);
+      BOOST_TEST(lines(r.err) == 1, r.err);
+      BOOST_TEST(contactrom::test::slurp(db) == before);
+    }
+  }
+  BOOST_TEST(!fs::exists(dir + "/x.h5"));
 }

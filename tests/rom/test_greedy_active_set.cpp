@@ -85,6 +85,8 @@ const std::vector<std::pair<const char*, rom::GreedyOptions>>& schedules() {
     rom::GreedyOptions nested, paper;
     nested.schedule = rom::GreedySchedule::Nested;
     paper.init = rom::WarmStart::Empty;
+    paper.anderson_depth = 0;
+    paper.nested_on_cycle = false;
     return std::vector<std::pair<const char*, rom::GreedyOptions>>{
         {"interleaved", {}}, {"nested", nested}, {"interleaved, init=empty", paper}};
   }();
@@ -348,6 +350,27 @@ BOOST_AUTO_TEST_CASE(schedule_options_are_checked) {
   BOOST_CHECK_THROW(rom::greedy_options(o), InputError);
   o.extra["max_solves"] = "12x";
   BOOST_CHECK_THROW(rom::greedy_options(o), InputError);
+  // rebuild and on_cycle: documented defaults, both values, and a refusal naming the value.
+  rom::OnlineSolverOptions p;
+  BOOST_TEST((rom::greedy_options(p).rebuild == rom::OperatorRebuild::Partial));
+  BOOST_TEST(rom::greedy_options(p).nested_on_cycle);
+  BOOST_TEST(rom::greedy_options(p).anderson_depth == 5);
+  p.extra["rebuild"] = "full";
+  p.extra["on_cycle"] = "continue";
+  BOOST_TEST((rom::greedy_options(p).rebuild == rom::OperatorRebuild::Full));
+  BOOST_TEST(!rom::greedy_options(p).nested_on_cycle);
+  for (const char* key : {"rebuild", "on_cycle"}) {
+    rom::OnlineSolverOptions bad;
+    bad.extra[key] = "sometimes";
+    try {
+      (void)rom::greedy_options(bad);
+      BOOST_ERROR(key << " = sometimes accepted");
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      BOOST_TEST(what.find("'sometimes'") != std::string::npos, what);
+      BOOST_TEST(what.find('\n') == std::string::npos, what);
+    }
+  }
 }
 
 BOOST_AUTO_TEST_CASE(zero_pressure_dictionary_gives_the_unconstrained_solution) {
@@ -434,6 +457,77 @@ BOOST_AUTO_TEST_CASE(warm_start_reaches_the_fixed_points_of_the_empty_start) {
         // starts that select columns (primal only still grows I one at a time).
         if (init != rom::WarmStart::Primal) BOOST_TEST(s.mean_iterations < 0.6 * base.mean_iterations);
       }
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(partial_rebuild_gives_the_full_rebuilds_results) {
+  // rebuild=partial settles the contact pairs of rows that cannot have changed
+  // segment instead of searching the whole master chain: on the validation queries
+  // of hertz 30 and ironing level 7 (δ = 1e-8), with both schedules and both starts,
+  // every query ends with the same selection, multipliers, iterations and status as
+  // with rebuild=full, and the same errors against the FOM to 1e-10.
+  Setup ironing("ironing");
+  for (auto [setup, n] : std::vector<std::pair<Setup*, int>>{{&hertz(), 30}, {&ironing, 7}}) {
+    const rom::ReducedModel model(*setup->problem, setup->db(n));
+    const auto& refs = setup->refs(n);
+    for (const auto& [schedule, partial_options] : schedules()) {
+      rom::GreedyOptions full_options = partial_options;
+      full_options.rebuild = rom::OperatorRebuild::Full;
+      BOOST_REQUIRE(partial_options.rebuild == rom::OperatorRebuild::Partial);  // the default
+      const rom::GreedyActiveSet partial(model, partial_options), full(model, full_options);
+      BOOST_TEST_CONTEXT(setup->problem->name() << ", " << schedule) {
+        for (size_t i = 0; i < setup->validation.size(); ++i) {
+          const fom::Param& mu = setup->validation[i];
+          const rom::OnlineResult a = full.solve(mu), b = partial.solve(mu);
+          BOOST_TEST(a.selected == b.selected, "mu = " << mu(0));
+          BOOST_TEST(a.iterations == b.iterations, "mu = " << mu(0));
+          BOOST_TEST(a.converged == b.converged, "mu = " << mu(0));
+          if (a.selected != b.selected) continue;
+          BOOST_TEST((a.coefficients - b.coefficients).norm() <= 1e-10 * std::max(1.0, a.coefficients.norm()));
+          const fom::Problem& problem = *setup->problem;
+          BOOST_TEST(std::abs(fom::relative_h1_error(problem, a.u, refs[i].u) -
+                              fom::relative_h1_error(problem, b.u, refs[i].u)) <= 1e-10);
+          BOOST_TEST(std::abs(fom::relative_l2_pressure_error(problem, a.lambda, refs[i].lambda) -
+                              fom::relative_l2_pressure_error(problem, b.lambda, refs[i].lambda)) <= 1e-10);
+        }
+      }
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(search_memory_settles_small_moves_and_searches_large_ones) {
+  // The contact operators of the support rows rebuilt with a memory equal those of a
+  // full search at every point of a walk of growing steps, and the memory does work:
+  // small moves are settled without the full search, large ones are searched.
+  Setup& h = hertz();
+  const rom::ReducedModel model(*h.problem, h.db(30));
+  const fom::ContactModel& contact = h.problem->contact();
+  const rom::SupportRows support(model.dictionary());
+  const fom::Param mu = fom::validation_set(*h.problem, 30)[40];
+  const Eigen::VectorXd lift = model.surface_lifting(mu);
+  const Eigen::VectorXd u0 = rom::GreedyActiveSet(model).solve(mu).u_hat;
+  Eigen::VectorXd direction = Eigen::VectorXd::Ones(u0.size());
+  direction *= u0.norm() / direction.norm();
+  rom::SupportOperators remembering(true);
+  for (double step : {0.0, 1e-8, 1e-6, 1e-4, 1e-3, 1e-2, 0.3, 0.0, 1e-5}) {
+    const Eigen::VectorXd u_s = model.surface_basis() * (u0 + step * direction) + lift;
+    rom::SupportOperators fresh(false);
+    fresh.rebuild(contact, support, u_s);
+    const int certified = remembering.certified_rows(), searched = remembering.searched_rows();
+    remembering.rebuild(contact, support, u_s);
+    BOOST_TEST_CONTEXT("step " << step << ": rows settled " << remembering.certified_rows() - certified
+                               << ", searched " << remembering.searched_rows() - searched) {
+      BOOST_TEST(remembering.pairing.segment == fresh.pairing.segment);
+      BOOST_TEST(remembering.pairing.xi == fresh.pairing.xi);
+      BOOST_TEST((remembering.pairing.normal - fresh.pairing.normal).norm() == 0.0);
+      BOOST_TEST((Eigen::MatrixXd(remembering.c) - Eigen::MatrixXd(fresh.c)).norm() == 0.0);
+      BOOST_TEST((remembering.g - fresh.g).norm() == 0.0);
+      // Each rebuild either settles every row or searches the pair again.
+      BOOST_TEST((remembering.certified_rows() - certified) + (remembering.searched_rows() - searched) ==
+                 static_cast<int>(support.rows.size()));
+      if (step > 0.0 && step <= 1e-6) BOOST_TEST(remembering.certified_rows() > certified);
+      if (step == 0.3) BOOST_TEST(remembering.searched_rows() > searched);
     }
   }
 }

@@ -5,17 +5,18 @@
 #include <boost/test/unit_test.hpp>
 
 #include <algorithm>
-#include <cstring>
 #include <filesystem>
 #include <string>
 
-#include "common/run_command.hpp"
+#include "common/database_checks.hpp"
 #include "rom/snapshot_database.hpp"
 
 namespace fs = std::filesystem;
 using contactrom::rom::read_database;
 using contactrom::rom::SnapshotDatabase;
+using contactrom::test::check_same_snapshots;
 using contactrom::test::run_command;
+using contactrom::test::work_dir;
 
 namespace {
 
@@ -25,25 +26,6 @@ const std::string exe = CONTACTROM_EXE;
 std::string mpirun(int ranks) {
   return std::string("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 ") + CONTACTROM_MPIEXEC +
          " --oversubscribe -np " + std::to_string(ranks) + " ";
-}
-
-/// A temporary folder for this test run, removed when the program ends.
-struct WorkDir {
-  std::string path = contactrom::test::temp_dir();
-  ~WorkDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
-
-const std::string& work_dir() {
-  static const WorkDir dir;
-  return dir.path;
-}
-
-bool bitwise_equal(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return a.rows() == b.rows() && a.cols() == b.cols() &&
-         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0;
 }
 
 /// Lines of `text` that carry a contactrom message (mpirun adds its own summary).
@@ -68,20 +50,21 @@ BOOST_AUTO_TEST_CASE(mpi_offline_is_bit_identical_to_serial) {
       BOOST_TEST(std::count(r.out.begin(), r.out.end(), '\n') == 1);  // one JSON object, from rank 0
       BOOST_TEST(r.out.find("\"ranks\":" + std::to_string(ranks)) != std::string::npos, r.out);
       const SnapshotDatabase b = read_database(path);
-      BOOST_TEST(b.problem == a.problem);
-      BOOST_TEST(b.mesh_fingerprint == a.mesh_fingerprint);
-      BOOST_TEST(b.training_kind == a.training_kind);
-      BOOST_TEST(b.training_size == a.training_size);
-      BOOST_TEST(b.param_names == a.param_names);
-      BOOST_TEST(bitwise_equal(b.parameters, a.parameters));
-      BOOST_TEST(bitwise_equal(b.primal, a.primal));
-      BOOST_TEST(bitwise_equal(b.dual, a.dual));
-      BOOST_TEST(b.status == a.status);
-      BOOST_TEST(b.iterations == a.iterations);
-      BOOST_TEST(b.pairing_iterations == a.pairing_iterations);
+      check_same_snapshots(a, b);
       BOOST_TEST(b.threads == ranks);
     }
   }
+}
+
+BOOST_AUTO_TEST_CASE(mpi_offline_append_completes_a_serial_part) {
+  const std::string serial = work_dir() + "/serial11.h5", db = work_dir() + "/append.h5";
+  auto r = run_command(exe + " offline --problem hertz --train 11 --threads 1 --out " + serial);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  r = run_command(exe + " offline --problem hertz --train 11 --threads 1 --part 1/3 --out " + db);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  r = run_command(mpirun(2) + exe + " offline --problem hertz --train 11 --threads 1 --append " + db);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  check_same_snapshots(read_database(serial), read_database(db));
 }
 
 BOOST_AUTO_TEST_CASE(mpi_offline_bad_argument_fails_on_every_rank_with_one_message) {

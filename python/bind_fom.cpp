@@ -1,0 +1,272 @@
+// Python bindings of the full-order side: Problem (parameters, operators K(μ),
+// C(u), g(u)), FullOrderSolver and its results, KKT residuals and verification.
+#include "baselines/kkt_verifier.hpp"
+#include "fom/errors.hpp"
+#include "python/bindings.hpp"
+#include "rom/offline.hpp"
+
+namespace contactrom::python {
+
+fom::FomSolution FullOrderSolver::solve(const fom::Param& mu) const {
+  return active_set ? active_set->solve(mu) : ipopt->solve(mu);
+}
+
+namespace {
+
+/// Pairing and constraint operator at u, with the columns in full dof numbering.
+struct ConstraintAt {
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> c;  // n_c × n_dofs
+  Eigen::VectorXd g;
+};
+
+ConstraintAt constraint_at(const fom::Problem& problem, const Eigen::VectorXd& u) {
+  if (u.size() != problem.num_dofs())
+    throw InputError("u has " + std::to_string(u.size()) + " entries; expected " +
+                     std::to_string(problem.num_dofs()) + " (the dofs of '" + problem.name() + "')");
+  const fom::ContactModel& contact = problem.contact();
+  const Eigen::VectorXd us = contact.restrict_to_surface(u);
+  fom::ConstraintMatrix cs;
+  ConstraintAt out;
+  contact.assemble(contact.search(us), cs, out.g);
+  const std::vector<int>& dofs = contact.surface_dofs();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<size_t>(cs.nonZeros()));
+  for (int r = 0; r < cs.outerSize(); ++r)
+    for (fom::ConstraintMatrix::InnerIterator it(cs, r); it; ++it) entries.emplace_back(r, dofs[it.col()], it.value());
+  out.c.resize(cs.rows(), problem.num_dofs());
+  out.c.setFromTriplets(entries.begin(), entries.end());
+  return out;
+}
+
+void check_sizes(const fom::Problem& problem, const Eigen::VectorXd& u, const Eigen::VectorXd& lambda) {
+  if (u.size() != problem.num_dofs())
+    throw InputError("u has " + std::to_string(u.size()) + " entries; expected " +
+                     std::to_string(problem.num_dofs()) + " (the dofs of '" + problem.name() + "')");
+  if (lambda.size() != problem.contact().num_constraints())
+    throw InputError("lam has " + std::to_string(lambda.size()) + " entries; expected " +
+                     std::to_string(problem.contact().num_constraints()) + " (the contact rows of '" +
+                     problem.name() + "')");
+}
+
+FomResult finish(const fom::Problem& problem, fom::FomSolution solution) {
+  // A failed solve may carry no field at all; its status and message say why.
+  if (solution.u.size() != problem.num_dofs() || solution.lambda.size() != problem.contact().num_constraints())
+    throw std::runtime_error("the FOM solver returned no solution for problem '" + problem.name() + "' (status " +
+                             to_string(solution.status) +
+                             (solution.message.empty() ? "" : ": " + solution.message) + ")");
+  FomResult r;
+  r.kkt = fom::kkt_residuals(problem, solution.mu, solution.u, solution.lambda);
+  r.contact_force = fom::contact_force(problem, solution.lambda);
+  r.solution = std::move(solution);
+  return r;
+}
+
+py::dict report_dict(const baselines::VerificationReport& r) {
+  py::dict d;
+  d["status"] = to_string(r.status);
+  d["message"] = r.message;
+  d["kkt"] = kkt_dict(r.kkt);
+  if (r.has_reference) {
+    py::dict e;
+    e["primal_h1"] = r.errors.primal_h1;
+    e["dual_l2"] = r.errors.dual_l2;
+    e["active_set_differences"] = r.errors.active_set_differences;
+    d["errors"] = e;
+  } else {
+    d["errors"] = py::none();
+  }
+  return d;
+}
+
+std::shared_ptr<fom::Problem> make(const std::string& name_or_path, int refine) {
+  fom::ProblemOptions options;
+  options.refine = refine;
+  return fom::make_problem(name_or_path, options);
+}
+
+}  // namespace
+
+void bind_fom(py::module_& m) {
+  py::class_<fom::Problem, std::shared_ptr<fom::Problem>> problem(m, "Problem", R"doc(
+A parametrised linear-elastic contact problem (a shipped name, a problem file or
+the built-in `rope`). K(mu), C(u) and g(u) are the operators of
+
+    min_u0 1/2 u0^T K(mu) u0 - u0^T f(mu)   s.t.   C(u) u - g(u) <= 0
+
+with u = u_lift(mu) + u0 on all dofs (Dirichlet dofs kept).)doc");
+  problem
+      .def_static("from_file", &make, py::arg("path"), py::arg("refine") = 0,
+                  "Reads a problem file (.toml), meshes it (refined `refine` times) and builds the problem.")
+      .def_property_readonly("name", &fom::Problem::name)
+      .def_property_readonly("param_names", &fom::Problem::param_names)
+      .def_property_readonly("num_params", &fom::Problem::num_params)
+      .def_property_readonly("param_lower", &fom::Problem::param_lower, py::return_value_policy::copy)
+      .def_property_readonly("param_upper", &fom::Problem::param_upper, py::return_value_policy::copy)
+      .def_property_readonly(
+          "param_ranges",
+          [](const fom::Problem& p) {
+            py::dict d;
+            for (int i = 0; i < p.num_params(); ++i)
+              d[py::str(p.param_names()[i])] = py::make_tuple(p.param_lower()(i), p.param_upper()(i));
+            return d;
+          },
+          "{name: (lower, upper)}; range_text says which lower bounds are open.")
+      .def_property_readonly("range_text", &fom::Problem::range_text)
+      .def_property_readonly("num_dofs", &fom::Problem::num_dofs)
+      .def_property_readonly("num_constraints", [](const fom::Problem& p) { return p.contact().num_constraints(); })
+      .def_property_readonly("dofs_per_node", &fom::Problem::dofs_per_node)
+      .def_property_readonly("free_dofs", &fom::Problem::free_dofs)
+      .def_property_readonly("surface_dofs", [](const fom::Problem& p) { return p.contact().surface_dofs(); })
+      .def_property_readonly(
+          "contact_weights", [](const fom::Problem& p) { return p.contact().weights(); },
+          "Tributary length of each contact row (the pressure lam is per unit length).")
+      .def_property_readonly(
+          "contact_points", [](const fom::Problem& p) { return Eigen::MatrixXd(p.contact().constraint_points().transpose()); },
+          "Reference coordinates of the contact rows, shape (n_c, 2).")
+      .def_property_readonly(
+          "node_coordinates",
+          [](const fom::Problem& p) -> py::object {
+            if (!p.mesh()) return py::cast(p.rope_x());
+            return py::cast(Eigen::MatrixXd(p.mesh()->nodes.transpose()));
+          },
+          "Node coordinates, shape (n_nodes, 2) (rope: the 1-D abscissae).")
+      .def_property_readonly("fingerprint", &fom::Problem::fingerprint)
+      .def_property_readonly("displacement_scale", &fom::Problem::displacement_scale)
+      .def("check_param", [](const fom::Problem& p, py::handle mu) { return to_param(p, mu); }, py::arg("mu"),
+           "mu as an array, checked against the ranges (ValueError with the CLI's message otherwise).")
+      .def(
+          "training_set", [](const fom::Problem& p, int n) { return params_array(fom::training_set(p, n), p.num_params()); },
+          py::arg("n"), "Training parameters of size or level n (the problem's [training] plan), shape (m, n_params).")
+      .def(
+          "validation_set",
+          [](const fom::Problem& p, int n) { return params_array(fom::validation_set(p, n), p.num_params()); },
+          py::arg("n"), "Validation parameters associated with training size or level n.")
+      .def(
+          "K", [](const fom::Problem& p, py::handle mu) { return p.stiffness(to_param(p, mu)); }, py::arg("mu"),
+          "Stiffness K(mu) on all dofs as a scipy.sparse.csc_matrix.")
+      .def(
+          "rhs", [](const fom::Problem& p, py::handle mu) { return p.rhs(to_param(p, mu)); }, py::arg("mu"),
+          "f(mu) = f_ext(mu) - K(mu) u_lift(mu), zero on Dirichlet rows.")
+      .def(
+          "lifting", [](const fom::Problem& p, py::handle mu) { return p.lifting(to_param(p, mu)); }, py::arg("mu"),
+          "u_lift(mu): the Dirichlet values, zero elsewhere.")
+      .def(
+          "C", [](const fom::Problem& p, const Eigen::VectorXd& u) { return constraint_at(p, u).c; }, py::arg("u"),
+          "Constraint operator C(u) (n_c x n_dofs, scipy.sparse.csr_matrix), pairing searched at u.")
+      .def(
+          "g", [](const fom::Problem& p, const Eigen::VectorXd& u) { return constraint_at(p, u).g; }, py::arg("u"),
+          "Gap vector g(u) (n_c) of the same linearisation: C(u) u - g(u) <= 0.")
+      .def(
+          "normal_gaps", [](const fom::Problem& p, const Eigen::VectorXd& u) { return fom::normal_gaps(p, u); },
+          py::arg("u"), "Gap of every contact row in length units (unpaired rows: inf).")
+      .def(
+          "contact_force",
+          [](const fom::Problem& p, const Eigen::VectorXd& lam) {
+            if (lam.size() != p.contact().num_constraints())
+              throw InputError("lam has " + std::to_string(lam.size()) + " entries; expected " +
+                               std::to_string(p.contact().num_constraints()));
+            return fom::contact_force(p, lam);
+          },
+          py::arg("lam"), "Total contact force sum_s w_s lam_s (per unit thickness).")
+      .def(
+          "kkt_residuals",
+          [](const fom::Problem& p, py::handle mu, const Eigen::VectorXd& u, const Eigen::VectorXd& lam) {
+            const fom::Param m = to_param(p, mu);
+            check_sizes(p, u, lam);
+            return kkt_dict(fom::kkt_residuals(p, m, u, lam));
+          },
+          py::arg("mu"), py::arg("u"), py::arg("lam"), "The four relative KKT residuals of (u, lam) at mu, as a dict.")
+      .def("__repr__", [](const fom::Problem& p) {
+        return "<contactrom.Problem '" + p.name() + "': " + p.range_text() + ", " + std::to_string(p.num_dofs()) +
+               " dofs, " + std::to_string(p.contact().num_constraints()) + " contact rows>";
+      });
+  m.def("problem", &make, py::arg("name"), py::arg("refine") = 0,
+        "A shipped problem by name ('hertz', 'ironing', 'rope', ...) or a problem file path.");
+
+  py::class_<FomResult>(m, "FomSolution", "One FOM solution; arrays are read-only views owned by this object.")
+      .def_property_readonly("mu", [](const FomResult& r) { return r.solution.mu; })
+      .def_property_readonly("u", [](py::object self) { return vector_view(self.cast<const FomResult&>().solution.u, self); },
+                             "Full displacement (lifting included), n_dofs.")
+      .def_property_readonly(
+          "lam", [](py::object self) { return vector_view(self.cast<const FomResult&>().solution.lambda, self); },
+          "Contact pressure per contact row (>= 0).")
+      .def_property_readonly("status", [](const FomResult& r) { return std::string(to_string(r.solution.status)); })
+      .def_property_readonly("converged", [](const FomResult& r) { return r.solution.status == Status::Success; })
+      .def_property_readonly("message", [](const FomResult& r) { return r.solution.message; })
+      .def_property_readonly("iterations", [](const FomResult& r) { return r.solution.iterations; })
+      .def_property_readonly("pairing_iterations", [](const FomResult& r) { return r.solution.pairing_iterations; })
+      .def_property_readonly("active", [](const FomResult& r) { return r.solution.active; })
+      .def_property_readonly("time_s", [](const FomResult& r) { return r.solution.time_s; })
+      .def_property_readonly("contact_force", [](const FomResult& r) { return r.contact_force; })
+      .def_property_readonly("kkt", [](const FomResult& r) { return kkt_dict(r.kkt); },
+                             "Relative KKT residuals (stationarity, penetration, negative_pressure, complementarity, max).")
+      .def("__repr__", [](const FomResult& r) {
+        return "<contactrom.FomSolution " + std::string(to_string(r.solution.status)) + ", " +
+               std::to_string(r.solution.active) + " active rows>";
+      });
+
+  py::class_<FullOrderSolver>(m, "FullOrderSolver", R"doc(
+The FOM solver of a problem: the active-set solver (default; K factorised once
+here when it does not depend on mu) or Ipopt (solver="ipopt").)doc")
+      .def(py::init([](std::shared_ptr<fom::Problem> problem, const std::string& solver) {
+             if (solver != "active-set" && solver != "ipopt")
+               throw InputError("solver '" + solver + "' unknown; expected active-set or ipopt");
+             auto s = std::make_unique<FullOrderSolver>();
+             s->problem = problem;
+             s->kind = solver;
+             py::gil_scoped_release release;
+             if (solver == "ipopt")
+               s->ipopt = std::make_unique<baselines::IpoptQpSolver>(*problem);
+             else
+               s->active_set = std::make_unique<fom::ActiveSetSolver>(*problem);
+             return s;
+           }),
+           py::arg("problem"), py::arg("solver") = "active-set")
+      .def_property_readonly("problem", [](const FullOrderSolver& s) { return std::const_pointer_cast<fom::Problem>(s.problem); })
+      .def_property_readonly("solver", [](const FullOrderSolver& s) { return s.kind; })
+      .def_property_readonly("setup_time_s", [](const FullOrderSolver& s) {
+        return s.active_set ? s.active_set->setup_time() : s.ipopt->setup_time();
+      })
+      .def(
+          "solve",
+          [](const FullOrderSolver& s, py::handle mu) {
+            const fom::Param p = to_param(*s.problem, mu);
+            py::gil_scoped_release release;
+            return finish(*s.problem, s.solve(p));
+          },
+          py::arg("mu"), "Solves at mu (GIL released). RuntimeError if the solver returns no solution at all.")
+      .def(
+          "solve_all",
+          [](const FullOrderSolver& s, py::handle params, int threads) {
+            const std::vector<fom::Param> ps = to_params(*s.problem, params);
+            std::vector<FomResult> out(ps.size());
+            py::gil_scoped_release release;
+            rom::parallel_for(static_cast<int>(ps.size()), threads,
+                              [&](int i) { out[i] = finish(*s.problem, s.solve(ps[i])); });
+            return out;
+          },
+          py::arg("params"), py::arg("threads") = 0,
+          "Solves at every row of params on `threads` threads (<= 0: all cores); a list of FomSolution.");
+
+  m.def(
+      "verify",
+      [](std::shared_ptr<fom::Problem> problem, py::handle mu, const Eigen::VectorXd& u, const Eigen::VectorXd& lam,
+         const FomResult* reference, double degenerate_tol) {
+        const fom::Param p = to_param(*problem, mu);
+        check_sizes(*problem, u, lam);
+        baselines::VerificationReport r;
+        {
+          py::gil_scoped_release release;
+          r = baselines::verify_solution(*problem, p, u, lam, reference ? &reference->solution : nullptr, degenerate_tol);
+        }
+        return report_dict(r);
+      },
+      py::arg("problem"), py::arg("mu"), py::arg("u"), py::arg("lam"), py::arg("reference") = nullptr,
+      py::arg("degenerate_tol") = 1e-8, R"doc(
+KKT verification of a candidate (u, lam) at mu: {'status', 'message', 'kkt': {...},
+'errors': {'primal_h1', 'dual_l2', 'active_set_differences'} or None}. The errors
+are computed against `reference` (a FomSolution, e.g. of FullOrderSolver(problem,
+solver="ipopt")) when one is given.)doc");
+}
+
+}  // namespace contactrom::python

@@ -1,0 +1,108 @@
+// Python bindings of the sparse kernels (rom/nnls.hpp, rom/omp.hpp,
+// rom/focuss.hpp) on numpy arrays. Shapes and finiteness are checked here, so a
+// wrong input is a ValueError naming it rather than a zero vector with status
+// invalid_input.
+#include <functional>
+
+#include "fom/errors.hpp"
+#include "python/bindings.hpp"
+#include "rom/focuss.hpp"
+#include "rom/nnls.hpp"
+#include "rom/omp.hpp"
+
+namespace contactrom::python {
+namespace {
+
+/// Result of a sparse kernel: x and how the solve ended.
+struct SparseResult {
+  Eigen::VectorXd x;
+  Status status = Status::Success;
+  int iterations = 0;
+  std::vector<Eigen::Index> support;
+};
+
+void check_system(const char* kernel, const Eigen::MatrixXd& a, const Eigen::VectorXd& b, const char* a_name,
+                  const char* b_name) {
+  if (b.size() != a.rows())
+    throw InputError(std::string(kernel) + ": " + b_name + " has " + std::to_string(b.size()) + " entries; expected " +
+                     std::to_string(a.rows()) + " (the rows of " + a_name + ")");
+  if (!a.allFinite()) throw InputError(std::string(kernel) + ": " + a_name + " has a non-finite entry");
+  if (!b.allFinite()) throw InputError(std::string(kernel) + ": " + b_name + " has a non-finite entry");
+}
+
+/// Runs `solve` without the GIL and packs the solver's outcome.
+template <class Solver>
+SparseResult run(Solver& solver, const std::function<Eigen::VectorXd()>& solve) {
+  SparseResult r;
+  {
+    py::gil_scoped_release release;
+    r.x = solve();
+  }
+  r.status = solver.info();
+  r.iterations = solver.iterations();
+  for (Eigen::Index i = 0; i < r.x.size(); ++i)
+    if (r.x(i) != 0.0) r.support.push_back(i);
+  return r;
+}
+
+/// Binds FOCUSS or nnFOCUSS (same options, same call) as `name`.
+template <class Solver>
+void bind_focuss(py::module_& m, const char* name, const char* doc) {
+  m.def(
+      name,
+      [name](const Eigen::MatrixXd& d, const Eigen::VectorXd& x, int max_iterations, double tolerance,
+             double prune_tolerance) {
+        check_system(name, d, x, "D", "x");
+        rom::FocussOptions o;
+        o.max_iterations = max_iterations;
+        o.tolerance = tolerance;
+        o.prune_tolerance = prune_tolerance;
+        Solver solver(o);
+        return run(solver, [&] { return solver.compute(d).solve(x); });
+      },
+      py::arg("D"), py::arg("x"), py::arg("max_iterations") = 100, py::arg("tolerance") = 1e-10,
+      py::arg("prune_tolerance") = 1e-8, doc);
+}
+
+}  // namespace
+
+void bind_kernels(py::module_& m) {
+  py::class_<SparseResult>(m, "SparseResult", "Solution of a sparse kernel: x, status, iterations, support.")
+      .def_property_readonly("x", [](py::object self) { return vector_view(self.cast<const SparseResult&>().x, self); })
+      .def_property_readonly("status", [](const SparseResult& r) { return std::string(to_string(r.status)); })
+      .def_readonly("iterations", &SparseResult::iterations)
+      .def_readonly("support", &SparseResult::support, "Indices of the non-zero entries of x, ascending.")
+      .def("__repr__", [](const SparseResult& r) {
+        return "<contactrom.SparseResult " + std::string(to_string(r.status)) + ", " +
+               std::to_string(r.support.size()) + " non-zeros>";
+      });
+
+  m.def(
+      "nnls",
+      [](const Eigen::MatrixXd& a, const Eigen::VectorXd& b, int max_iterations, double tolerance) {
+        check_system("nnls", a, b, "A", "b");
+        rom::NnlsOptions o;
+        o.max_iterations = max_iterations;
+        o.tolerance = tolerance;
+        rom::Nnls solver(o);
+        return run(solver, [&] { return solver.compute(a).solve(b); });
+      },
+      py::arg("A"), py::arg("b"), py::arg("max_iterations") = 0, py::arg("tolerance") = 1e-12,
+      "min ||A x - b|| s.t. x >= 0 (Lawson-Hanson); max_iterations <= 0: 3n.");
+  m.def(
+      "omp",
+      [](const Eigen::MatrixXd& d, const Eigen::VectorXd& x, int max_atoms, double tolerance) {
+        check_system("omp", d, x, "D", "x");
+        rom::OmpOptions o;
+        o.max_atoms = max_atoms;
+        o.tolerance = tolerance;
+        rom::Omp solver(o);
+        return run(solver, [&] { return solver.compute(d).solve(x); });
+      },
+      py::arg("D"), py::arg("x"), py::arg("max_atoms") = -1, py::arg("tolerance") = 1e-8,
+      "Orthogonal matching pursuit: sparse alpha with D alpha ~ x (||x - D alpha|| <= tolerance ||x||).");
+  bind_focuss<rom::Focuss>(m, "focuss", "FOCUSS (re-weighted minimum norm) from the minimum-norm solution.");
+  bind_focuss<rom::NnFocuss>(m, "nnfocuss", "nnFOCUSS (non-negative FOCUSS started from NNLS).");
+}
+
+}  // namespace contactrom::python

@@ -1,0 +1,318 @@
+// Python bindings of the reduced side: the offline stage and its snapshot
+// database, the reduced model with its online method, and the evaluation of a
+// reduced model against the FOM over a parameter set.
+#include <Python.h>
+
+#include "fom/errors.hpp"
+#include "python/bindings.hpp"
+#include "rom/offline.hpp"
+
+namespace contactrom::python {
+namespace {
+
+rom::LiftingKind lifting_kind(const std::string& text) {
+  if (text == "harmonic") return rom::LiftingKind::Harmonic;
+  if (text == "dirichlet") return rom::LiftingKind::Dirichlet;
+  throw InputError("lifting '" + text + "' unknown; expected harmonic or dirichlet");
+}
+
+std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, double delta, const std::string& method,
+                                                  const py::dict& options, const std::string& lifting,
+                                                  bool include_failed) {
+  if (!(delta >= 0.0 && delta <= 1.0))
+    throw InputError("delta = " + fom::format_number(delta) + " is outside [0, 1]; expected a POD tolerance such as 1e-8");
+  rom::check_online_method(method);
+  std::map<std::string, std::string> values;
+  for (const auto& [key, value] : options) values[py::str(key)] = option_text(value);
+  const rom::OnlineSolverOptions solver_options = rom::online_options_from_values(values);
+  rom::ReducedModelOptions model_options;
+  model_options.delta = delta;
+  model_options.lifting = lifting_kind(lifting);
+  model_options.include_failed_snapshots = include_failed;
+  auto r = std::make_unique<ReducedModel>();
+  r->db = database.db;
+  {
+    py::gil_scoped_release release;
+    r->rom = std::make_shared<rom::OnlineModel>(database.problem, *r->db, model_options, method, solver_options);
+  }
+  if (r->rom->model().primal_rank() == 0 &&
+      PyErr_WarnEx(PyExc_RuntimeWarning,
+                   ("ReducedModel: delta " + fom::format_number(delta) +
+                    " keeps no POD mode; the reduced displacement is the offset alone")
+                       .c_str(),
+                   1) != 0)
+    throw py::error_already_set();  // the warning was turned into an error
+  return r;
+}
+
+std::unique_ptr<ReducedModel> load_reduced_model(const std::string& path) {
+  auto r = std::make_unique<ReducedModel>();
+  py::gil_scoped_release release;
+  r->rom = std::make_shared<rom::OnlineModel>(rom::OnlineModel::load(path));
+  return r;
+}
+
+py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& problem) {
+  const int num_params = problem.num_params();
+  py::dict d;
+  d["problem"] = problem.name();
+  d["method"] = s.method;
+  d["delta"] = s.delta;
+  d["dictionary_size"] = s.dictionary_size;
+  d["dual_basis_size"] = s.dual_basis_size;
+  d["primal_rank"] = s.primal_rank;
+  d["validation_size"] = s.rows.size();
+  d["mean_primal_error"] = s.mean_primal_error;
+  d["max_primal_error"] = s.max_primal_error;
+  d["mean_dual_error"] = s.mean_dual_error;
+  d["max_dual_error"] = s.max_dual_error;
+  d["mean_sparsity"] = s.mean_sparsity;
+  d["max_sparsity"] = s.max_sparsity;
+  d["mean_iterations"] = s.mean_iterations;
+  d["mean_time_s"] = s.mean_time_s;
+  d["median_time_s"] = s.median_time_s;
+  d["nonconverged"] = s.nonconverged;
+  d["fom_failures"] = s.fom_failures;
+  d["max_kkt"] = s.max_kkt;
+  const py::ssize_t n = static_cast<py::ssize_t>(s.rows.size());
+  std::vector<fom::Param> mus;
+  py::array_t<double> primal(n), dual(n), time(n);
+  py::array_t<int> sparsity(n), iterations(n);
+  py::array_t<bool> converged(n);
+  py::list status;
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const rom::EvaluationRow& row = s.rows[i];
+    mus.push_back(row.mu);
+    primal.mutable_at(i) = row.primal_error;
+    dual.mutable_at(i) = row.dual_error;
+    time.mutable_at(i) = row.time_s;
+    sparsity.mutable_at(i) = row.sparsity;
+    iterations.mutable_at(i) = row.iterations;
+    converged.mutable_at(i) = row.converged;
+    status.append(to_string(row.status));
+  }
+  py::dict rows;
+  rows["mu"] = params_array(mus, num_params);
+  rows["primal_error"] = primal;
+  rows["dual_error"] = dual;
+  rows["sparsity"] = sparsity;
+  rows["iterations"] = iterations;
+  rows["time_s"] = time;
+  rows["converged"] = converged;
+  rows["status"] = status;
+  d["rows"] = rows;
+  return d;
+}
+
+}  // namespace
+
+void bind_rom(py::module_& m) {
+  py::class_<Database>(m, "SnapshotDatabase", R"doc(
+FOM snapshots at the training parameters with the problem they belong to. Arrays
+are read-only views with one snapshot per row, as in the HDF5 file.)doc")
+      .def_property_readonly("problem", [](const Database& d) { return std::const_pointer_cast<fom::Problem>(d.problem); })
+      .def_property_readonly("problem_name", [](const Database& d) { return d.db->problem; })
+      .def_property_readonly("num_snapshots", [](const Database& d) { return d.db->num_snapshots(); })
+      .def_property_readonly("num_dofs", [](const Database& d) { return d.db->num_dofs(); })
+      .def_property_readonly("num_constraints", [](const Database& d) { return d.db->num_constraints(); })
+      .def_property_readonly("param_names", [](const Database& d) { return d.db->param_names; })
+      .def_property_readonly("training_kind", [](const Database& d) { return d.db->training_kind; })
+      .def_property_readonly("training_size", [](const Database& d) { return d.db->training_size; })
+      .def_property_readonly(
+          "parameters", [](py::object self) { return columns_as_rows(self.cast<const Database&>().db->parameters, self); },
+          "(n_snap, n_params)")
+      .def_property_readonly(
+          "primal", [](py::object self) { return columns_as_rows(self.cast<const Database&>().db->primal, self); },
+          "(n_snap, n_dofs): u - u_lift of each snapshot")
+      .def_property_readonly(
+          "dual", [](py::object self) { return columns_as_rows(self.cast<const Database&>().db->dual, self); },
+          "(n_snap, n_c): contact pressure of each snapshot")
+      .def_property_readonly("status",
+                             [](const Database& d) {
+                               std::vector<std::string> s;
+                               for (Status st : d.db->status) s.push_back(to_string(st));
+                               return s;
+                             })
+      .def_property_readonly("iterations", [](const Database& d) { return d.db->iterations; })
+      .def_property_readonly("time_s", [](const Database& d) { return d.db->time_s; })
+      .def_property_readonly("wall_time_s", [](const Database& d) { return d.db->wall_time_s; })
+      .def_property_readonly("threads", [](const Database& d) { return d.db->threads; })
+      .def(
+          "validation_set",
+          [](const Database& d) {
+            return params_array(rom::database_validation_set(*d.db, *d.problem), d.problem->num_params());
+          },
+          "The validation parameters of the database's training set (those `contactrom online` evaluates).")
+      .def(
+          "save",
+          [](const Database& d, const std::string& path) {
+            py::gil_scoped_release release;
+            rom::write_database(path, *d.db);
+          },
+          py::arg("path"), "Writes the HDF5 file (atomically), readable by the CLI and load_database.")
+      .def("__repr__", [](const Database& d) {
+        return "<contactrom.SnapshotDatabase '" + d.db->problem + "': " + std::to_string(d.db->num_snapshots()) +
+               " snapshots>";
+      });
+
+  m.def(
+      "load_database",
+      [](const std::string& path) {
+        py::gil_scoped_release release;
+        auto db = std::make_shared<rom::SnapshotDatabase>(rom::read_database(path));
+        Database d;
+        d.problem = rom::problem_from_database(*db, path);
+        d.db = std::move(db);
+        return d;
+      },
+      py::arg("path"), "Reads a database written by `contactrom offline` or SnapshotDatabase.save; rebuilds its problem.");
+
+  m.def(
+      "offline",
+      [](std::shared_ptr<fom::Problem> problem, py::handle params, int threads) {
+        rom::OfflineOptions options;
+        options.threads = threads;
+        Database d;
+        d.problem = problem;
+        if (py::isinstance<py::int_>(params)) {
+          const int n = params.cast<int>();
+          py::gil_scoped_release release;
+          d.db = std::make_shared<rom::SnapshotDatabase>(rom::generate_snapshots(*problem, n, options));
+        } else {
+          const std::vector<fom::Param> ps = to_params(*problem, params);
+          py::gil_scoped_release release;
+          d.db = std::make_shared<rom::SnapshotDatabase>(
+              rom::generate_snapshots(*problem, ps, "train", static_cast<int>(ps.size()), options));
+        }
+        return d;
+      },
+      py::arg("problem"), py::arg("params"), py::arg("threads") = 0, R"doc(
+FOM snapshots in parallel (GIL released). `params` is an int n (the training set
+of size or level n, as `contactrom offline --train n` / `--level n`) or an array
+of parameters (n, n_params); a database of other parameters than a training set
+works in memory but is refused when read back from a file.)doc");
+
+  py::class_<rom::OnlineResult>(m, "RomSolution",
+                                "One online query; arrays are read-only views owned by this object.")
+      .def_property_readonly("mu", [](const rom::OnlineResult& r) { return r.mu; })
+      .def_property_readonly("u_hat", [](py::object self) { return vector_view(self.cast<const rom::OnlineResult&>().u_hat, self); },
+                             "Reduced coordinates (r).")
+      .def_property_readonly("u", [](py::object self) { return vector_view(self.cast<const rom::OnlineResult&>().u, self); },
+                             "Full displacement Phi u_hat + offset(mu) (n_dofs).")
+      .def_property_readonly(
+          "lam", [](py::object self) { return vector_view(self.cast<const rom::OnlineResult&>().lambda, self); },
+          "Full contact pressure D[:, selected] @ coefficients (n_c).")
+      .def_property_readonly("selected", [](const rom::OnlineResult& r) { return r.selected; },
+                             "Selected dictionary columns (indices into ReducedModel.dictionary columns).")
+      .def_property_readonly(
+          "coefficients", [](py::object self) { return vector_view(self.cast<const rom::OnlineResult&>().coefficients, self); },
+          "Coefficients of the selected columns, in the same order.")
+      .def_readonly("iterations", &rom::OnlineResult::iterations)
+      .def_readonly("converged", &rom::OnlineResult::converged)
+      .def_property_readonly("status", [](const rom::OnlineResult& r) { return std::string(to_string(r.status)); })
+      .def_readonly("message", &rom::OnlineResult::message)
+      .def_readonly("time_s", &rom::OnlineResult::time_s)
+      .def("__repr__", [](const rom::OnlineResult& r) {
+        return "<contactrom.RomSolution " + std::string(to_string(r.status)) + ", " + std::to_string(r.selected.size()) +
+               " columns, " + std::to_string(r.iterations) + " iterations>";
+      });
+
+  py::class_<ReducedModel>(m, "ReducedModel", R"doc(
+POD basis, dual dictionary, reduced operators and an online method, built from a
+snapshot database or loaded from a reduced-model file (`contactrom reduce`). The
+object owns the problem (and the database) it needs.)doc")
+      .def(py::init(&build_reduced_model), py::arg("db"), py::arg("delta") = 1e-8, py::arg("method") = "greedy",
+           py::arg("options") = py::dict(), py::arg("lifting") = "harmonic",
+           py::arg("include_failed_snapshots") = false)
+      .def_static("load", &load_reduced_model, py::arg("path"),
+                  "Reads a reduced-model file (`contactrom reduce` or ReducedModel.save): no FOM, no meshing.")
+      .def(
+          "save",
+          [](const ReducedModel& r, const std::string& path) {
+            py::gil_scoped_release release;
+            r.rom->save(path);
+          },
+          py::arg("path"), "Writes the reduced-model file (atomically), readable by `contactrom query` and load.")
+      .def_property_readonly("problem",
+                             [](const ReducedModel& r) { return std::const_pointer_cast<fom::Problem>(r.rom->shared_problem()); })
+      .def_property_readonly(
+          "database",
+          [](const ReducedModel& r) -> py::object {
+            if (!r.db) return py::none();
+            return py::cast(Database{r.db, r.rom->shared_problem()});
+          },
+          "The snapshot database it was built from (None when loaded from a file).")
+      .def_property_readonly("method", [](const ReducedModel& r) { return r.rom->method(); })
+      .def_property_readonly("options", [](const ReducedModel& r) { return rom::online_option_values(r.rom->options()); },
+                             "The method's settings as text, as stored in the reduced-model file.")
+      .def_property_readonly("delta", [](const ReducedModel& r) { return r.rom->model().delta(); })
+      .def_property_readonly("primal_rank", [](const ReducedModel& r) { return r.rom->model().primal_rank(); })
+      .def_property_readonly("dictionary_size", [](const ReducedModel& r) { return r.rom->model().dictionary_size(); })
+      .def_property_readonly("dual_basis_size", [](const ReducedModel& r) { return r.rom->solver().dual_basis_size(); })
+      .def_property_readonly(
+          "basis", [](const ReducedModel& r) -> const Eigen::MatrixXd& { return r.rom->model().basis(); },
+          py::return_value_policy::reference_internal, "POD basis Phi (n_dofs, r), read-only view.")
+      .def_property_readonly(
+          "dictionary", [](const ReducedModel& r) -> const Eigen::MatrixXd& { return r.rom->model().dictionary(); },
+          py::return_value_policy::reference_internal, "Dual dictionary D (n_c, m), read-only view.")
+      .def_property_readonly(
+          "singular_values",
+          [](const ReducedModel& r) -> const Eigen::VectorXd& { return r.rom->model().singular_values(); },
+          py::return_value_policy::reference_internal)
+      .def_property_readonly("dictionary_snapshots",
+                             [](const ReducedModel& r) { return r.rom->model().dictionary_snapshots(); },
+                             "Database snapshot index of each dictionary column.")
+      .def(
+          "solve",
+          [](const ReducedModel& r, py::handle mu) {
+            const fom::Param p = to_param(r.rom->problem(), mu);
+            py::gil_scoped_release release;
+            return r.rom->solver().solve(p);
+          },
+          py::arg("mu"), "One online query (GIL released): a RomSolution.")
+      .def(
+          "solve_all",
+          [](const ReducedModel& r, py::handle params) {
+            const std::vector<fom::Param> ps = to_params(r.rom->problem(), params);
+            std::vector<rom::OnlineResult> out;
+            out.reserve(ps.size());
+            py::gil_scoped_release release;
+            for (const fom::Param& p : ps) out.push_back(r.rom->solver().solve(p));
+            return out;
+          },
+          py::arg("params"), "Online queries at every row of params, in order (GIL released).")
+      .def(
+          "evaluate",
+          [](const ReducedModel& r, py::object params, int threads, bool kkt) {
+            const fom::Problem& problem = r.rom->problem();
+            if (params.is_none() && !r.db)
+              throw InputError("evaluate() of a reduced model loaded from a file needs params; it has no database "
+                               "and so no validation set");
+            const std::vector<fom::Param> ps =
+                params.is_none() ? rom::database_validation_set(*r.db, problem) : to_params(problem, params);
+            rom::EvaluationSummary s;
+            {
+              py::gil_scoped_release release;
+              const fom::ActiveSetSolver fom_solver(problem);
+              const std::vector<fom::FomSolution> refs = rom::compute_references(fom_solver, ps, threads);
+              rom::EvaluationOptions options;
+              options.kkt = kkt;
+              s = rom::evaluate_online(r.rom->solver(), ps, refs, options);
+            }
+            return summary_dict(s, problem);
+          },
+          py::arg("params") = py::none(), py::arg("threads") = 0, py::arg("kkt") = false, R"doc(
+Errors against the FOM over `params` (default: the database's validation set, as
+`contactrom online --validation`): the summary of `online --json` plus 'rows',
+the per-parameter arrays (mu, primal_error, dual_error, sparsity, iterations,
+time_s, converged, status).)doc")
+      .def("__repr__", [](const ReducedModel& r) {
+        return "<contactrom.ReducedModel '" + r.rom->problem().name() + "' " + r.rom->method() + ": rank " +
+               std::to_string(r.rom->model().primal_rank()) + ", dictionary " +
+               std::to_string(r.rom->model().dictionary_size()) + ">";
+      });
+
+  m.def("online_methods", &rom::online_solver_names, "Names of the registered online methods.");
+}
+
+}  // namespace contactrom::python

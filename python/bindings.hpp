@@ -1,0 +1,99 @@
+#pragma once
+/// \file bindings.hpp
+/// \brief Shared pieces of the contactrom Python module (_contactrom): the objects
+/// that own what the C++ classes only reference, parameter conversion and
+/// read-only numpy views of Eigen storage.
+///
+/// Ownership: a fom::ActiveSetSolver keeps a reference to its Problem and a
+/// rom::OnlineModel a shared pointer; the Python objects below hold shared pointers
+/// to everything they reference, so a Python user may drop the problem or the
+/// database and keep the solver or the reduced model.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "baselines/ipopt_qp.hpp"
+#include "fom/active_set_solver.hpp"
+#include "fom/kkt.hpp"
+#include "fom/problem.hpp"
+#include "rom/online_evaluation.hpp"
+#include "rom/reduced_model.hpp"
+#include "rom/reduced_model_file.hpp"
+#include "rom/snapshot_database.hpp"
+
+namespace contactrom::python {
+
+namespace py = pybind11;
+
+using ProblemPtr = std::shared_ptr<const fom::Problem>;
+
+/// \brief A snapshot database and the problem it was computed for (built by
+/// `offline`, or rebuilt from the file by `load_database`).
+struct Database {
+  std::shared_ptr<const rom::SnapshotDatabase> db;
+  ProblemPtr problem;
+};
+
+/// \brief A FOM solution with its KKT residuals (computed once, after the solve).
+struct FomResult {
+  fom::FomSolution solution;
+  fom::KktResiduals kkt;
+  double contact_force = 0.0;
+};
+
+/// \brief The FOM solver of `FullOrderSolver`: the active-set solver or Ipopt.
+struct FullOrderSolver {
+  ProblemPtr problem;
+  std::string kind;  // "active-set" or "ipopt"
+  std::unique_ptr<fom::ActiveSetSolver> active_set;
+  std::unique_ptr<baselines::IpoptQpSolver> ipopt;
+  /// Solves at μ (thread-safe; the caller releases the GIL).
+  fom::FomSolution solve(const fom::Param& mu) const;
+};
+
+/// \brief A reduced model with its online method (which owns its problem), and the
+/// database it was built from (null for a model loaded from a reduced-model file).
+struct ReducedModel {
+  std::shared_ptr<const rom::OnlineModel> rom;
+  std::shared_ptr<const rom::SnapshotDatabase> db;
+};
+
+/// \brief μ from a Python number or sequence, checked as the CLI checks `--param`
+/// (same messages: the values are written back as the shortest text that reads as
+/// the same double). \throws InputError for a wrong count, a non-finite value or a
+/// value out of range.
+fom::Param to_param(const fom::Problem& problem, py::handle value);
+
+/// \brief A list of parameters (one per row of a 2-D array, or a 1-D array / list
+/// of numbers for a one-parameter problem), each checked by to_param.
+std::vector<fom::Param> to_params(const fom::Problem& problem, py::handle values);
+
+/// \brief Parameters as an (n, n_params) numpy array.
+py::array_t<double> params_array(const std::vector<fom::Param>& params, int num_params);
+
+/// \brief Read-only numpy view of a vector owned by `owner` (no copy).
+py::array vector_view(const Eigen::VectorXd& v, py::handle owner);
+
+/// \brief Read-only numpy view of the columns of `m` as rows: shape (cols, rows),
+/// one snapshot or mode per row (no copy; m is column-major).
+py::array columns_as_rows(const Eigen::MatrixXd& m, py::handle owner);
+
+/// \brief The KKT residuals as a dict (stationarity, penetration,
+/// negative_pressure, complementarity, max).
+py::dict kkt_dict(const fom::KktResiduals& k);
+
+/// \brief Text form of a Python option value: bool → true/false, numbers as the
+/// shortest text that reads back the same, strings as they are.
+std::string option_text(py::handle value);
+
+void bind_fom(py::module_& m);
+void bind_rom(py::module_& m);
+void bind_kernels(py::module_& m);
+
+}  // namespace contactrom::python

@@ -1,0 +1,44 @@
+"""contactrom: projection-based reduced-order models of contact problems.
+
+The classes and functions are those of the C++ library (module ``_contactrom``);
+see docs/python.md. Bad input raises ValueError with the one-line message the
+command-line tool prints; a solver that returns no solution at all raises
+RuntimeError; numerical non-convergence is a ``status`` of the result.
+"""
+from ._contactrom import (
+    FomSolution,
+    FullOrderSolver,
+    Problem,
+    ReducedModel,
+    RomSolution,
+    SnapshotDatabase,
+    SparseResult,
+    focuss,
+    load_database,
+    nnfocuss,
+    nnls,
+    offline,
+    omp,
+    online_methods,
+    problem,
+    verify,
+)
+
+__all__ = [
+    "FomSolution",
+    "FullOrderSolver",
+    "Problem",
+    "ReducedModel",
+    "RomSolution",
+    "SnapshotDatabase",
+    "SparseResult",
+    "focuss",
+    "load_database",
+    "nnfocuss",
+    "nnls",
+    "offline",
+    "omp",
+    "online_methods",
+    "problem",
+    "verify",
+]

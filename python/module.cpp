@@ -1,0 +1,121 @@
+// The _contactrom extension module: error translation, the shared conversions of
+// bindings.hpp, and the registration of the fom, rom and sparse-kernel bindings.
+// The pure-Python package `contactrom` (python/contactrom/) re-exports it.
+#include <cmath>
+
+#include "baselines/reduced_active_set.hpp"
+#include "fom/errors.hpp"
+#include "fom/input_values.hpp"
+#include "python/bindings.hpp"
+#include "rom/convex_hull.hpp"
+
+namespace contactrom::python {
+
+namespace {
+// One text, checked by the CLI's parser, so that a refusal reads exactly as the
+// CLI's for the same numbers.
+fom::Param checked_param(const fom::Problem& problem, const double* values, py::ssize_t n) {
+  std::string text;
+  for (py::ssize_t i = 0; i < n; ++i) text += (i ? "," : "") + fom::format_number(values[i]);
+  return parse_problem_param(problem, text);
+}
+}  // namespace
+
+fom::Param to_param(const fom::Problem& problem, py::handle value) {
+  if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
+    const double v = value.cast<double>();
+    return checked_param(problem, &v, 1);
+  }
+  const auto refuse = [&] {
+    return InputError("a parameter of '" + problem.name() + "' is a number or a sequence of " +
+                      std::to_string(problem.num_params()) + " numbers (" + problem.range_text() + ")");
+  };
+  if (py::isinstance<py::str>(value)) throw refuse();  // numpy would read the text
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (a && a.ndim() == 0) return checked_param(problem, a.data(), 1);  // numpy scalars
+  if (!a || a.ndim() != 1) throw refuse();
+  return checked_param(problem, a.data(), a.size());
+}
+
+std::vector<fom::Param> to_params(const fom::Problem& problem, py::handle values) {
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
+  const bool one = problem.num_params() == 1;
+  if (!a || a.ndim() < 1 || a.ndim() > 2 || (a.ndim() == 1 && !one))
+    throw InputError("parameters of '" + problem.name() + "' are an array of shape (n, " +
+                     std::to_string(problem.num_params()) + ")" + (one ? " or (n,)" : "") + " (" +
+                     problem.range_text() + ")");
+  const py::ssize_t width = a.ndim() == 1 ? 1 : a.shape(1);
+  std::vector<fom::Param> out;
+  for (py::ssize_t i = 0; i < a.shape(0); ++i) out.push_back(checked_param(problem, a.data() + i * width, width));
+  return out;
+}
+
+py::array_t<double> params_array(const std::vector<fom::Param>& params, int num_params) {
+  py::array_t<double> out({static_cast<py::ssize_t>(params.size()), static_cast<py::ssize_t>(num_params)});
+  auto w = out.mutable_unchecked<2>();
+  for (size_t i = 0; i < params.size(); ++i)
+    for (int k = 0; k < num_params; ++k) w(i, k) = params[i](k);
+  return out;
+}
+
+namespace {
+py::array readonly(py::array a) {
+  a.attr("setflags")(py::arg("write") = false);
+  return a;
+}
+}  // namespace
+
+py::array vector_view(const Eigen::VectorXd& v, py::handle owner) {
+  return readonly(py::array(py::dtype::of<double>(), {v.size()}, {static_cast<py::ssize_t>(sizeof(double))},
+                            v.data(), owner));
+}
+
+py::array columns_as_rows(const Eigen::MatrixXd& m, py::handle owner) {
+  const auto d = static_cast<py::ssize_t>(sizeof(double));
+  return readonly(py::array(py::dtype::of<double>(), {m.cols(), m.rows()}, {m.rows() * d, d}, m.data(), owner));
+}
+
+py::dict kkt_dict(const fom::KktResiduals& k) {
+  py::dict d;
+  d["stationarity"] = k.stationarity;
+  d["penetration"] = k.penetration;
+  d["negative_pressure"] = k.negative_pressure;
+  d["complementarity"] = k.complementarity;
+  d["max"] = k.max();
+  return d;
+}
+
+std::string option_text(py::handle value) {
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::int_>(value)) return py::str(value);
+  if (py::isinstance<py::float_>(value)) return fom::format_number(value.cast<double>());
+  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  throw InputError("option value " + std::string(py::str(py::repr(value))) +
+                   " is not a number, a string or a bool");
+}
+
+}  // namespace contactrom::python
+
+PYBIND11_MODULE(_contactrom, m) {
+  namespace py = pybind11;
+  using namespace contactrom;
+  m.doc() = "contactrom: reduced-order models of contact problems (C++ core)";
+
+  // Bad input → ValueError with the CLI's one-line message; anything else the C++
+  // side throws (std::bad_alloc aside) is a RuntimeError, as pybind11 does by default.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    }
+  });
+
+  // The online methods outside contactrom::rom's own file are registered here once.
+  baselines::register_baseline_online_solvers();
+  rom::register_convex_hull_solver();
+
+  python::bind_fom(m);
+  python::bind_rom(m);
+  python::bind_kernels(m);
+}

@@ -1,0 +1,157 @@
+"""A Python reduced model built from a CLI database answers as `contactrom online`
+on that database; a Python offline stage writes the CLI's database."""
+import gc
+
+import numpy as np
+import pytest
+
+import contactrom
+from conftest import HERTZ_TRAIN, run_cli, run_cli_json
+
+
+@pytest.fixture(scope="module")
+def db(hertz_db_path):
+    return contactrom.load_database(str(hertz_db_path))
+
+
+@pytest.fixture(scope="module")
+def rom(db):
+    return contactrom.ReducedModel(db, delta=1e-8, method="greedy")
+
+
+def test_validation_errors_equal_cli(hertz_db_path, rom):
+    cli = run_cli_json("online", "--db", str(hertz_db_path), "--method", "greedy", "--delta", "1e-8", "--threads", "2")
+    ours = rom.evaluate(threads=2)
+    assert ours["validation_size"] == cli["validation_size"] == 119
+    for key in ("primal_rank", "dictionary_size", "dual_basis_size", "max_sparsity", "nonconverged", "fom_failures"):
+        assert ours[key] == cli[key], key
+    for key in ("mean_primal_error", "max_primal_error", "mean_dual_error", "max_dual_error", "mean_sparsity",
+                "mean_iterations"):
+        assert ours[key] == pytest.approx(cli[key], rel=1e-12, abs=1e-300), key
+    assert ours["max_primal_error"] == ours["rows"]["primal_error"].max()
+
+
+@pytest.mark.parametrize("mu", [0.0137, 0.2])
+def test_single_query_equals_cli(hertz_db_path, rom, mu):
+    cli = run_cli_json("online", "--db", str(hertz_db_path), "--param", repr(mu))
+    r = rom.solve(mu)
+    assert r.status == cli["status"] and r.converged == cli["converged"]
+    assert r.iterations == cli["iterations"]
+    snapshots = [rom.dictionary_snapshots[c] for c in r.selected]
+    assert snapshots == cli["selected"]
+    assert np.allclose(r.coefficients, cli["coefficients"], rtol=1e-12, atol=0.0)
+    assert rom.problem.contact_force(r.lam) == pytest.approx(cli["contact_force"], rel=1e-12)
+
+
+def test_solution_is_the_dictionary_combination(rom):
+    r = rom.solve(0.17)
+    assert r.u_hat.shape == (rom.primal_rank,)
+    assert len(r.selected) == len(r.coefficients) > 0
+    assert np.all(r.coefficients >= 0.0)
+    D = rom.dictionary
+    assert D.shape == (rom.problem.num_constraints, rom.dictionary_size)
+    assert np.allclose(r.lam, D[:, r.selected] @ r.coefficients, rtol=1e-13, atol=1e-14 * abs(D).max())
+    # u = Phi u_hat + offset(mu): the offset does not depend on u_hat.
+    other = rom.solve(0.17)
+    assert np.array_equal(r.u, other.u)
+
+
+def test_python_offline_writes_the_cli_database(tmp_path, db):
+    problem = contactrom.problem("hertz")
+    ours = contactrom.offline(problem, HERTZ_TRAIN, threads=2)
+    assert ours.num_snapshots == HERTZ_TRAIN
+    assert np.array_equal(ours.parameters, db.parameters)
+    assert np.array_equal(ours.primal, db.primal)
+    assert np.array_equal(ours.dual, db.dual)
+    path = tmp_path / "py.h5"
+    ours.save(str(path))
+    back = contactrom.load_database(str(path))
+    assert np.array_equal(back.primal, db.primal)
+    cli = run_cli_json("online", "--db", str(path), "--param", "0.2")
+    r = contactrom.ReducedModel(back).solve(0.2)
+    assert r.coefficients.tolist() == pytest.approx(cli["coefficients"], rel=1e-12)
+
+
+def test_offline_at_given_parameters():
+    problem = contactrom.problem("hertz")
+    params = np.array([[0.05], [0.1], [0.25]])
+    db = contactrom.offline(problem, params, threads=1)
+    assert np.array_equal(db.parameters, params)
+    fom = contactrom.FullOrderSolver(problem)
+    for j, mu in enumerate(params):
+        assert np.array_equal(db.dual[j], fom.solve(mu).lam)
+
+
+def test_model_owns_problem_and_database(hertz_db_path):
+    rom = contactrom.ReducedModel(contactrom.load_database(str(hertz_db_path)), method="greedy")
+    gc.collect()
+    r = rom.solve(0.1)
+    assert r.status == "success"
+    assert rom.database.num_snapshots == HERTZ_TRAIN
+    basis = rom.basis
+    del rom
+    gc.collect()
+    assert np.isfinite(basis).all()  # the view keeps the model alive
+
+
+@pytest.mark.parametrize("method,options", [("cpg", {"cpg_tolerance": 1e-2}), ("full-dictionary", {}),
+                                            ("greedy", {"max_iterations": 20, "tau": 1e-8})])
+def test_other_methods_and_options(db, method, options):
+    rom = contactrom.ReducedModel(db, method=method, options=options)
+    assert rom.method == method
+    r = rom.solve(0.2)
+    assert r.status == "success"
+    report = contactrom.verify(rom.problem, 0.2, r.u, r.lam)
+    assert report["kkt"]["stationarity"] < 1e-2
+
+
+def test_solve_all_equals_single_solves(rom):
+    params = np.linspace(0.01, 0.3, 5)
+    results = rom.solve_all(params)
+    for mu, r in zip(params, results):
+        assert r.selected == rom.solve(mu).selected
+
+
+QUERY_PARAMS = [0.0137, 0.1, 0.2999]
+
+
+def query_cli(tmp_path, rom_path):
+    csv = tmp_path / "params.csv"
+    csv.write_text("d\n" + "\n".join(repr(p) for p in QUERY_PARAMS) + "\n")
+    return run_cli_json("query", "--rom", str(rom_path), "--params", str(csv))["queries"]
+
+
+def assert_same_answers(model, queries):
+    assert len(queries) == len(QUERY_PARAMS)
+    for q, mu in zip(queries, QUERY_PARAMS):
+        r = model.solve(mu)
+        assert r.status == q["status"] and r.iterations == q["iterations"]
+        assert [model.dictionary_snapshots[c] for c in r.selected] == q["selected"]
+        assert np.allclose(r.coefficients, q["coefficients"], rtol=1e-12, atol=0.0)
+        assert model.problem.contact_force(r.lam) == pytest.approx(q["contact_force"], rel=1e-12)
+
+
+def test_saved_model_answers_as_cli_query(tmp_path, rom):
+    path = tmp_path / "rom.h5"
+    rom.save(str(path))
+    queries = query_cli(tmp_path, path)
+    assert_same_answers(rom, queries)
+    loaded = contactrom.ReducedModel.load(str(path))
+    assert loaded.database is None
+    assert (loaded.method, loaded.primal_rank, loaded.dictionary_size) == (rom.method, rom.primal_rank,
+                                                                          rom.dictionary_size)
+    assert_same_answers(loaded, queries)
+
+
+def test_cli_reduced_model_loads_in_python(tmp_path, hertz_db_path):
+    path = tmp_path / "cpg.h5"
+    run_cli("reduce", "--db", str(hertz_db_path), "--method", "cpg", "--option", "cpg_tolerance=0.01",
+            "--out", str(path))
+    loaded = contactrom.ReducedModel.load(str(path))
+    assert loaded.method == "cpg"
+    assert float(loaded.options["cpg_tolerance"]) == 0.01
+    assert_same_answers(loaded, query_cli(tmp_path, path))
+    with pytest.raises(ValueError, match="needs params"):
+        loaded.evaluate()
+    report = loaded.evaluate(QUERY_PARAMS, threads=1)
+    assert report["validation_size"] == len(QUERY_PARAMS)
