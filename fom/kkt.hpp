@@ -4,7 +4,9 @@
 ///
 /// For a candidate (u, λ) at parameter μ, the pairing is recomputed from u in the
 /// deformed configuration and C(u), g(u) assembled. Residuals, all relative:
-///  - stationarity: \f$ \|K u_0 - f + C^T\lambda\|_2 / \|f\|_2 \f$ on free dofs,
+///  - stationarity: \f$ \|K u_0 - f + C^T\lambda\|_2 / \max(\|K u_0\|_2, \|f\|_2, \|C^T\lambda\|_2) \f$
+///    on free dofs (\f$u_0\f$: u minus the lifting; a normwise backward error, at most 3,
+///    and meaningful also when the load vanishes),
 ///  - penetration: \f$ \max_s (C u - g)_s^+ / (w_s\, U) \f$ (gap per node in units
 ///    of the problem's displacement scale U),
 ///  - negative pressure: \f$ \max_s (-\lambda_s)^+ / \|\lambda\|_\infty \f$,
@@ -54,6 +56,29 @@ double relative_h1_error(const Problem& problem, const Eigen::VectorXd& u, const
 /// \brief Relative L²(Γc) error of pressures (absolute if the reference is zero).
 double relative_l2_pressure_error(const Problem& problem, const Eigen::VectorXd& lambda,
                                   const Eigen::VectorXd& lambda_ref);
+
+/// \brief A reference displacement whose H¹ norm is below this fraction of the
+/// problem's scale \f$ U\,\|\mathbf 1\|_{H^1} \f$ (U the displacement scale, \f$\mathbf 1\f$
+/// the field equal to 1 in every component, so the scale is U times the square root
+/// of the domain's measure per component) counts as near zero: errors against it are
+/// reported absolute, since a relative error divides by round-off there.
+constexpr double kNearZeroReference = 1e-6;
+
+/// \brief Errors of a candidate against a reference, relative unless the reference is near zero.
+struct ReferenceErrors {
+  /// \f$ \|u-u_{ref}\|_{H^1} / \|u_{ref}\|_{H^1} \f$, or \f$ \|u-u_{ref}\|_{H^1} \f$ when `absolute`.
+  double primal = 0.0;
+  /// \f$ \|\lambda-\lambda_{ref}\|_{L^2(\Gamma_c)} / \|\lambda_{ref}\|_{L^2(\Gamma_c)} \f$, or the
+  /// numerator alone when `absolute` (or when λ_ref = 0).
+  double dual = 0.0;
+  /// The reference displacement is near zero (kNearZeroReference): both errors are absolute.
+  bool absolute = false;
+};
+
+/// \brief Errors of (u, λ) against (u_ref, λ_ref): relative, or absolute when the
+/// reference displacement is near zero (see kNearZeroReference).
+ReferenceErrors reference_errors(const Problem& problem, const Eigen::VectorXd& u, const Eigen::VectorXd& lambda,
+                                 const Eigen::VectorXd& u_ref, const Eigen::VectorXd& lambda_ref);
 
 /// \brief Total contact force \f$ \sum_s w_s \lambda_s \f$ (per unit thickness).
 double contact_force(const Problem& problem, const Eigen::VectorXd& lambda);

@@ -2,14 +2,23 @@
 
 #include "fom/data_directory.hpp"
 
+#include <fcntl.h>
 #include <gmsh.h>
+#include <poll.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
 #include <clocale>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -419,61 +428,168 @@ std::string Mesh::fingerprint() const {
 
 namespace {
 
-/// The mesh file gmsh is reading (empty: none). A .geo file is a program: its
-/// `Exit;` command makes gmsh call exit(0) in the middle of the session. The exit
-/// handler below turns that into a one-line error and exit code 2 instead of a
-/// silent success with no output.
-/// A plain buffer, not a std::string: it must outlive static destructors, which
-/// exit() runs before the handler.
-char g_mesh_being_read[4096] = "";
+// --- gmsh in a child process --------------------------------------------------
+//
+// A .geo file is a program, and gmsh can end the process that reads it: `Exit;`
+// calls exit(0), some options and inputs crash it (Mesh.Algorithm = 8 segfaults in
+// gmsh 4.8.4), a NaN radius makes it loop forever. load_mesh therefore runs gmsh in
+// a forked child process that sends the finished Mesh (or an error message) back
+// through a pipe. Whatever gmsh does to that child — exit, crash, hang, print — the
+// caller sees an InputError naming the file, with its own state untouched: no exit
+// handler of the caller runs, nothing reaches its stdout, and a half-written output
+// file of the caller cannot be closed or flushed by gmsh's exit. The child starts
+// with a fresh gmsh (none runs in the caller), so no gmsh state survives from one
+// call to the next either.
 
-void refuse_exit_inside_gmsh() {
-  if (g_mesh_being_read[0] == '\0') return;
-  std::fprintf(stderr,
-               "contactrom: error: mesh '%s' ended the program while gmsh read it (an Exit command or a fatal gmsh "
-               "error); a .geo file is a program: expected one that only builds a mesh\n",
-               g_mesh_being_read);
-  std::fflush(stderr);
-  std::_Exit(2);
-}
+/// Exit code of a child in which gmsh called exit() (a `.geo` `Exit` command).
+constexpr int kChildCalledExit = 121;
+/// Message tags on the pipe: a mesh follows, or an error message follows.
+constexpr char kMeshFollows = 'M', kErrorFollows = 'E';
 
-/// Marks `path` as being read for the lifetime of the guard.
-class MeshReadGuard {
+/// Binary form of a Mesh on the pipe (same machine, so native byte order).
+class MeshWriter {
  public:
-  explicit MeshReadGuard(const std::string& path) {
-    static const bool registered = std::atexit(refuse_exit_inside_gmsh) == 0;
-    (void)registered;
-    std::snprintf(g_mesh_being_read, sizeof g_mesh_being_read, "%s", path.c_str());
+  template <class T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    m_bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
   }
-  ~MeshReadGuard() { g_mesh_being_read[0] = '\0'; }
-  MeshReadGuard(const MeshReadGuard&) = delete;
-  MeshReadGuard& operator=(const MeshReadGuard&) = delete;
+  void put(const std::string& s) {
+    put<std::uint64_t>(s.size());
+    m_bytes += s;
+  }
+  template <class T>
+  void put_vector(const std::vector<T>& v) {
+    put<std::uint64_t>(v.size());
+    m_bytes.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+  std::string& bytes() { return m_bytes; }
+
+ private:
+  std::string m_bytes;
 };
 
-}  // namespace
+class MeshReader {
+ public:
+  MeshReader(const std::string& bytes, std::string where) : m_bytes(bytes), m_where(std::move(where)) {}
+  template <class T>
+  T get() {
+    T v;
+    std::memcpy(&v, take(sizeof v), sizeof v);
+    return v;
+  }
+  std::string get_string() {
+    const std::size_t n = count(1);
+    return std::string(take(n), n);
+  }
+  template <class T>
+  std::vector<T> get_vector() {
+    const std::size_t n = count(sizeof(T));
+    std::vector<T> v(n);
+    if (n > 0) std::memcpy(v.data(), take(n * sizeof(T)), n * sizeof(T));
+    return v;
+  }
 
-Mesh load_mesh(const std::string& path, const MeshOptions& options) {
-  if (options.refine < 0 || options.refine > MeshOptions::kMaxRefine)
-    throw InputError("mesh refinement " + std::to_string(options.refine) + " invalid; expected an integer in 0.." +
-                     std::to_string(MeshOptions::kMaxRefine));
+ private:
+  std::size_t count(std::size_t item) {
+    const auto n = get<std::uint64_t>();
+    if (n > (m_bytes.size() - m_pos) / item) broken();
+    return static_cast<std::size_t>(n);
+  }
+  const char* take(std::size_t n) {
+    if (n > m_bytes.size() - m_pos) broken();
+    const char* p = m_bytes.data() + m_pos;
+    m_pos += n;
+    return p;
+  }
+  [[noreturn]] void broken() const { throw InputError(m_where + ": the gmsh process sent an incomplete mesh"); }
 
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh file '" + path + "' not found");
-  if (!std::ifstream(path)) throw InputError("mesh file '" + path + "' is not readable");
+  const std::string& m_bytes;
+  std::string m_where;
+  std::size_t m_pos = 0;
+};
+
+std::string serialize(const Mesh& mesh) {
+  MeshWriter w;
+  w.put(kMeshFollows);
+  w.put_vector(std::vector<double>(mesh.nodes.data(), mesh.nodes.data() + mesh.nodes.size()));
+  w.put_vector(mesh.quads);
+  w.put_vector(mesh.quad_body);
+  w.put<std::uint64_t>(mesh.body_names.size());
+  for (const auto& name : mesh.body_names) w.put(name);
+  w.put<std::uint64_t>(mesh.segments.size());
+  for (const auto& [name, segs] : mesh.segments) w.put(name), w.put_vector(segs);
+  w.put<std::uint64_t>(mesh.curve_nodes.size());
+  for (const auto& [name, nodes] : mesh.curve_nodes) w.put(name), w.put_vector(nodes);
+  return std::move(w.bytes());
+}
+
+Mesh deserialize(const std::string& bytes, const std::string& where) {
+  MeshReader r(bytes, where);
+  if (r.get<char>() != kMeshFollows) throw InputError(where + ": the gmsh process sent no mesh");
+  Mesh mesh;
+  const auto coords = r.get_vector<double>();
+  mesh.nodes = Eigen::Map<const Eigen::Matrix2Xd>(coords.data(), 2, static_cast<Eigen::Index>(coords.size() / 2));
+  mesh.quads = r.get_vector<std::array<int, 4>>();
+  mesh.quad_body = r.get_vector<int>();
+  for (auto n = r.get<std::uint64_t>(); n > 0; --n) mesh.body_names.push_back(r.get_string());
+  for (auto n = r.get<std::uint64_t>(); n > 0; --n) {
+    std::string name = r.get_string();
+    mesh.segments[name] = r.get_vector<std::array<int, 2>>();
+  }
+  for (auto n = r.get<std::uint64_t>(); n > 0; --n) {
+    std::string name = r.get_string();
+    mesh.curve_nodes[name] = r.get_vector<int>();
+  }
+  return mesh;
+}
+
+std::size_t node_count() {
+  std::vector<std::size_t> tags;
+  std::vector<double> coord, param;
+  gmsh::model::mesh::getNodes(tags, coord, param, -1, -1, false, false);
+  return tags.size();
+}
+
+std::size_t surface_element_count() {
+  std::vector<int> types;
+  std::vector<std::vector<std::size_t>> element_tags, node_tags;
+  gmsh::model::mesh::getElements(types, element_tags, node_tags, 2, -1);
+  std::size_t n = 0;
+  for (const auto& tags : element_tags) n += tags.size();
+  return n;
+}
+
+std::string refined_times(int refine) {
+  return refine == 0 ? std::string() : " refined " + std::to_string(refine) + (refine == 1 ? " time" : " times");
+}
+
+[[noreturn]] void refuse_size(const std::string& where, const std::string& count, int refine, long long limit) {
+  throw InputError(where + refined_times(refine) + " has " + count + " nodes, above the limit of " +
+                   std::to_string(limit) + " (max_mesh_nodes)");
+}
+
+/// Reads, meshes and refines the file with gmsh in this process (the child).
+Mesh mesh_with_gmsh(const std::string& path, const MeshOptions& options) {
   const std::string where = "mesh '" + path + "'";
-  const std::string ext = lower_extension(path);
-
   GmshSession session;
-  const MeshReadGuard guard(path);
   try {
     gmsh::open(path);
     if (std::string err = session.take_first_error(); !err.empty())
       throw InputError(where + ": gmsh could not read it: " + err);
-    if (ext == ".geo") {
+    if (lower_extension(path) == ".geo") {
       gmsh::model::mesh::generate(2);
       if (std::string err = session.take_first_error(); !err.empty())
         throw InputError(where + ": gmsh meshing failed: " + err);
     }
+    if (const std::size_t n = node_count(); n > static_cast<std::size_t>(options.max_nodes))
+      refuse_size(where, std::to_string(n), 0, options.max_nodes);
+    // Each level multiplies the surface elements by four, and a quad mesh has at
+    // least as many nodes as quads: refuse before refining what would be too large.
+    const double at_least = static_cast<double>(surface_element_count()) * std::pow(4.0, options.refine);
+    if (at_least > static_cast<double>(options.max_nodes))
+      refuse_size(where, "at least " + std::to_string(static_cast<long long>(at_least)), options.refine,
+                  options.max_nodes);
     // gmsh's refine splits each quad in four through its mid-edge and centre nodes,
     // placed on the model's curves and surfaces (not at straight-line midpoints)
     // because Mesh.SecondOrderLinear is 0 by default.
@@ -482,7 +598,10 @@ Mesh load_mesh(const std::string& path, const MeshOptions& options) {
       if (std::string err = session.take_first_error(); !err.empty())
         throw InputError(where + ": gmsh refinement failed: " + err);
     }
-    return read_current_model(where);
+    Mesh mesh = read_current_model(where);
+    if (mesh.num_nodes() > options.max_nodes)
+      refuse_size(where, std::to_string(mesh.num_nodes()), options.refine, options.max_nodes);
+    return mesh;
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
@@ -492,6 +611,127 @@ Mesh load_mesh(const std::string& path, const MeshOptions& options) {
     std::string err = session.take_first_error();
     throw InputError(where + ": gmsh failed" + (err.empty() ? std::string() : ": " + err));
   }
+}
+
+void write_all(int fd, const std::string& bytes) {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;  // the parent went away: nothing left to tell
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+/// The child: gmsh with default signal handling, no core file, stdout to /dev/null,
+/// and an exit handler that turns gmsh's exit() into a recognisable exit code
+/// before any handler inherited from the parent runs. Never returns.
+[[noreturn]] void run_child(int fd, const std::string& path, const MeshOptions& options) {
+  for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
+  const struct rlimit no_core = {0, 0};
+  ::setrlimit(RLIMIT_CORE, &no_core);
+  if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) ::dup2(null, STDOUT_FILENO), ::close(null);
+  std::atexit([] { ::_exit(kChildCalledExit); });  // registered last, runs first
+  std::string message;
+  try {
+    message = serialize(mesh_with_gmsh(path, options));
+  } catch (const std::exception& e) {
+    message = std::string(1, kErrorFollows) + e.what();
+  } catch (...) {
+    message = std::string(1, kErrorFollows) + "mesh '" + path + "': gmsh failed";
+  }
+  write_all(fd, message);
+  ::_exit(0);
+}
+
+std::string signal_name(int sig) {
+  switch (sig) {
+    case SIGSEGV: return "SIGSEGV";
+    case SIGBUS: return "SIGBUS";
+    case SIGFPE: return "SIGFPE";
+    case SIGILL: return "SIGILL";
+    case SIGABRT: return "SIGABRT";
+    case SIGKILL: return "SIGKILL";
+    default: return "signal " + std::to_string(sig);
+  }
+}
+
+/// Forks, meshes in the child, and reads the child's answer within the time limit.
+Mesh mesh_in_child_process(const std::string& path, const MeshOptions& options) {
+  const std::string where = "mesh '" + path + "'";
+  int fds[2];
+  if (::pipe(fds) != 0) throw std::runtime_error(where + ": cannot create a pipe: " + std::strerror(errno));
+  std::fflush(nullptr);  // nothing buffered may be written twice
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]), ::close(fds[1]);
+    throw std::runtime_error(where + ": cannot start a process for gmsh: " + std::strerror(errno));
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    run_child(fds[1], path, options);
+  }
+  ::close(fds[1]);
+  std::string bytes;
+  bool timed_out = false;
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(options.time_limit_s);
+  char buffer[1 << 16];
+  for (;;) {
+    const double left = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+    if (left <= 0) {
+      timed_out = true;
+      break;
+    }
+    struct pollfd p = {fds[0], POLLIN, 0};
+    const int ready = ::poll(&p, 1, static_cast<int>(std::min(left * 1000.0 + 1.0, 60000.0)));
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready <= 0) continue;
+    const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;  // end of file: the child is done (or gone)
+    bytes.append(buffer, static_cast<std::size_t>(n));
+  }
+  ::close(fds[0]);
+  if (timed_out) ::kill(pid, SIGKILL);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (timed_out) {
+    std::ostringstream limit;
+    limit << options.time_limit_s;
+    throw InputError(where + ": gmsh did not finish within the time limit of " + limit.str() +
+                     " s (mesh_time_limit); stopped");
+  }
+  if (WIFSIGNALED(status))
+    throw InputError(where + ": gmsh crashed (" + signal_name(WTERMSIG(status)) +
+                     ") while reading or meshing it; expected a file gmsh can mesh");
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (!bytes.empty() && bytes[0] == kErrorFollows && code == 0) throw InputError(bytes.substr(1));
+  if (code == 0 && !bytes.empty()) return deserialize(bytes, where);
+  if (code == kChildCalledExit || code == 0)
+    throw InputError(where + " ended the program while gmsh read it (an Exit command); a .geo file is a program: "
+                             "expected one that only builds a mesh");
+  throw InputError(where + ": gmsh ended with exit code " + std::to_string(code) + " while reading or meshing it");
+}
+
+}  // namespace
+
+Mesh load_mesh(const std::string& path, const MeshOptions& options) {
+  if (options.refine < 0 || options.refine > MeshOptions::kMaxRefine)
+    throw InputError("mesh refinement " + std::to_string(options.refine) + " invalid; expected an integer in 0.." +
+                     std::to_string(MeshOptions::kMaxRefine));
+  if (options.max_nodes < 1)
+    throw InputError("mesh node limit (max_nodes) " + std::to_string(options.max_nodes) +
+                     " invalid; expected a positive integer");
+  if (!(options.time_limit_s > 0) || !std::isfinite(options.time_limit_s))
+    throw InputError("mesh time limit " + std::to_string(options.time_limit_s) +
+                     " s invalid; expected a positive number of seconds");
+
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh file '" + path + "' not found");
+  if (!std::ifstream(path)) throw InputError("mesh file '" + path + "' is not readable");
+  return mesh_in_child_process(path, options);
 }
 
 std::string mesh_directory() { return data_directory("meshes", "CONTACTROM_MESH_DIR"); }

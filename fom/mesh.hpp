@@ -60,6 +60,16 @@ struct MeshOptions {
   int refine = 0;
   /// Largest accepted `refine` (8 levels multiply the node count by about 65536).
   static constexpr int kMaxRefine = 8;
+  /// Largest accepted number of nodes of the mesh, after refinement (problem files:
+  /// `[problem] max_mesh_nodes`). A larger mesh is an InputError naming its count and
+  /// the limit; a refinement that would exceed it is refused before it runs, from the
+  /// element count. Must be >= 1; default 1,000,000 (about 2 M dofs).
+  long long max_nodes = 1000000;
+  /// Wall-clock limit of gmsh's reading, meshing and refinement, in seconds (problem
+  /// files: `[problem] mesh_time_limit`); gmsh is stopped and an InputError names the
+  /// file when it runs longer (e.g. a `.geo` with a NaN radius loops forever). Must be
+  /// > 0; default 600.
+  double time_limit_s = 600.0;
 };
 
 /// \brief Meshes a `.geo` file (or reads a `.msh`) with the gmsh API and returns
@@ -74,17 +84,19 @@ struct MeshOptions {
 ///
 /// A `.geo` file is a gmsh program, not data: it can run shell commands
 /// (`System`), loop, or end the process (`Exit`). Read only trusted `.geo` files;
-/// a `.msh` file is data. A `.geo` that ends the process while it is read makes
-/// contactrom print one error line naming it and exit with code 2.
+/// a `.msh` file is data. gmsh runs in a child process (fork) that sends the mesh
+/// back: a `.geo` that ends the process (`Exit`), a gmsh crash (e.g.
+/// `Mesh.Algorithm = 8` in gmsh 4.8.4) or gmsh running past `time_limit_s` is an
+/// InputError naming the file, and the caller's process, its exit handlers and its
+/// stdout are untouched (the child's stdout goes to /dev/null).
 ///
-/// Each call opens and closes its own gmsh session (initialize ... finalize,
-/// no config files, nothing printed), so it may be called any number of times,
-/// but NOT concurrently from several threads, and not while the caller itself
-/// holds a gmsh session (gmsh keeps its state in globals). Keep it out of hot
-/// loops: a session costs about 0.01-0.1 s.
+/// Each call starts its own gmsh (no config files, nothing printed), so it may be
+/// called any number of times, also while the caller holds a gmsh session of its
+/// own. Keep it out of hot loops: a call costs about 0.01-0.1 s.
 /// \param path file to read
 /// \param options refinement (see MeshOptions)
-/// \throws InputError if `options.refine` is outside 0..MeshOptions::kMaxRefine, if the file is missing ("mesh file 'X' not found"),
+/// \throws InputError if `options.refine` is outside 0..MeshOptions::kMaxRefine, if the mesh has more than
+///   `options.max_nodes` nodes, if gmsh exits, crashes or runs past `options.time_limit_s`, if the file is missing ("mesh file 'X' not found"),
 ///   unreadable, rejected by gmsh (syntax error, meshing error; the message names
 ///   the file and quotes gmsh), produces non-quad elements, lacks physical
 ///   groups, or has a curve group that is not a single chain.

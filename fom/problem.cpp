@@ -362,6 +362,8 @@ std::unique_ptr<Problem> make_problem(const std::string& name_or_path, const Pro
   def.refine += options.refine;
   MeshOptions mesh_options;
   mesh_options.refine = def.refine;
+  mesh_options.max_nodes = def.max_mesh_nodes;
+  mesh_options.time_limit_s = def.mesh_time_limit;
   Mesh mesh = load_mesh(def.mesh, mesh_options);
   return build_problem(std::move(def), std::move(mesh));
 }

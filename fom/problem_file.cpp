@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <toml++/toml.h>
@@ -156,7 +157,8 @@ class Reader {
 
   void read_problem(const toml::table* t) {
     const std::string p = "problem.";
-    allow_keys(*t, p, {"name", "mesh", "formulation", "refine", "displacement_scale"});
+    allow_keys(*t, p,
+               {"name", "mesh", "formulation", "refine", "displacement_scale", "max_mesh_nodes", "mesh_time_limit"});
     m_def.name = string(*t, p, "name", true);
     for (char ch : m_def.name)
       if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.'))
@@ -171,6 +173,12 @@ class Reader {
            "'" + formulation + "' is unknown; expected \"plane_strain\" or \"plane_stress\"");
     m_def.plane_stress = formulation == "plane_stress";
     m_def.refine = static_cast<int>(integer(*t, p, "refine", 0, 0, 6));
+    m_def.max_mesh_nodes = integer(*t, p, "max_mesh_nodes", static_cast<long>(m_def.max_mesh_nodes), 1,
+                                   std::numeric_limits<long>::max());
+    if (const toml::node* n = t->get("mesh_time_limit")) {
+      m_def.mesh_time_limit = number(n, p + "mesh_time_limit");
+      if (!(m_def.mesh_time_limit > 0)) fail(n, p + "mesh_time_limit", "expected a positive number of seconds");
+    }
     if (const toml::node* n = t->get("displacement_scale")) {
       m_def.displacement_scale = number(n, p + "displacement_scale");
       if (!(m_def.displacement_scale > 0)) fail(n, p + "displacement_scale", "expected a positive number");

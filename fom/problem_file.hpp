@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "fom/mesh.hpp"
 #include "fom/parameter_space.hpp"
 #include "fom/sampling.hpp"
 
@@ -69,6 +70,8 @@ struct ProblemDefinition {
   std::string mesh;                      ///< mesh path, resolved against the file's folder
   bool plane_stress = false;             ///< `formulation = "plane_stress"` (unit thickness)
   int refine = 0;                        ///< uniform refinements of the mesh (each splits a quad in four)
+  long long max_mesh_nodes = MeshOptions{}.max_nodes;   ///< `[problem] max_mesh_nodes` (MeshOptions::max_nodes)
+  double mesh_time_limit = MeshOptions{}.time_limit_s;  ///< `[problem] mesh_time_limit` in s (MeshOptions::time_limit_s)
   double displacement_scale = 0.0;       ///< U for relative residuals; 0: max |Dirichlet value| over the box
   std::string builtin;                   ///< non-empty for problems written in C++ ("rope")
   ParameterSpace parameters;

@@ -383,8 +383,10 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
     on.u_hat.noalias() += res.alpha(j) * dict.reduced_coordinates().col(j);
   }
   res.sum_violation = std::abs(res.alpha.sum() - 1.0);
-  const double bf_norm = bf.norm();
-  const double residual = (a * res.alpha - bf).norm();
+  // stableNorm: at a vanishing load (d = 1e-300) the squares of bf underflow, and a
+  // zero norm made the residual absolute, i.e. tiny, and the query a success.
+  const double bf_norm = bf.stableNorm();
+  const double residual = (a * res.alpha - bf).stableNorm();
   res.projected_residual = bf_norm > 0.0 ? residual / bf_norm : residual;
   on.iterations = res.focuss_iterations;
   on.converged = status == Status::Success && settled;

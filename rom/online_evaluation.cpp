@@ -56,8 +56,10 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
     const fom::FomSolution& ref = references[i];
     EvaluationRow row;
     row.mu = params[i];
-    row.primal_error = fom::relative_h1_error(problem, res.u, ref.u);
-    row.dual_error = fom::relative_l2_pressure_error(problem, res.lambda, ref.lambda);
+    const fom::ReferenceErrors errors = fom::reference_errors(problem, res.u, res.lambda, ref.u, ref.lambda);
+    row.primal_error = errors.primal;
+    row.dual_error = errors.dual;
+    row.absolute_errors = errors.absolute;
     row.sparsity = static_cast<int>(res.selected.size());
     row.iterations = res.iterations;
     row.time_s = res.time_s;
@@ -70,10 +72,14 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
       row.kkt = fom::kkt_residuals(problem, params[i], res.u, res.lambda);
       s.max_kkt = std::max(s.max_kkt, row.kkt.max());
     }
-    s.mean_primal_error += row.primal_error;
-    s.max_primal_error = std::max(s.max_primal_error, row.primal_error);
-    s.mean_dual_error += row.dual_error;
-    s.max_dual_error = std::max(s.max_dual_error, row.dual_error);
+    if (row.absolute_errors) {
+      ++s.absolute_error_rows;
+    } else {
+      s.mean_primal_error += row.primal_error;
+      s.max_primal_error = std::max(s.max_primal_error, row.primal_error);
+      s.mean_dual_error += row.dual_error;
+      s.max_dual_error = std::max(s.max_dual_error, row.dual_error);
+    }
     s.mean_sparsity += row.sparsity;
     s.max_sparsity = std::max(s.max_sparsity, row.sparsity);
     s.mean_iterations += row.iterations;
@@ -84,8 +90,9 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
     s.rows.push_back(std::move(row));
   }
   const double n = std::max<double>(1.0, static_cast<double>(params.size()));
-  s.mean_primal_error /= n;
-  s.mean_dual_error /= n;
+  const double n_relative = std::max<double>(1.0, static_cast<double>(params.size() - s.absolute_error_rows));
+  s.mean_primal_error /= n_relative;
+  s.mean_dual_error /= n_relative;
   s.mean_sparsity /= n;
   s.mean_iterations /= n;
   s.mean_time_s /= n;
@@ -96,14 +103,14 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
 void write_evaluation_csv(const std::string& path, const fom::Problem& problem, const EvaluationSummary& summary) {
   write_file_atomically(path, [&](std::ostream& out) {
     for (const std::string& name : problem.param_names()) out << name << ',';
-    out << "primal_h1_error,dual_l2_error,sparsity,iterations,time_s,converged,status,selected\n";
+    out << "primal_h1_error,dual_l2_error,sparsity,iterations,time_s,converged,status,selected,errors\n";
     for (const EvaluationRow& row : summary.rows) {
       for (int k = 0; k < row.mu.size(); ++k) out << format_double(row.mu(k)) << ',';
       out << format_double(row.primal_error) << ',' << format_double(row.dual_error) << ',' << row.sparsity << ','
           << row.iterations << ',' << format_double(row.time_s) << ',' << (row.converged ? 1 : 0) << ','
           << to_string(row.status) << ',';
       for (size_t j = 0; j < row.selected.size(); ++j) out << (j ? " " : "") << row.selected[j];
-      out << '\n';
+      out << ',' << (row.absolute_errors ? "absolute" : "relative") << '\n';
     }
   });
 }

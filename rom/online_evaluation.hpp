@@ -163,8 +163,11 @@ std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& sol
 /// \brief One evaluated query.
 struct EvaluationRow {
   fom::Param mu;
-  double primal_error = 0.0;   ///< relative H¹ error against the FOM
-  double dual_error = 0.0;     ///< relative L²(Γc) error against the FOM
+  double primal_error = 0.0;   ///< relative H¹ error against the FOM (absolute if `absolute_errors`)
+  double dual_error = 0.0;     ///< relative L²(Γc) error against the FOM (absolute if `absolute_errors`)
+  /// The FOM displacement is near zero (fom::kNearZeroReference): the two errors are
+  /// absolute, since relative ones would divide by round-off.
+  bool absolute_errors = false;
   int sparsity = 0;            ///< |I|, number of selected dictionary columns
   int iterations = 0;
   double time_s = 0.0;         ///< online core time (OnlineResult::time_s)
@@ -189,8 +192,11 @@ struct EvaluationSummary {
   int dual_basis_size = 0;  ///< OnlineSolver::dual_basis_size()
   int primal_rank = 0;
   std::vector<EvaluationRow> rows;
+  /// Means and maxima of the relative errors: rows with absolute errors are left out
+  /// (counted in `absolute_error_rows`).
   double mean_primal_error = 0.0, max_primal_error = 0.0;
   double mean_dual_error = 0.0, max_dual_error = 0.0;
+  int absolute_error_rows = 0;  ///< rows whose errors are absolute (near-zero FOM displacement)
   double mean_sparsity = 0.0;
   int max_sparsity = 0;
   double mean_iterations = 0.0;
@@ -208,7 +214,8 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
 
 /// \brief Writes the rows as CSV (atomically): one column per parameter (named
 /// after it), then primal_h1_error, dual_l2_error, sparsity, iterations, time_s,
-/// converged (0/1), status, selected (space-separated database snapshot indices).
+/// converged (0/1), status, selected (space-separated database snapshot indices),
+/// errors ("relative", or "absolute" where the FOM displacement is near zero).
 void write_evaluation_csv(const std::string& path, const fom::Problem& problem, const EvaluationSummary& summary);
 
 /// \brief Median online time per query.

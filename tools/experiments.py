@@ -113,7 +113,7 @@ def read_rows(path):
         sel = r.get("selected", "").split()
         out.append({
             "params": [float(r[k]) for k in r if k not in {"primal_h1_error", "dual_l2_error", "sparsity", "iterations",
-                                                           "time_s", "converged", "status", "selected"}],
+                                                           "time_s", "converged", "status", "selected", "errors"}],
             "primal": float(r["primal_h1_error"]),
             "dual": float(r["dual_l2_error"]),
             "sparsity": int(r["sparsity"]),

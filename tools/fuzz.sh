@@ -2,7 +2,7 @@
 # Runs every libFuzzer target of fuzz/ for N seconds each (default 60) on a copy
 # of its seed corpus, and prints a one-line summary per target.
 #
-#   tools/fuzz.sh [N] [BUILD_DIR]
+#   tools/fuzz.sh [N] [BUILD_DIR] [TARGET...]     (default: every target)
 #
 # BUILD_DIR (default build-fuzz) is configured and built here if needed, with
 # clang: CC=clang CXX=clang++ cmake -DCONTACTROM_FUZZ=ON -DCONTACTROM_BUILD_TESTS=OFF.
@@ -18,6 +18,8 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
 fi
 targets="fuzz_csv fuzz_database"
 [ -f "$root/fom/problem_file.hpp" ] && targets="$targets fuzz_problem_file"
+[ -f "$root/rom/reduced_model_file.hpp" ] && targets="$targets fuzz_reduced_model"
+[ $# -gt 2 ] && { shift 2; targets="$*"; }
 cmake --build "$build" --target $targets >/dev/null || exit 100
 failures=0
 for target in $targets; do

@@ -247,3 +247,33 @@ BOOST_FIXTURE_TEST_CASE(geo_that_exits_is_an_error_not_a_silent_success, Fixture
   check_case({"fom --problem " + hertz_problem_next_to(meshes) + " --param 0.1 --json",
               "/hertz.geo' ended the program while gmsh read it", "", ""});
 }
+
+BOOST_FIXTURE_TEST_CASE(gmsh_crash_or_oversized_mesh_writes_nothing, Fixture) {
+  // Mesh.Algorithm = 8 segfaults inside gmsh 4.8.4: gmsh runs in a child process,
+  // and meshing precedes every output file, so the command fails cleanly.
+  const std::string meshes = file("meshes");
+  fs::create_directories(meshes);
+  {
+    std::ifstream in(std::string(CONTACTROM_SOURCE_DIR) + "/meshes/hertz.geo");
+    std::ofstream geo(meshes + "/hertz.geo");
+    geo << in.rdbuf() << "\nMesh.Algorithm = 8;\n";
+  }
+  const std::string problem = hertz_problem_next_to(meshes);
+  check_case({"fom --problem " + problem + " --param 0.1 --json --out " + file("fields"), "gmsh crashed (SIGSEGV)",
+              file("fields"), ""});
+  check_case({"offline --problem " + problem + " --train 3 --out " + file("s.h5"), "gmsh crashed", file("s.h5"), ""});
+  BOOST_TEST(temporaries_in(dir) == 0);
+
+  // The shipped mesh above a node limit of 100: the count and the limit are named.
+  std::string text = contactrom::test::slurp(std::string(CONTACTROM_SOURCE_DIR) + "/problems/hertz.toml");
+  const std::string from = "../meshes/hertz.geo\"";
+  text.replace(text.find(from), from.size(), std::string(CONTACTROM_SOURCE_DIR) + "/meshes/hertz.geo\"\nmax_mesh_nodes = 100");
+  std::ofstream(file("small.toml")) << text;
+  check_case({"offline --problem " + file("small.toml") + " --train 3 --out " + file("t.h5"), "above the limit of 100",
+              file("t.h5"), ""});
+  // The limits themselves are checked.
+  std::string bad = text;
+  bad.replace(bad.find("max_mesh_nodes = 100"), 20, "mesh_time_limit = -1");
+  std::ofstream(file("bad.toml")) << bad;
+  check_case({"fom --problem " + file("bad.toml") + " --param 0.1", "mesh_time_limit", "", ""});
+}

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -495,4 +496,110 @@ BOOST_AUTO_TEST_CASE(clockwise_quads_are_flipped_and_closed_curves_are_chained) 
   for (const auto& s : segs)
     area += 0.5 * (m.nodes(0, s[0]) * m.nodes(1, s[1]) - m.nodes(0, s[1]) * m.nodes(1, s[0]));
   BOOST_TEST(area == 1.0, boost::test_tools::tolerance(1e-12));
+}
+
+// ------------------------------------------- a .geo is a program (trusted code) --
+
+namespace {
+/// A unit square of n x n transfinite quads with one body and one curve group,
+/// after `prefix` (gmsh commands run first).
+std::string square_geo(const std::string& prefix, int n = 4) {
+  return prefix +
+         "Point(1) = {0, 0, 0}; Point(2) = {1, 0, 0}; Point(3) = {1, 1, 0}; Point(4) = {0, 1, 0};\n"
+         "Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};\n"
+         "Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};\n"
+         "Transfinite Curve{1, 2, 3, 4} = " + std::to_string(n + 1) +
+         "; Transfinite Surface{1}; Recombine Surface{1};\n"
+         "Physical Surface(\"square\") = {1}; Physical Curve(\"base\") = {1};\n";
+}
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(a_geo_that_ends_the_process_is_an_input_error_and_the_caller_lives_on) {
+  const TempFile geo("exit.geo", square_geo("Exit;\n"));
+  const std::string msg = input_error_of([&] { load_mesh(geo.path.string()); });
+  BOOST_TEST(contains(msg, geo.path.string()), msg);
+  BOOST_TEST(contains(msg, "ended the program"), msg);
+  // This process is still here, and gmsh still works.
+  BOOST_TEST(load_mesh(kMeshDir + "hertz.geo").fingerprint() == hertz().fingerprint());
+}
+
+BOOST_AUTO_TEST_CASE(a_gmsh_crash_is_an_input_error_naming_the_file) {
+  // Mesh.Algorithm = 8 (Frontal-Delaunay for quads) segfaults in gmsh 4.8.4.
+  const std::string crashing =
+      "Point(1) = {0,0,0,0.1}; Point(2) = {1,0,0,0.1}; Point(3) = {1,1,0,0.1}; Point(4) = {0,1,0,0.1};\n"
+      "Line(1) = {1,2}; Line(2) = {2,3}; Line(3) = {3,4}; Line(4) = {4,1};\n"
+      "Curve Loop(1) = {1,2,3,4}; Plane Surface(1) = {1}; Recombine Surface{1};\n"
+      "Mesh.Algorithm = 8;\n"
+      "Physical Surface(\"body\") = {1}; Physical Curve(\"base\") = {1};\n";
+  const TempFile geo("alg8.geo", crashing);
+  const std::string msg = input_error_of([&] { load_mesh(geo.path.string()); });
+  BOOST_TEST(contains(msg, geo.path.string()), msg);
+  BOOST_TEST(contains(msg, "gmsh crashed"), msg);
+  BOOST_TEST(load_mesh(kMeshDir + "ironing.geo").fingerprint() == ironing().fingerprint());
+}
+
+BOOST_AUTO_TEST_CASE(gmsh_running_past_the_time_limit_is_stopped) {
+  // A NaN radius makes gmsh 4.8.4 loop forever meshing the arc.
+  const TempFile geo("nan.geo",
+                     "r = Sqrt(-1);\n"
+                     "Point(1) = {0,0,0,0.1}; Point(2) = {r,0,0,0.1}; Point(3) = {0,r,0,0.1};\n"
+                     "Circle(1) = {2,1,3}; Line(2) = {1,2}; Line(3) = {3,1};\n"
+                     "Curve Loop(1) = {2,1,3}; Plane Surface(1) = {1}; Recombine Surface{1};\n"
+                     "Physical Surface(\"body\") = {1}; Physical Curve(\"base\") = {2};\n");
+  contactrom::fom::MeshOptions options;
+  options.time_limit_s = 2.0;
+  const auto start = std::chrono::steady_clock::now();
+  const std::string msg = input_error_of([&] { load_mesh(geo.path.string(), options); });
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  BOOST_TEST(contains(msg, geo.path.string()), msg);
+  BOOST_TEST(contains(msg, "2 s"), msg);
+  BOOST_TEST(elapsed < 30.0);
+}
+
+BOOST_AUTO_TEST_CASE(a_mesh_above_the_node_limit_is_refused_with_its_count) {
+  const TempFile geo("square.geo", square_geo("", 10));  // 121 nodes
+  contactrom::fom::MeshOptions options;
+  options.max_nodes = 120;
+  std::string msg = input_error_of([&] { load_mesh(geo.path.string(), options); });
+  BOOST_TEST(contains(msg, geo.path.string()), msg);
+  BOOST_TEST(contains(msg, "121 nodes"), msg);
+  BOOST_TEST(contains(msg, "limit of 120"), msg);
+  options.max_nodes = 121;
+  BOOST_TEST(load_mesh(geo.path.string(), options).num_nodes() == 121);
+  // Refinement is refused before it runs: 100 quads refined 3 times are 6400 quads.
+  options.max_nodes = 5000;
+  options.refine = 3;
+  msg = input_error_of([&] { load_mesh(geo.path.string(), options); });
+  BOOST_TEST(contains(msg, "refined 3 times"), msg);
+  BOOST_TEST(contains(msg, "limit of 5000"), msg);
+  options.max_nodes = 0;
+  BOOST_TEST(contains(input_error_of([&] { load_mesh(geo.path.string(), options); }), "max_nodes"));
+}
+
+BOOST_AUTO_TEST_CASE(nothing_gmsh_prints_reaches_stdout) {
+  // A .geo that prints: its output must not reach this process's stdout (--json).
+  const TempFile geo("printf.geo", square_geo("Printf(\"from the geo file\");\nGeneral.Terminal = 1;\n"
+                                              "Printf(\"again\");\n"));
+  std::fflush(stdout);
+  const int saved = ::dup(1);
+  const TempFile captured("stdout.txt", "");
+  std::FILE* f = std::fopen(captured.path.c_str(), "w");
+  ::dup2(::fileno(f), 1);
+  const Mesh m = load_mesh(geo.path.string());
+  std::fflush(stdout);
+  ::dup2(saved, 1);
+  ::close(saved);
+  std::fclose(f);
+  std::ifstream in(captured.path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  BOOST_TEST(text.empty(), text);
+  BOOST_TEST(m.num_quads() == 16);
+}
+
+BOOST_AUTO_TEST_CASE(a_msh_written_by_gmsh_gives_the_same_mesh_as_its_geo) {
+  // The safe way to pass a mesh on: mesh the trusted .geo once, hand over the .msh.
+  const TempFile msh("hertz.msh", "");
+  const std::string command = "gmsh -2 " + kMeshDir + "hertz.geo -o " + msh.path.string() + " > /dev/null 2>&1";
+  BOOST_REQUIRE_MESSAGE(std::system(command.c_str()) == 0, command);
+  BOOST_TEST(load_mesh(msh.path.string()).fingerprint() == hertz().fingerprint());
 }
