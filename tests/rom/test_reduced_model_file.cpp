@@ -12,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/database_checks.hpp"
 #include "common/run_command.hpp"
 #include "fom/problem.hpp"
 #include "rom/offline.hpp"
@@ -23,23 +24,11 @@ using contactrom::fom::Param;
 using contactrom::rom::OnlineModel;
 using contactrom::rom::OnlineResult;
 using contactrom::test::run_command;
+using contactrom::test::work_dir;
 
 namespace {
 
 const std::string exe = CONTACTROM_EXE;
-
-struct WorkDir {
-  std::string path = contactrom::test::temp_dir();
-  ~WorkDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
-
-const std::string& work_dir() {
-  static const WorkDir dir;
-  return dir.path;
-}
 
 std::shared_ptr<const contactrom::fom::Problem> hertz() {
   static std::shared_ptr<const contactrom::fom::Problem> p = contactrom::fom::make_problem("hertz");
