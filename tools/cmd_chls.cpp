@@ -227,8 +227,10 @@ CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
   add_number(sub, "--sum-weight", args->sum_weight, "weight of the convexity row, relative (default 0.1)", Interval::greater_than(0));
   sub->add_flag("--no-polish", args->no_polish, "keep the plain nnFOCUSS coefficients (no exact simplex re-solve)");
   add_integer(sub, "--max-pairing-iterations", args->max_pairing_iterations, "pairing fixed-point cap (default 20)", 1, 100000);
-  sub->add_option("--option", args->options,
-                  "further convex-hull setting KEY=VALUE (repeatable; keys: see rom/convex_hull.hpp)");
+  std::string keys;
+  for (const rom::OptionSpec& spec : rom::online_method("convex-hull").options)
+    keys += (keys.empty() ? "" : ", ") + spec.key;
+  sub->add_option("--option", args->options, "further convex-hull setting KEY=VALUE (repeatable; keys: " + keys + ")");
   sub->add_option("--out", args->out, "CSV file, one row per query")
       ->check(non_empty_path());
   add_integer(sub, "--threads", args->threads, "threads for the FOM references (default: hardware concurrency)", 1, 1024);

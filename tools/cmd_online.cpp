@@ -154,6 +154,9 @@ void run_online(const OnlineArgs& a) {
   if (!a.out.empty() && a.param.empty()) check_output_path(a.out);
   if (!a.param.empty() && a.validation)
     throw InputError("--param and --validation exclude each other; give one");
+  if (!a.param.empty() && a.out.size() >= 4 && a.out.compare(a.out.size() - 4, 4, ".csv") == 0)
+    throw InputError("--out '" + a.out + "' with --param names the folder of the VTU/CSV fields, not a CSV file; "
+                     "expected a folder name (a CSV of results comes from --validation or contactrom query --out)");
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
   const rom::OnlineSolverOptions options = a.solver_options();

@@ -96,6 +96,8 @@ BOOST_FIXTURE_TEST_CASE(options_and_parameters, Fixture) {
       {"online --db " + rope_db + " --tau inf", "--tau 'inf'", "", ""},
       {"online --db " + rope_db + " --delta -1", "--delta '-1'", "", ""},
       {"online --db " + rope_db + " --max-iterations 2.5", "'2.5'", "", ""},
+      // With --param, --out names a folder: a .csv name is refused, not made a folder.
+      {"online --db " + rope_db + " --param 20 --out " + file("res.csv"), "res.csv", file("res.csv"), ""},
       {"online --db " + rope_db + " --method cpg --option cpg_tolerance=nan", "'nan'", "", ""},
       {"online --db " + rope_db + " --param 60", "'60'", "", ""},
       {"online --db " + rope_db + " --method nosuch", "'nosuch'", "", ""},
