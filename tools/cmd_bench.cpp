@@ -118,12 +118,23 @@ void run_bench(const BenchArgs& a) {
   }
   std::cout << "contactrom bench: " << problem->name() << ", training " << n << ", delta " << a.delta << ", "
             << r.queries << " queries x " << a.repeats << " repeats (median seconds per query)\n";
+  // One column of names wide enough for the longest (ratio names run to 70 characters).
+  std::vector<std::pair<std::string, double>> times, quotients;
   for (auto it = j.begin(); it != j.end(); ++it)
     if ((it.key().rfind("fom_", 0) == 0 || it.key().rfind("rom_", 0) == 0) && it.value().is_number())
-      std::cout << "  " << std::left << std::setw(40) << it.key() << std::setprecision(4) << it.value().get<double>() << "\n";
+      times.emplace_back(it.key(), it.value().get<double>());
+  for (auto it = ratios.begin(); it != ratios.end(); ++it) quotients.emplace_back(it.key(), it.value().get<double>());
+  size_t width = 0;
+  for (const auto* list : {&times, &quotients})
+    for (const auto& [key, value] : *list) width = std::max(width, key.size());
+  const auto print = [width](const std::vector<std::pair<std::string, double>>& list) {
+    for (const auto& [key, value] : list)
+      std::cout << "  " << std::left << std::setw(static_cast<int>(width + 2)) << key << std::setprecision(4) << value
+                << "\n";
+  };
+  print(times);
   std::cout << "ratios:\n";
-  for (auto it = ratios.begin(); it != ratios.end(); ++it)
-    std::cout << "  " << std::left << std::setw(40) << it.key() << std::setprecision(4) << it.value().get<double>() << "\n";
+  print(quotients);
 }
 
 CommandRegistrar reg("bench", [](CLI::App& app) {

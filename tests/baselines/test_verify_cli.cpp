@@ -150,6 +150,23 @@ BOOST_AUTO_TEST_CASE(bench_on_a_database_skips_the_offline_stage) {
   BOOST_TEST(j["snapshots"] == 17);
   BOOST_TEST(j["offline_s"].get<double>() == 0.0);
   BOOST_TEST(j["rom_greedy"].get<double>() > 0.0);
+  // The text output: every time and ratio line is a name, blanks, then a number.
+  const auto text = run_command(exe + " bench --db " + dbs().ironing + " --repeats 1 --queries 2 --ipopt-queries 1");
+  BOOST_REQUIRE(text.exit_code == 0);
+  std::istringstream lines(text.out);
+  std::string line;
+  int rows = 0;
+  while (std::getline(lines, line)) {
+    if (line.rfind("  ", 0) != 0) continue;
+    std::istringstream fields(line);
+    std::string name;
+    double value = 0.0;
+    std::string rest;
+    fields >> name >> value;
+    BOOST_TEST((!fields.fail() && !(fields >> rest)), line);
+    ++rows;
+  }
+  BOOST_TEST(rows > 20);
   const auto r = run_command(exe + " bench --db " + dbs().ironing + " --level 4");
   BOOST_TEST(r.exit_code == 2);
   BOOST_TEST(r.err.find("--problem, not --db") != std::string::npos, r.err);
