@@ -2,7 +2,7 @@
 /// \file kkt_verifier.hpp
 /// \brief KKT verification of candidate contact solutions (FOM, reduced, baselines)
 /// against the optimality conditions of the full-order QP and, optionally, against
-/// a reference solution (usually the Ipopt one, DESIGN §3).
+/// a reference solution (usually the Ipopt one; docs/theory.md §2.3).
 ///
 /// All quantities come from fom/kkt.hpp (one implementation of the residuals and
 /// errors): for a candidate (u, λ) at μ the pairing is recomputed from u in the

@@ -3,7 +3,7 @@
 /// \brief The production FOM solver: contact pairing fixed point around a
 /// condensed primal–dual active-set QP solve.
 ///
-/// Algorithm (DESIGN §2):
+/// Algorithm (docs/theory.md §2):
 ///  1. Offline per stiffness: factorise K_ff once (CHOLMOD, SparseCholesky) with the
 ///     contact-surface dofs eliminated last, and condense onto the contact surface:
 ///     \f$ S = E_s^T K^{-1} E_s \f$ is read from the factor's trailing block (no

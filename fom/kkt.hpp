@@ -1,6 +1,6 @@
 #pragma once
 /// \file kkt.hpp
-/// \brief Full-order KKT residuals and solution comparisons (DESIGN §2, §3).
+/// \brief Full-order KKT residuals and solution comparisons (docs/theory.md §2.3, §4).
 ///
 /// For a candidate (u, λ) at parameter μ, the pairing is recomputed from u in the
 /// deformed configuration and C(u), g(u) assembled. Residuals, all relative:

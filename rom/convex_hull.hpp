@@ -2,7 +2,7 @@
 /// \file convex_hull.hpp
 /// \brief The non-penetrating convex-hull ROM with a monolithic dictionary
 /// (Kollepara et al., "Sparse approximations for contact mechanics", appendix B;
-/// DESIGN §3). Math and choices: docs/convex_hull.md.
+/// docs/theory.md §3.3). Math and choices: docs/convex_hull.md.
 ///
 /// Offline (MonolithicDictionary): the columns of the monolithic dictionary are
 /// the training solutions, each displacement snapshot \f$ d_{p,j} = u_j - u_{lift}(\mu_j) \f$

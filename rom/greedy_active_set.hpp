@@ -1,7 +1,7 @@
 #pragma once
 /// \file greedy_active_set.hpp
 /// \brief Greedy active-set online solver (Kollepara et al., "Sparse
-/// approximations for contact mechanics", Algorithm 1; DESIGN §3).
+/// approximations for contact mechanics", Algorithm 1; docs/theory.md §3.2).
 ///
 /// Unknowns: reduced displacement û (u = Φû + u_lift(μ)) and sparse dictionary
 /// coefficients λ̂_I (λ = D_d[:, I] λ̂_I). Starting from I = ∅ and the

@@ -184,7 +184,7 @@ struct EvaluationOptions {
   bool kkt = false;  ///< compute the FOM KKT residuals of every ROM solution. Default false.
 };
 
-/// \brief Means and maxima over the rows; keys of DESIGN §5 `online`.
+/// \brief Means and maxima over the rows; the keys of `online --json`.
 struct EvaluationSummary {
   std::string method;
   double delta = 0.0;

@@ -6,7 +6,7 @@
 //  - --validation (default without --param): at every validation parameter of the
 //    problem (validation_set(n), n = the database's training size/level), against
 //    the FOM; --out FILE.csv gets one row per parameter; prints a summary (or the
-//    JSON object of DESIGN §5 with --json).
+//    JSON object with --json, keys in docs/rom.md).
 //  - --param V: one query, compared with the FOM; --out DIR writes
 //    DIR/<problem>_<method>.vtu and DIR/<problem>_<method>_surface.csv.
 #include <algorithm>

@@ -1,4 +1,4 @@
-// contactrom — command-line driver. Subcommands (see README and ../shared/DESIGN.md §5):
+// contactrom — command-line driver. Subcommands (see README):
 //   contactrom fom     --problem hertz --param 0.1 --json
 //   contactrom offline --problem hertz --train 30 --out hertz30.h5
 //   contactrom online  --db hertz30.h5 --method greedy --validation --json

@@ -33,7 +33,7 @@ const fom::Problem& problem(const std::string& name) {
   return *p;
 }
 
-/// Agreement tolerance of the acceptance criterion (DESIGN §6: same solution to 1e-6).
+/// Agreement tolerance of the acceptance criterion (the Ipopt cross-check: same solution to 1e-6).
 constexpr double kAgreement = 1e-6;
 
 /// Solves every μ with both solvers and checks that they agree; prints the worst case.

@@ -1,5 +1,5 @@
 // Greedy active-set ROM (rom/greedy_active_set.hpp, paper Alg. 1) on the project's
-// problems: reproduction of training snapshots, the accuracy targets of DESIGN §6
+// problems: reproduction of training snapshots, the accuracy targets of the paper
 // on hertz (30 snapshots, δ = 1e-10), the error decay with the dictionary size
 // (hertz 12 → 120, ironing levels 3 → 7), the reduced KKT conditions at a converged
 // solution, edge cases, the method registry and thread safety. The properties that
@@ -172,7 +172,7 @@ BOOST_AUTO_TEST_CASE(hertz30_dual_error_and_sparsity_meet_targets) {
   BOOST_TEST(s.nonconverged == 0);
 }
 
-// DESIGN §6 / paper Table 3: mean primal H¹ error ≤ 2e-3 with 30 snapshots. See
+// Paper Table 3: mean primal H¹ error ≤ 2e-3 with 30 snapshots. See
 // docs/rom.md: the best approximation of the validation solutions in the reduced
 // space itself averages 1.8e-3, dominated by the two validation points below the
 // first training parameter (d = 0.00375, 0.00625).
@@ -185,7 +185,7 @@ BOOST_AUTO_TEST_CASE(hertz30_mean_primal_error_meets_paper_target, *boost::unit_
 }
 
 BOOST_AUTO_TEST_CASE(hertz30_mean_primal_error_inside_the_training_range) {
-  // The validation set of DESIGN §1 starts at d = 0.00375, below the first of the 30
+  // The hertz validation set starts at d = 0.00375, below the first of the 30
   // training parameters (d = 0.01): three queries extrapolate, with primal errors
   // 0.02–0.12 that the POD space itself cannot do much better on. Over the 116
   // validation points inside the training range the paper's target holds.
