@@ -23,12 +23,6 @@ using hdf5::Handle;
 /// Value of attribute `kind`: tells a reduced model from a database.
 constexpr const char* kKind = "contactrom reduced model";
 
-std::string format_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 /// The column-major rows × cols matrix as a dataset of cols rows (one column of
 /// `m` per dataset row, as h5py users index them).
 void write_columns(hid_t f, hid_t dcpl, const char* name, const Eigen::MatrixXd& m) {
@@ -152,7 +146,7 @@ OnlineModel OnlineModel::load(const std::string& path) {
     method = hdf5::read_string_attribute(f, "method");
     d.options.delta = hdf5::read_double_attribute(f, "delta");
     if (!(d.options.delta >= 0.0) || !std::isfinite(d.options.delta))
-      throw hdf5::Refused("attribute delta is " + format_number(d.options.delta) + ", expected a number >= 0");
+      throw hdf5::Refused("attribute delta is " + fom::format_number(d.options.delta) + ", expected a number >= 0");
     const std::string lifting = hdf5::read_string_attribute(f, "lifting");
     if (lifting != "harmonic" && lifting != "dirichlet")
       throw hdf5::Refused("attribute lifting is '" + lifting + "', expected 'harmonic' or 'dirichlet'");
@@ -268,14 +262,14 @@ void write_query_csv(const std::string& path, const OnlineModel& rom, const std:
     for (const std::string& name : rom.problem().param_names()) out << name << ',';
     out << "status,converged,iterations,sparsity,contact_force,time_s,selected,coefficients\n";
     for (const OnlineResult& res : results) {
-      for (int k = 0; k < res.mu.size(); ++k) out << format_number(res.mu(k)) << ',';
+      for (int k = 0; k < res.mu.size(); ++k) out << fom::format_number(res.mu(k)) << ',';
       out << to_string(res.status) << ',' << (res.converged ? 1 : 0) << ',' << res.iterations << ','
-          << res.selected.size() << ',' << format_number(fom::contact_force(rom.problem(), res.lambda)) << ','
-          << format_number(res.time_s) << ',';
+          << res.selected.size() << ',' << fom::format_number(fom::contact_force(rom.problem(), res.lambda)) << ','
+          << fom::format_number(res.time_s) << ',';
       for (size_t j = 0; j < res.selected.size(); ++j)
         out << (j ? " " : "") << rom.model().dictionary_snapshots()[static_cast<size_t>(res.selected[j])];
       out << ',';
-      for (Eigen::Index j = 0; j < res.coefficients.size(); ++j) out << (j ? " " : "") << format_number(res.coefficients(j));
+      for (Eigen::Index j = 0; j < res.coefficients.size(); ++j) out << (j ? " " : "") << fom::format_number(res.coefficients(j));
       out << '\n';
     }
   });
