@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "baselines/reduced_active_set.hpp"
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "rom/nnls.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"

@@ -16,7 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "fom/anderson.hpp"
+#include "core/anderson.hpp"
+#include "core/stopwatch.hpp"
 #include "fom/kkt.hpp"
 
 namespace contactrom::baselines {
@@ -32,10 +33,6 @@ namespace {
 /// Ipopt's "minus infinity" for one-sided bounds (anything ≤ nlp_lower_bound_inf = -1e19).
 constexpr double kMinusInfinity = -1e20;
 constexpr double kPlusInfinity = 1e20;
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// K_ff, its lower triangle in coordinate form (the constant Ipopt Hessian) and, for
 /// contact models with a pairing, a factorisation that gives the unconstrained
@@ -366,7 +363,7 @@ FomSolution IpoptQpSolver::solve(const Param& mu, const FomSolution* warm) const
   Eigen::VectorXd gap = Eigen::VectorXd::Constant(nc, std::numeric_limits<double>::infinity());
   // Anderson-accelerated pairing fixed point, as in fom::ActiveSetSolver: the QP is
   // always solved exactly; the extrapolated x only chooses the next pairing.
-  fom::AndersonMixer mixer(opt.anderson_depth);
+  AndersonMixer mixer(opt.anderson_depth);
 
   bool converged = false;
   for (int it = 0; it < opt.max_pairing_iterations; ++it) {

@@ -22,8 +22,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "fom/active_set_solver.hpp"
-#include "fom/errors.hpp"
 #include "fom/kkt.hpp"
 #include "fom/problem.hpp"
 

@@ -9,7 +9,7 @@
 #include "baselines/cpg.hpp"
 #include "baselines/ipopt_qp.hpp"
 #include "baselines/reduced_active_set.hpp"
-#include "fom/atomic_file.hpp"
+#include "core/atomic_file.hpp"
 #include "fom/parameter_space.hpp"
 #include "rom/greedy_active_set.hpp"
 #include "rom/offline.hpp"

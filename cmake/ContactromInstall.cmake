@@ -1,17 +1,17 @@
 # cmake --install build --prefix P installs:
-#   P/include/contactrom/{fom,rom,baselines}/*.hpp   (#include "rom/reduced_model.hpp")
-#   P/lib/libcontactrom_{fom,rom,baselines}.{a,so}
+#   P/include/contactrom/{core,fom,rom,baselines}/*.hpp   (#include "rom/reduced_model.hpp")
+#   P/lib/libcontactrom_{core,fom,rom,baselines}.{a,so}
 #   P/bin/contactrom
 #   P/share/contactrom/{problems,meshes}
 #   P/lib/cmake/contactrom/contactromConfig.cmake (+ version, targets)
 include(CMakePackageConfigHelpers)
 set(CONTACTROM_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/contactrom)
 
-foreach(folder fom rom baselines)
+foreach(folder core fom rom baselines)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/contactrom/${folder}
           FILES_MATCHING PATTERN "*.hpp")
 endforeach()
-install(TARGETS contactrom_fom contactrom_rom contactrom_baselines EXPORT contactromTargets
+install(TARGETS contactrom_core contactrom_fom contactrom_rom contactrom_baselines EXPORT contactromTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

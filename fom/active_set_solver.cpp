@@ -3,16 +3,13 @@
 #include <Eigen/CholmodSupport>
 #include <chrono>
 
-#include "fom/anderson.hpp"
-#include "fom/errors.hpp"
+#include "core/anderson.hpp"
+#include "core/errors.hpp"
+#include "core/stopwatch.hpp"
 #include "fom/rigid_bodies.hpp"
 
 namespace contactrom::fom {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// S C_Wᵀ (n_s x |W|) for the constraint rows W: column a is the sum of the
 /// columns of the symmetric S picked by row W[a]'s (at most six) entries.

@@ -6,7 +6,7 @@
 #include <map>
 #include <string>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 
 namespace contactrom::fom {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 
 namespace contactrom::fom {
 namespace {

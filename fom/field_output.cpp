@@ -4,8 +4,8 @@
 #include <iomanip>
 #include <limits>
 
-#include "fom/atomic_file.hpp"
-#include "fom/errors.hpp"
+#include "core/atomic_file.hpp"
+#include "core/errors.hpp"
 #include "fom/input_values.hpp"
 #include "fom/kkt.hpp"
 

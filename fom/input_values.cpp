@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 
 namespace contactrom {
 namespace {

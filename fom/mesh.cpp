@@ -26,7 +26,7 @@
 #include <unordered_map>
 #include <utility>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 
 #ifndef CONTACTROM_DEFAULT_MESH_DIR
 #define CONTACTROM_DEFAULT_MESH_DIR "meshes"

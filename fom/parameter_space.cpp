@@ -5,18 +5,9 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 
 namespace contactrom::fom {
-
-std::string format_number(double value) {
-  char buf[64];
-  for (int digits = 6; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
-    if (std::strtod(buf, nullptr) == value) break;
-  }
-  return buf;
-}
 
 int ParameterSpace::index_of(const std::string& name) const {
   for (int i = 0; i < size(); ++i)

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "core/format.hpp"
+
 namespace contactrom::fom {
 
 using Param = Eigen::VectorXd;
@@ -53,8 +55,5 @@ struct AffineExpression {
 /// two parameters, stray characters) and lists the parameter names; the caller
 /// prefixes it with the file, line and key.
 AffineExpression parse_affine_expression(const std::string& text, const ParameterSpace& space);
-
-/// Shortest text that reads back as the same double ("%.17g" trimmed).
-std::string format_number(double value);
 
 }  // namespace contactrom::fom

@@ -6,7 +6,8 @@
 #include <set>
 #include <sstream>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
+#include "core/format.hpp"
 
 namespace contactrom::fom {
 namespace {
@@ -26,9 +27,9 @@ std::string point_text(const Mesh& mesh, int node) {
 }
 
 std::string joined_keys(const std::map<std::string, std::vector<int>>& groups) {
-  std::string out;
-  for (const auto& [name, nodes] : groups) out += (out.empty() ? "" : ", ") + name;
-  return out;
+  std::vector<std::string> names;
+  for (const auto& group : groups) names.push_back(group.first);
+  return join(names);
 }
 
 /// Affine terms: index 0 is the constant, index 1+i the coefficient of parameter i.

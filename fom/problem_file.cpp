@@ -12,7 +12,7 @@
 #include <sstream>
 #include <toml++/toml.h>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 
 #ifndef CONTACTROM_DEFAULT_PROBLEM_DIR
 #define CONTACTROM_DEFAULT_PROBLEM_DIR "problems"

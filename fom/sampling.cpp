@@ -5,7 +5,7 @@
 #include <numeric>
 #include <random>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 
 namespace contactrom::fom {
 namespace {

@@ -17,7 +17,7 @@
 #include <memory>
 #include <vector>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 
 namespace contactrom::fom {
 

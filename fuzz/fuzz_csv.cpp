@@ -5,7 +5,7 @@
 #include <sstream>
 #include <string>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "rom/dense_csv.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <string>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "rom/snapshot_database.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

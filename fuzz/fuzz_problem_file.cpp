@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "fom/problem_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -10,7 +10,7 @@
 #include <cstdio>
 #include <string>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "rom/reduced_model_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

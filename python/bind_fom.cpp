@@ -1,7 +1,7 @@
 // Python bindings of the full-order side: Problem (parameters, operators K(μ),
 // C(u), g(u)), FullOrderSolver and its results, KKT residuals and verification.
 #include "baselines/kkt_verifier.hpp"
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "python/bindings.hpp"
 #include "rom/offline.hpp"
 

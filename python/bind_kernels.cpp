@@ -4,7 +4,7 @@
 // invalid_input.
 #include <functional>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "python/bindings.hpp"
 #include "rom/focuss.hpp"
 #include "rom/nnls.hpp"

@@ -3,7 +3,7 @@
 // reduced model against the FOM over a parameter set.
 #include <Python.h>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "python/bindings.hpp"
 #include "rom/offline.hpp"
 

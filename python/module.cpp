@@ -3,7 +3,7 @@
 // The pure-Python package `contactrom` (python/contactrom/) re-exports it.
 #include <cmath>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "fom/input_values.hpp"
 #include "python/bindings.hpp"
 

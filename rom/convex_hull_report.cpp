@@ -4,8 +4,8 @@
 #include <cmath>
 #include <ostream>
 
+#include "core/atomic_file.hpp"
 #include "fom/active_set_solver.hpp"
-#include "fom/atomic_file.hpp"
 #include "fom/parameter_space.hpp"
 #include "rom/offline.hpp"
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "core/format.hpp"
+
 namespace contactrom::rom {
 namespace {
 
@@ -14,12 +16,7 @@ void check_compatible(const SnapshotDatabase& a, const std::string& name_a, cons
   };
   if (a.problem != b.problem) differ("problem", a.problem, b.problem);
   if (a.mesh_fingerprint != b.mesh_fingerprint) differ("mesh fingerprint", a.mesh_fingerprint, b.mesh_fingerprint);
-  auto join = [](const std::vector<std::string>& v) {
-    std::string s;
-    for (const auto& x : v) s += (s.empty() ? "" : ",") + x;
-    return s;
-  };
-  if (a.param_names != b.param_names) differ("parameter names", join(a.param_names), join(b.param_names));
+  if (a.param_names != b.param_names) differ("parameter names", join(a.param_names, ","), join(b.param_names, ","));
   if (a.training_kind != b.training_kind || a.training_size != b.training_size)
     differ("training set", a.training_kind + " " + std::to_string(a.training_size),
            b.training_kind + " " + std::to_string(b.training_size));

@@ -6,7 +6,7 @@
 #include <istream>
 #include <vector>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "fom/input_values.hpp"
 
 namespace contactrom::rom {

@@ -10,7 +10,7 @@
 #include <string>
 #include <utility>
 
-#include "fom/anderson.hpp"
+#include "core/anderson.hpp"
 
 namespace contactrom::rom {
 

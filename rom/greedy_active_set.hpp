@@ -57,7 +57,7 @@
 /// k_max counts the rebuilds, GreedyOptions::max_solves the one-change steps.
 #include <iosfwd>
 
-#include "fom/anderson.hpp"
+#include "core/anderson.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/support_rows.hpp"

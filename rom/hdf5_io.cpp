@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <limits>
 
-#include "fom/atomic_file.hpp"
-#include "fom/errors.hpp"
+#include "core/atomic_file.hpp"
+#include "core/errors.hpp"
 
 namespace contactrom::rom::hdf5 {
 namespace {

@@ -113,7 +113,7 @@ void write_dataset(hid_t file, hid_t dcpl, const char* name, hid_t file_type, hi
 /// \brief Creates an HDF5 file in memory (core driver, no backing store) with the
 /// file-creation properties `fcpl`: HDF5 never touches the disk, so a full disk
 /// or a failing device cannot leave a half-closed file inside the library.
-/// Write it out with file_image() and fom/atomic_file.
+/// Write it out with file_image() and core/atomic_file.
 /// \param label name of the file in HDF5's error messages
 hid_t create_memory_file(const std::string& label, hid_t fcpl);
 
@@ -128,7 +128,7 @@ void write_string_list(hid_t loc, hid_t dcpl, const char* name, const std::vecto
 std::vector<std::string> read_string_list(hid_t loc, const char* name, std::uint64_t max_bytes);
 
 /// \brief Builds an HDF5 file in memory with `fill(file, dcpl)` and writes it to
-/// `path` atomically (fom/atomic_file.hpp). Object modification times are not
+/// `path` atomically (core/atomic_file.hpp). Object modification times are not
 /// stored, so the same content gives the same bytes.
 /// \throws Failure from `fill` or HDF5; InputError (from the atomic write) naming
 ///   `path` if the target is refused or the disk is full. No partial file is left.

@@ -18,7 +18,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 
 namespace contactrom::rom {
 

@@ -1,72 +1,8 @@
 #include "rom/offline.hpp"
 
 #include <algorithm>
-#include <atomic>
-#include <condition_variable>
-#include <cstdio>
-#include <exception>
-#include <mutex>
-#include <ostream>
-#include <thread>
 
 namespace contactrom::rom {
-
-int resolve_threads(int requested) {
-  if (requested > 0) return requested;
-  return std::max(1u, std::thread::hardware_concurrency());
-}
-
-void parallel_for(int n, int threads, const std::function<void(int)>& task, const ProgressCallback& progress) {
-  if (n <= 0) return;
-  const int nt = std::min(resolve_threads(threads), n);
-  std::atomic<int> next{0};
-  std::atomic<bool> failed{false};
-  std::mutex mutex;
-  std::condition_variable changed;
-  int done = 0;
-  std::exception_ptr error;
-
-  auto worker = [&] {
-    for (;;) {
-      if (failed.load()) return;
-      const int i = next.fetch_add(1);
-      if (i >= n) return;
-      try {
-        task(i);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!error) error = std::current_exception();
-        failed = true;
-      }
-      {
-        std::lock_guard<std::mutex> lock(mutex);
-        ++done;
-      }
-      changed.notify_one();
-    }
-  };
-
-  std::vector<std::thread> pool;
-  pool.reserve(nt);
-  for (int t = 0; t < nt; ++t) pool.emplace_back(worker);
-  // The calling thread only reports progress, so the callback never runs
-  // concurrently and may write to a stream without locking.
-  {
-    std::unique_lock<std::mutex> lock(mutex);
-    int reported = 0;
-    while (reported < n && !failed) {
-      changed.wait(lock, [&] { return done > reported || failed; });
-      reported = done;
-      if (progress && !failed) {
-        lock.unlock();
-        progress(reported, n);
-        lock.lock();
-      }
-    }
-  }
-  for (auto& th : pool) th.join();
-  if (error) std::rethrow_exception(error);
-}
 
 SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vector<fom::Param>& params,
                                     const std::string& training_kind, int training_size,
@@ -122,37 +58,6 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
 
 SnapshotDatabase generate_snapshots(const fom::Problem& problem, int n, const OfflineOptions& options) {
   return generate_snapshots(problem, fom::training_set(problem, n), problem.definition().training.selector(), n, options);
-}
-
-ProgressBar::ProgressBar(std::ostream& out, std::string label, bool enabled)
-    : m_out(out), m_label(std::move(label)), m_enabled(enabled), m_start(std::chrono::steady_clock::now()),
-      m_last(m_start) {}
-
-void ProgressBar::update(int done, int total) {
-  if (!m_enabled || total <= 0) return;
-  const auto now = std::chrono::steady_clock::now();
-  if (done < total && m_drawn && now - m_last < std::chrono::milliseconds(50)) return;
-  m_last = now;
-  const double elapsed = std::chrono::duration<double>(now - m_start).count();
-  const double rate = elapsed > 0.0 ? done / elapsed : 0.0;
-  const double eta = rate > 0.0 ? (total - done) / rate : 0.0;
-  constexpr int width = 30;
-  const int filled = static_cast<int>(static_cast<long long>(width) * done / total);
-  std::string bar(filled, '#');
-  bar += std::string(width - filled, '.');
-  char text[160];
-  if (done < total)
-    std::snprintf(text, sizeof text, " [%s] %d/%d  %.1f/s  ETA %.1f s", bar.c_str(), done, total, rate, eta);
-  else
-    std::snprintf(text, sizeof text, " [%s] %d/%d  %.1f/s  %.1f s", bar.c_str(), done, total, rate, elapsed);
-  // Trailing blanks erase a longer previous line; the line never wraps.
-  m_out << '\r' << m_label << text << "   " << std::flush;
-  m_drawn = true;
-}
-
-void ProgressBar::finish() {
-  if (m_drawn) m_out << '\n' << std::flush;
-  m_drawn = false;
 }
 
 }  // namespace contactrom::rom

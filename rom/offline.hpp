@@ -20,25 +20,13 @@
 #include <string>
 #include <vector>
 
+#include "core/parallel_for.hpp"
+#include "core/progress_bar.hpp"
 #include "fom/active_set_solver.hpp"
 #include "fom/problem.hpp"
 #include "rom/snapshot_database.hpp"
 
 namespace contactrom::rom {
-
-/// \brief Called after each completed task with (completed, total); calls are
-/// serialised (never concurrent) and come from the thread that called the
-/// parallel function.
-using ProgressCallback = std::function<void(int done, int total)>;
-
-/// \brief Runs `task(i)` for i = 0..n-1 on `threads` worker threads (≤ 0: the
-/// hardware concurrency; never more threads than tasks). Tasks are handed out in
-/// increasing order from a shared counter. The first exception thrown by a task is
-/// rethrown after all workers have stopped (the remaining tasks are skipped).
-void parallel_for(int n, int threads, const std::function<void(int)>& task, const ProgressCallback& progress = {});
-
-/// \brief Number of worker threads `requested` resolves to (≤ 0: hardware concurrency, at least 1).
-int resolve_threads(int requested);
 
 /// \brief Options of generate_snapshots (documented defaults).
 struct OfflineOptions {
@@ -61,25 +49,5 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
 /// \brief Same, with the training set selected by `n` as the problem expects
 /// (fom::training_set(problem, n): `--train n` or `--level n` as its training plan says).
 SnapshotDatabase generate_snapshots(const fom::Problem& problem, int n, const OfflineOptions& options = {});
-
-/// \brief A one-line progress bar "label [#####.....] 17/30  42.1/s  ETA 0.3 s"
-/// redrawn in place with a carriage return. It draws only when enabled (the CLI enables it
-/// when stderr is a terminal or with --progress); finish() ends the line.
-class ProgressBar {
- public:
-  ProgressBar(std::ostream& out, std::string label, bool enabled);
-  /// Redraws with `done` of `total` completed (throttled to ~20 redraws/s, and
-  /// always drawn for the last one).
-  void update(int done, int total);
-  /// Ends the line (prints '\n') if anything was drawn.
-  void finish();
-
- private:
-  std::ostream& m_out;
-  std::string m_label;
-  bool m_enabled;
-  bool m_drawn = false;
-  std::chrono::steady_clock::time_point m_start, m_last;
-};
 
 }  // namespace contactrom::rom

@@ -12,7 +12,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "rom/nnls.hpp"
 
 namespace contactrom::rom {

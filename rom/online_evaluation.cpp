@@ -7,18 +7,10 @@
 #include <limits>
 #include <ostream>
 
-#include "fom/atomic_file.hpp"
+#include "core/atomic_file.hpp"
+#include "core/format.hpp"
 
 namespace contactrom::rom {
-namespace {
-
-std::string format_double(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
-}  // namespace
 
 std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& solver,
                                                  const std::vector<fom::Param>& params, int threads,
@@ -105,9 +97,9 @@ void write_evaluation_csv(const std::string& path, const fom::Problem& problem, 
     for (const std::string& name : problem.param_names()) out << name << ',';
     out << "primal_h1_error,dual_l2_error,sparsity,iterations,time_s,converged,status,selected,errors\n";
     for (const EvaluationRow& row : summary.rows) {
-      for (int k = 0; k < row.mu.size(); ++k) out << format_double(row.mu(k)) << ',';
-      out << format_double(row.primal_error) << ',' << format_double(row.dual_error) << ',' << row.sparsity << ','
-          << row.iterations << ',' << format_double(row.time_s) << ',' << (row.converged ? 1 : 0) << ','
+      for (int k = 0; k < row.mu.size(); ++k) out << format_number(row.mu(k)) << ',';
+      out << format_number(row.primal_error) << ',' << format_number(row.dual_error) << ',' << row.sparsity << ','
+          << row.iterations << ',' << format_number(row.time_s) << ',' << (row.converged ? 1 : 0) << ','
           << to_string(row.status) << ',';
       for (size_t j = 0; j < row.selected.size(); ++j) out << (j ? " " : "") << row.selected[j];
       out << ',' << (row.absolute_errors ? "absolute" : "relative") << '\n';

@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "fom/active_set_solver.hpp"
-#include "fom/errors.hpp"
 #include "fom/kkt.hpp"
 #include "fom/problem.hpp"
 #include "rom/offline.hpp"

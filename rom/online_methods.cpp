@@ -5,6 +5,7 @@
 #include <mutex>
 #include <sstream>
 
+#include "core/format.hpp"
 #include "fom/input_values.hpp"
 #include "fom/parameter_space.hpp"
 #include "rom/convex_hull.hpp"
@@ -147,12 +148,6 @@ std::string known_keys(const OnlineMethod& m) {
 void check_key(const OnlineMethod& m, const std::string& key) {
   if (!find_spec(m, key))
     throw InputError("online method '" + m.name + "' has no option " + quoted(key) + "; it knows: " + known_keys(m));
-}
-
-std::string join(const std::vector<std::string>& words, const std::string& sep) {
-  std::string s;
-  for (const auto& w : words) s += (s.empty() ? "" : sep) + w;
-  return s;
 }
 
 }  // namespace

@@ -23,7 +23,7 @@
 /// numerical rank.
 #include <Eigen/Dense>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 
 namespace contactrom::rom {
 

@@ -2,19 +2,14 @@
 
 #include <cmath>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
+#include "core/format.hpp"
 #include "rom/hdf5_io.hpp"
 
 namespace contactrom::rom {
 namespace {
 
 using hdf5::Handle;
-
-std::string join(const std::vector<std::string>& items, const char* sep) {
-  std::string out;
-  for (size_t i = 0; i < items.size(); ++i) out += (i ? sep : "") + items[i];
-  return out;
-}
 
 std::vector<std::string> split(const std::string& text, char sep) {
   std::vector<std::string> out;

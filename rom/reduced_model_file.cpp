@@ -8,8 +8,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "fom/atomic_file.hpp"
-#include "fom/errors.hpp"
+#include "core/atomic_file.hpp"
+#include "core/errors.hpp"
 #include "fom/kkt.hpp"
 #include "rom/dense_csv.hpp"
 #include "rom/hdf5_io.hpp"

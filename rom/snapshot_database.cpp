@@ -10,7 +10,8 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "fom/atomic_file.hpp"
+#include "core/atomic_file.hpp"
+#include "core/format.hpp"
 #include "rom/hdf5_io.hpp"
 #include "rom/problem_record.hpp"
 
@@ -89,12 +90,6 @@ void set_problem_record(SnapshotDatabase& db, ProblemRecord r) {
   db.lifting_terms = std::move(r.lifting_terms);
 }
 
-std::string format_value(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 /// Refuses values that no offline run writes: non-finite numbers, negative
 /// pressures (beyond rounding), negative counts or times, a training size < 1.
 void validate_values(const SnapshotDatabase& db) {
@@ -102,7 +97,7 @@ void validate_values(const SnapshotDatabase& db) {
     for (Eigen::Index j = 0; j < m.cols(); ++j)
       for (Eigen::Index i = 0; i < m.rows(); ++i)
         if (bad(m(i, j)))
-          return "row " + std::to_string(j) + ", column " + std::to_string(i) + " holds " + format_value(m(i, j));
+          return "row " + std::to_string(j) + ", column " + std::to_string(i) + " holds " + format_number(m(i, j));
     return "";
   };
   const auto not_finite = [](double v) { return !std::isfinite(v); };

@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "fom/problem.hpp"
 
 namespace contactrom::rom {
@@ -74,7 +74,7 @@ struct SnapshotDatabase {
 /// \brief Writes `db` to `path` (HDF5) atomically: the file is built in memory,
 /// written to a temporary file next to `path` and renamed over it once complete.
 /// \throws InputError naming `path` and the reason if the target is refused
-///   (fom/atomic_file.hpp: a link, folder or device), the folder is not writable
+///   (core/atomic_file.hpp: a link, folder or device), the folder is not writable
 ///   or the disk is full; no partial file is left behind.
 void write_database(const std::string& path, const SnapshotDatabase& db);
 

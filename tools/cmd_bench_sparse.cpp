@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "rom/focuss.hpp"
 #include "rom/nnls.hpp"
 #include "rom/omp.hpp"

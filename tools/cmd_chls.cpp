@@ -25,9 +25,10 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "core/atomic_file.hpp"
+#include "core/errors.hpp"
+#include "core/format.hpp"
 #include "fom/active_set_solver.hpp"
-#include "fom/atomic_file.hpp"
-#include "fom/errors.hpp"
 #include "fom/kkt.hpp"
 #include "rom/chls.hpp"
 #include "rom/convex_hull.hpp"
@@ -42,12 +43,6 @@
 namespace contactrom::cli {
 namespace {
 
-
-std::string format_double(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 // ---------------------------------------------------------------- chls
 
@@ -129,10 +124,10 @@ void run_hull_report(const HullArgs& a) {
   // through OnlineSolverOptions::extra, as for `contactrom online`.
   rom::OnlineSolverOptions generic;
   generic.extra["basis"] = a.basis;
-  if (a.basis_delta >= 0.0) generic.extra["basis_delta"] = format_double(a.basis_delta);
+  if (a.basis_delta >= 0.0) generic.extra["basis_delta"] = format_number(a.basis_delta);
   if (a.rank_l > 0) generic.extra["rank_l"] = std::to_string(a.rank_l);
   generic.extra["seed"] = std::to_string(a.seed);
-  generic.extra["sum_weight"] = format_double(a.sum_weight);
+  generic.extra["sum_weight"] = format_number(a.sum_weight);
   generic.extra["polish"] = a.no_polish ? "0" : "1";
   generic.extra["max_pairing_iterations"] = std::to_string(a.max_pairing_iterations);
   for (const std::string& kv : a.options) {

@@ -19,8 +19,9 @@
 #include <filesystem>
 #include <iostream>
 
+#include "core/errors.hpp"
+#include "core/stopwatch.hpp"
 #include "fom/active_set_solver.hpp"
-#include "fom/errors.hpp"
 #include "fom/kkt.hpp"
 #include "rom/greedy_active_set.hpp"
 #include "rom/offline.hpp"
@@ -38,10 +39,6 @@ struct DemoArgs {
   int train = 30, threads = 0;
   double delta = 1e-8;
 };
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// Contact half-width: midway between the outermost active node and the next
 /// node, averaged over both sides of the symmetric contact.

@@ -18,14 +18,14 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "rom/database_merge.hpp"
 #include "rom/offline.hpp"
 #ifdef CONTACTROM_HAVE_MPI
 #include "rom/offline_mpi.hpp"
 #endif
+#include "core/atomic_file.hpp"
 #include "rom/snapshot_database.hpp"
-#include "fom/atomic_file.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 

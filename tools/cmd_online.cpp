@@ -15,15 +15,15 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "core/atomic_file.hpp"
+#include "core/errors.hpp"
 #include "fom/active_set_solver.hpp"
-#include "fom/errors.hpp"
 #include "fom/field_output.hpp"
 #include "fom/kkt.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
-#include "fom/atomic_file.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 

@@ -7,7 +7,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "fom/atomic_file.hpp"
+#include "core/atomic_file.hpp"
 #include "fom/field_output.hpp"
 #include "fom/kkt.hpp"
 #include "rom/reduced_model_file.hpp"

@@ -8,7 +8,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "fom/atomic_file.hpp"
+#include "core/atomic_file.hpp"
 #include "rom/reduced_model_file.hpp"
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"

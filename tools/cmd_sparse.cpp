@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "rom/dense_csv.hpp"
 #include "rom/focuss.hpp"
 #include "rom/nnls.hpp"

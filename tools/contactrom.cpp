@@ -13,7 +13,7 @@
 #include <new>
 #include <stdexcept>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "fom/input_values.hpp"
 #include "tools/cli.hpp"
 #ifdef CONTACTROM_HAVE_MPI

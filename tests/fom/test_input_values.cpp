@@ -6,8 +6,8 @@
 #include <cmath>
 #include <string>
 
-#include "fom/atomic_file.hpp"
-#include "fom/errors.hpp"
+#include "core/atomic_file.hpp"
+#include "core/errors.hpp"
 #include "fom/input_values.hpp"
 #include "fom/problem.hpp"
 

@@ -16,7 +16,7 @@
 #include <string>
 #include <tuple>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "fom/mesh.hpp"
 
 using contactrom::InputError;

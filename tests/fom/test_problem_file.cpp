@@ -11,8 +11,8 @@
 
 #include "baselines/ipopt_qp.hpp"
 #include "common/run_command.hpp"
+#include "core/errors.hpp"
 #include "fom/active_set_solver.hpp"
-#include "fom/errors.hpp"
 #include "fom/kkt.hpp"
 #include "fom/problem.hpp"
 

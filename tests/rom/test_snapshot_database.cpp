@@ -14,7 +14,7 @@
 #include <string>
 #include <unistd.h>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "fom/problem.hpp"
 #include "rom/snapshot_database.hpp"
 

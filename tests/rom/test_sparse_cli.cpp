@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "common/random_problems.hpp"
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "rom/dense_csv.hpp"
 #include "rom/nnls.hpp"
 #include "rom/omp.hpp"

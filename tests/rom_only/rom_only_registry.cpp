@@ -3,7 +3,7 @@
 #include <iostream>
 #include <string>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "rom/online_methods.hpp"
 
 int main() {

@@ -1,8 +1,8 @@
-#include "fom/anderson.hpp"
+#include "core/anderson.hpp"
 
 #include <algorithm>
 
-namespace contactrom::fom {
+namespace contactrom {
 
 AndersonMixer::AndersonMixer(int depth) : m_depth(std::max(depth, 0)) {}
 
@@ -35,4 +35,4 @@ Eigen::VectorXd AndersonMixer::next(const Eigen::VectorXd& x, const Eigen::Vecto
   return out;
 }
 
-}  // namespace contactrom::fom
+}  // namespace contactrom

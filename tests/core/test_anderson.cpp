@@ -1,14 +1,14 @@
-// fom::AndersonMixer: on a linear fixed point x = A x + b, Anderson acceleration with
+// AndersonMixer: on a linear fixed point x = A x + b, Anderson acceleration with
 // depth >= n reaches the solution in about n + 2 steps (GMRES-equivalence, Walker &
 // Ni 2011), where the plain iteration needs hundreds; depth 0 is the plain iteration.
-#define BOOST_TEST_MODULE fom_anderson
+#define BOOST_TEST_MODULE core_anderson
 #include <Eigen/Dense>
 #include <boost/test/unit_test.hpp>
 #include <cmath>
 
-#include "fom/anderson.hpp"
+#include "core/anderson.hpp"
 
-using contactrom::fom::AndersonMixer;
+using contactrom::AndersonMixer;
 
 namespace {
 

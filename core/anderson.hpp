@@ -1,11 +1,11 @@
 #pragma once
 /// \file anderson.hpp
 /// \brief Anderson acceleration (Walker & Ni 2011, "type II", restarted) of a fixed
-/// point x = F(x), shared by the contact-pairing loops of the FOM solvers.
+/// point x = F(x), shared by the contact-pairing loops of the FOM and ROM solvers.
 #include <Eigen/Dense>
 #include <vector>
 
-namespace contactrom::fom {
+namespace contactrom {
 
 /// \brief Keeps the last `depth` differences of the iterates and their residuals
 /// r = F(x) − x, and extrapolates x_next = F(x) − ΔF γ with γ = argmin |r − ΔR γ|
@@ -26,4 +26,8 @@ class AndersonMixer {
   std::vector<Eigen::VectorXd> m_df, m_dr;
 };
 
-}  // namespace contactrom::fom
+namespace fom {
+using contactrom::AndersonMixer;  // the name it had when it lived in fom/
+}  // namespace fom
+
+}  // namespace contactrom

@@ -1,4 +1,4 @@
-#include "fom/atomic_file.hpp"
+#include "core/atomic_file.hpp"
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -9,7 +9,7 @@
 #include <cstring>
 #include <fstream>
 
-#include "fom/errors.hpp"
+#include "core/errors.hpp"
 #include "fom/input_values.hpp"
 
 namespace contactrom {

@@ -1,0 +1,22 @@
+#pragma once
+/// \file format.hpp
+/// \brief Text helpers shared by the libraries and the CLI: numbers written so that
+/// they read back exactly, and comma-separated lists.
+#include <string>
+#include <vector>
+
+namespace contactrom {
+
+/// \brief Shortest text that reads back as the same double: "%.{6..17}g", the first
+/// precision whose strtod() gives `value` again (e.g. 0.1 → "0.1", 1/3 →
+/// "0.33333333333333331"); "nan", "inf", "-inf" for non-finite values.
+std::string format_number(double value);
+
+/// \brief `items` separated by `separator` (default ", "): {"a", "b"} → "a, b".
+std::string join(const std::vector<std::string>& items, const std::string& separator = ", ");
+
+namespace fom {
+using contactrom::format_number;  // the name it had when it lived in fom/parameter_space.hpp
+}  // namespace fom
+
+}  // namespace contactrom

@@ -1,0 +1,70 @@
+#include "core/parallel_for.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace contactrom {
+
+int resolve_threads(int requested) {
+  if (requested > 0) return requested;
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+void parallel_for(int n, int threads, const std::function<void(int)>& task, const ProgressCallback& progress) {
+  if (n <= 0) return;
+  const int nt = std::min(resolve_threads(threads), n);
+  std::atomic<int> next{0};
+  std::atomic<bool> failed{false};
+  std::mutex mutex;
+  std::condition_variable changed;
+  int done = 0;
+  std::exception_ptr error;
+
+  auto worker = [&] {
+    for (;;) {
+      if (failed.load()) return;
+      const int i = next.fetch_add(1);
+      if (i >= n) return;
+      try {
+        task(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!error) error = std::current_exception();
+        failed = true;
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        ++done;
+      }
+      changed.notify_one();
+    }
+  };
+
+  std::vector<std::thread> pool;
+  pool.reserve(nt);
+  for (int t = 0; t < nt; ++t) pool.emplace_back(worker);
+  // The calling thread only reports progress, so the callback never runs
+  // concurrently and may write to a stream without locking.
+  {
+    std::unique_lock<std::mutex> lock(mutex);
+    int reported = 0;
+    while (reported < n && !failed) {
+      changed.wait(lock, [&] { return done > reported || failed; });
+      reported = done;
+      if (progress && !failed) {
+        lock.unlock();
+        progress(reported, n);
+        lock.lock();
+      }
+    }
+  }
+  for (auto& th : pool) th.join();
+  if (error) std::rethrow_exception(error);
+}
+
+}  // namespace contactrom
