@@ -36,7 +36,7 @@
 
 #include "baselines/reduced_active_set.hpp"
 #include "core/errors.hpp"
-#include "rom/nnls.hpp"
+#include "core/nnls.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
 

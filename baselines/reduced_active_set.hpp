@@ -55,8 +55,8 @@
 #include <string>
 #include <vector>
 
+#include "core/nnls.hpp"
 #include "rom/greedy_active_set.hpp"
-#include "rom/nnls.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/support_rows.hpp"

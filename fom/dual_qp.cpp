@@ -4,6 +4,8 @@
 #include <cmath>
 #include <set>
 
+#include "core/nnls.hpp"
+
 namespace contactrom::fom {
 
 bool DualQpSolver::solve_on(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<int>& set,
@@ -74,7 +76,7 @@ Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::Vecto
     }
     if (seen.count(next)) {
       m_fallback = true;
-      return lawson_hanson(g, h, eligible, tol);
+      return lawson_hanson(g, h, eligible);
     }
     active = next;
   }
@@ -82,54 +84,36 @@ Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::Vecto
   return lambda;
 }
 
-// Lawson–Hanson active-set method on the QP form (Lawson & Hanson 1974, ch. 23),
-// started from λ = 0. Terminates for positive semi-definite G.
+// Lawson–Hanson on the rows that may become active (NnlsQp, core/nnls.hpp), started
+// from λ = 0; it terminates for any positive semi-definite G. Its optimality test
+// uses the same relative tolerance, against max(|h|∞, |Gλ|∞).
 Eigen::VectorXd DualQpSolver::lawson_hanson(const Eigen::MatrixXd& g, const Eigen::VectorXd& h,
-                                            const std::vector<char>& eligible, double tol) {
+                                            const std::vector<char>& eligible) {
   const int n = static_cast<int>(h.size());
-  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
-  std::vector<char> passive(n, 0);
-  while (m_iterations < m_options.max_iterations) {
-    const Eigen::VectorXd descent = h - g * lambda;  // minus the gradient
-    int j = -1;
-    double best = tol;
-    for (int i = 0; i < n; ++i)
-      if (eligible[i] && !passive[i] && descent(i) > best) best = descent(i), j = i;
-    if (j < 0) return lambda;
-    passive[j] = 1;
-    while (m_iterations < m_options.max_iterations) {
-      ++m_iterations;
-      std::vector<int> set;
-      for (int i = 0; i < n; ++i)
-        if (passive[i]) set.push_back(i);
-      Eigen::VectorXd z;
-      if (!solve_on(g, h, set, z)) {
-        m_info = Status::NumericalIssue;
-        return lambda;
-      }
-      if (z.minCoeff() > 0.0) {
-        for (size_t a = 0; a < set.size(); ++a) lambda(set[a]) = z(a);
-        break;
-      }
-      // Step towards z until the first passive multiplier reaches zero; it leaves.
-      double alpha = 2.0;  // some z(a) <= 0, so the minimum below is <= 1
-      int blocking = -1;
-      for (size_t a = 0; a < set.size(); ++a) {
-        if (z(a) > 0.0) continue;
-        const double step = lambda(set[a]) / (lambda(set[a]) - z(a));
-        if (step < alpha) alpha = step, blocking = set[a];
-      }
-      for (size_t a = 0; a < set.size(); ++a) {
-        const int i = set[a];
-        lambda(i) += alpha * (z(a) - lambda(i));
-        if (i == blocking || lambda(i) <= 0.0) {
-          lambda(i) = 0.0;
-          passive[i] = 0;
-        }
-      }
-    }
+  std::vector<int> rows;
+  for (int i = 0; i < n; ++i)
+    if (eligible[i]) rows.push_back(i);
+  const int m = static_cast<int>(rows.size());
+  Eigen::MatrixXd g_e(m, m);
+  Eigen::VectorXd h_e(m);
+  for (int a = 0; a < m; ++a) {
+    h_e(a) = h(rows[a]);
+    for (int b = 0; b < m; ++b) g_e(a, b) = g(rows[a], rows[b]);
   }
-  m_info = Status::NoConvergence;
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
+  const int budget = m_options.max_iterations - m_iterations;
+  if (budget <= 0) {
+    m_info = Status::NoConvergence;
+    return lambda;
+  }
+  NnlsOptions options;
+  options.max_iterations = budget;
+  options.tolerance = m_options.relative_tolerance;
+  NnlsQp nnls(options);
+  const Eigen::VectorXd lambda_e = nnls.compute(g_e).solve(h_e);
+  m_iterations += nnls.iterations();
+  m_info = nnls.info();
+  for (int a = 0; a < m; ++a) lambda(rows[a]) = lambda_e(a);
   return lambda;
 }
 

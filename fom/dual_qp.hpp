@@ -11,8 +11,9 @@
 /// active set is \f$ \{ i : \lambda_i - c\,w_i > 0 \} \f$; each iteration solves
 /// one dense SPD system on the active set. PDAS converges superlinearly and
 /// terminates finitely for M-matrices but may cycle otherwise; a repeated active
-/// set switches to the Lawson–Hanson primal active-set method, which terminates
-/// for any positive semi-definite G.
+/// set switches to the Lawson–Hanson primal active-set method (NnlsQp,
+/// core/nnls.hpp, on the rows that may become active), which terminates for any
+/// positive semi-definite G.
 #include <Eigen/Dense>
 #include <vector>
 
@@ -48,8 +49,7 @@ class DualQpSolver {
 
  private:
   bool solve_on(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<int>& set, Eigen::VectorXd& z) const;
-  Eigen::VectorXd lawson_hanson(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<char>& eligible,
-                                double tol);
+  Eigen::VectorXd lawson_hanson(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<char>& eligible);
 
   DualQpOptions m_options;
   Status m_info = Status::Success;

@@ -5,9 +5,9 @@
 #include <functional>
 
 #include "core/errors.hpp"
+#include "core/nnls.hpp"
 #include "python/bindings.hpp"
 #include "rom/focuss.hpp"
-#include "rom/nnls.hpp"
 #include "rom/omp.hpp"
 
 namespace contactrom::python {

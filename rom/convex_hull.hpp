@@ -66,7 +66,7 @@
 #include "fom/problem.hpp"
 #include "rom/chls.hpp"
 #include "rom/focuss.hpp"
-#include "rom/nnls.hpp"
+#include "core/nnls.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"
 
@@ -126,7 +126,7 @@ struct ConvexHullOptions {
   /// nnFOCUSS settings (rom/focuss.hpp); defaults: 100 iterations, tolerance 1e-10,
   /// pruning 1e-8.
   FocussOptions focuss;
-  /// NNLS settings of the nnFOCUSS start (rom/nnls.hpp).
+  /// NNLS settings of the nnFOCUSS start (core/nnls.hpp).
   NnlsOptions nnls;
   /// Settings of the exact polishing solve (rom/chls.hpp).
   SimplexLeastSquaresOptions simplex;

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "rom/nnls.hpp"
+#include "core/nnls.hpp"
 
 namespace contactrom::rom {
 

@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/nnls.hpp"
 #include "rom/focuss.hpp"
-#include "rom/nnls.hpp"
 #include "rom/omp.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"

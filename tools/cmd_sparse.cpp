@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/nnls.hpp"
 #include "rom/dense_csv.hpp"
 #include "rom/focuss.hpp"
-#include "rom/nnls.hpp"
 #include "rom/omp.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"

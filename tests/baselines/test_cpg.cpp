@@ -14,8 +14,8 @@
 
 #include "baselines/cpg.hpp"
 #include "baselines/reduced_active_set.hpp"
+#include "core/nnls.hpp"
 #include "fom/problem.hpp"
-#include "rom/nnls.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/reduced_model.hpp"

@@ -25,8 +25,8 @@
 
 #include "common/random_problems.hpp"
 #include "core/errors.hpp"
+#include "core/nnls.hpp"
 #include "rom/dense_csv.hpp"
-#include "rom/nnls.hpp"
 #include "rom/omp.hpp"
 
 namespace fs = std::filesystem;

@@ -1,8 +1,8 @@
-// Tests of rom/nnls.hpp: Lawson–Hanson NNLS in matrix form (Nnls) and Gram/QP form
+// Tests of core/nnls.hpp: Lawson–Hanson NNLS in matrix form (Nnls) and Gram/QP form
 // (NnlsQp), checked against the KKT conditions on seeded random problems of every
 // shape, against closed-form answers, and on edge cases. The cross-check against
 // SciPy's scipy.optimize.nnls runs through the CLI in test_sparse_cli.cpp.
-#define BOOST_TEST_MODULE rom_nnls
+#define BOOST_TEST_MODULE core_nnls
 #include <boost/test/unit_test.hpp>
 
 #include <cmath>
@@ -11,12 +11,12 @@
 #include <string>
 
 #include "common/random_problems.hpp"
-#include "rom/nnls.hpp"
+#include "core/nnls.hpp"
 
 using contactrom::Status;
-using contactrom::rom::Nnls;
-using contactrom::rom::NnlsOptions;
-using contactrom::rom::NnlsQp;
+using contactrom::Nnls;
+using contactrom::NnlsOptions;
+using contactrom::NnlsQp;
 using contactrom::test::gaussian;
 using Eigen::Index;
 using Eigen::MatrixXd;

@@ -1,9 +1,9 @@
-#include "rom/nnls.hpp"
+#include "core/nnls.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-namespace contactrom::rom {
+namespace contactrom {
 
 using Eigen::Index;
 using Eigen::MatrixXd;
@@ -292,4 +292,4 @@ VectorXd Nnls::run(const VectorXd& b, const VectorXd* x0) {
   return x;
 }
 
-}  // namespace contactrom::rom
+}  // namespace contactrom

@@ -5,6 +5,11 @@
 /// quadratic programme given by its Gram matrix,
 /// \f$\min_x \tfrac12 x^T G x - c^T x\f$ s.t. \f$x \ge 0\f$ (NnlsQp).
 ///
+/// This is the one NNLS of contactrom: the sparse kernels (OMP, nnFOCUSS, CPG's cone
+/// projections) use the matrix form; the dual contact QP of the FOM
+/// (fom::DualQpSolver) falls back to the Gram form when its primal–dual active-set
+/// iteration cycles.
+///
 /// Reference: C. L. Lawson and R. J. Hanson, *Solving Least Squares Problems*,
 /// Prentice-Hall 1974 (SIAM 1995), chapter 23, algorithm NNLS. The math, the
 /// stopping rule and the update strategy are described in docs/sparse_kernels.md.
@@ -20,7 +25,7 @@
 
 #include "core/errors.hpp"
 
-namespace contactrom::rom {
+namespace contactrom {
 
 /// \brief Settings of Nnls and NnlsQp.
 struct NnlsOptions {
@@ -107,7 +112,7 @@ class GramCholesky {
 /// rounding) where \f$x_j > 0\f$.
 ///
 /// \code
-///   contactrom::rom::NnlsQp qp;
+///   contactrom::NnlsQp qp;
 ///   qp.compute(G);                       // stores G (upper triangle is read)
 ///   Eigen::VectorXd x = qp.solve(c);     // Lawson–Hanson from x = 0
 ///   if (qp.info() != contactrom::Status::Success) { ... }
@@ -175,7 +180,7 @@ class NnlsQp {
 /// \f$\varepsilon\,\kappa(A_P)^2\f$.
 ///
 /// \code
-///   contactrom::rom::Nnls nnls;
+///   contactrom::Nnls nnls;
 ///   nnls.compute(A);                      // O(m n^2), once per matrix
 ///   Eigen::VectorXd x = nnls.solve(b);    // many right-hand sides
 /// \endcode
@@ -224,4 +229,12 @@ class Nnls {
   Status m_info = Status::InvalidInput;
 };
 
-}  // namespace contactrom::rom
+namespace rom {
+using contactrom::gram_matrix;  // the names they had when they lived in rom/nnls.hpp
+using contactrom::GramCholesky;
+using contactrom::Nnls;
+using contactrom::NnlsOptions;
+using contactrom::NnlsQp;
+}  // namespace rom
+
+}  // namespace contactrom
