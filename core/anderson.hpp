@@ -19,6 +19,15 @@ class AndersonMixer {
   /// \returns the next iterate, given the current one `x` and its image `f` = F(x).
   Eigen::VectorXd next(const Eigen::VectorXd& x, const Eigen::VectorXd& f);
 
+  /// \brief Drops the differences but keeps the last point: the next call mixes
+  /// with that point only (e.g. after an extrapolation the caller rejected).
+  void restart() { m_df.clear(), m_dr.clear(); }
+  /// \brief Forgets everything: the next call returns F(x) (e.g. when the map changed).
+  void clear() {
+    restart();
+    m_started = false;
+  }
+
  private:
   int m_depth;
   bool m_started = false;

@@ -8,6 +8,7 @@
 #include <random>
 #include <set>
 
+#include "core/anderson.hpp"
 #include "fom/input_values.hpp"
 #include "rom/pod.hpp"
 
@@ -275,7 +276,7 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
   Status status = Status::Success;
   bool settled = !pairing, frozen = false;
   std::vector<Index> support_prev;
-  std::vector<VectorXd> hist_g, hist_f;  // Anderson history: g(x_i), g(x_i) − x_i
+  AndersonMixer mixer(opt.anderson_depth);  // on α, frozen phase only
   double last_change = std::numeric_limits<double>::infinity();
   int full_solves = 0;
   for (int it = 0; it < cap; ++it) {
@@ -338,35 +339,18 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
     if (!frozen && (same_support || full_solves >= opt.selection_iterations)) frozen = true;
     // Anderson safeguard: restart the history when the support changed or the
     // residual grew (the map is only piecewise smooth: pairing segments switch).
-    if (!frozen || !same_support || change > last_change) hist_g.clear(), hist_f.clear();
+    if (!frozen || !same_support || change > last_change) mixer.clear();
     last_change = change;
     support_prev = std::move(support);
 
     // Next x: Anderson mixing of the last iterates in the frozen phase, else g(x).
     VectorXd next = res.alpha;
-    if (frozen && opt.anderson_depth > 0 && x.size()) {
-      hist_g.push_back(res.alpha);
-      hist_f.push_back(res.alpha - x);
-      if (static_cast<int>(hist_g.size()) > opt.anderson_depth + 1) {
-        hist_g.erase(hist_g.begin());
-        hist_f.erase(hist_f.begin());
-      }
-      const auto k = static_cast<Index>(hist_g.size()) - 1;
-      if (k > 0) {
-        MatrixXd df(m, k), dg(m, k);
-        for (Index i = 0; i < k; ++i) {
-          df.col(i) = hist_f[static_cast<std::size_t>(i + 1)] - hist_f[static_cast<std::size_t>(i)];
-          dg.col(i) = hist_g[static_cast<std::size_t>(i + 1)] - hist_g[static_cast<std::size_t>(i)];
-        }
-        const VectorXd gamma = df.completeOrthogonalDecomposition().solve(hist_f.back());
-        const VectorXd mixed = res.alpha - dg * gamma;
-        if (mixed.allFinite() && (mixed.array() >= 0.0).all()) {
-          next = mixed;
-        } else {  // restart the history from the plain step
-          hist_g.erase(hist_g.begin(), hist_g.end() - 1);
-          hist_f.erase(hist_f.begin(), hist_f.end() - 1);
-        }
-      }
+    if (frozen && x.size()) {
+      const VectorXd mixed = mixer.next(x, res.alpha);
+      if (mixed.allFinite() && (mixed.array() >= 0.0).all())
+        next = mixed;
+      else  // restart the history from the plain step
+        mixer.restart();
     }
     x = std::move(next);
   }
