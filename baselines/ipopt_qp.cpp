@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "core/anderson.hpp"
 #include "core/stopwatch.hpp"
 #include "fom/kkt.hpp"
+#include "fom/pairing_fixed_point.hpp"
 
 namespace contactrom::baselines {
 
@@ -361,13 +361,11 @@ FomSolution IpoptQpSolver::solve(const Param& mu, const FomSolution* warm) const
   if (warm_fits) sol.lambda = warm->lambda;
   bool have_multipliers = warm_fits;
   Eigen::VectorXd gap = Eigen::VectorXd::Constant(nc, std::numeric_limits<double>::infinity());
-  // Anderson-accelerated pairing fixed point, as in fom::ActiveSetSolver: the QP is
-  // always solved exactly; the extrapolated x only chooses the next pairing.
-  AndersonMixer mixer(opt.anderson_depth);
-
-  bool converged = false;
-  for (int it = 0; it < opt.max_pairing_iterations; ++it) {
-    ++sol.pairing_iterations;
+  // One exact Ipopt solve per pairing; the shared pairing fixed point
+  // (fom/pairing_fixed_point.hpp) re-pairs, accelerates and decides when to stop.
+  auto solve_at = [&](const Pairing& pairing, const ConstraintMatrix&, const Eigen::VectorXd&,
+                      const Eigen::VectorXd&) {
+    fom::PairedSolution out;
     m_impl->build_constraints(pairing, lift_s, qp);
     qp.lambda0.resize(0);
     if (opt.warm_start && have_multipliers && !qp.kept_rows.empty()) {
@@ -393,6 +391,7 @@ FomSolution IpoptQpSolver::solve(const Param& mu, const FomSolution* warm) const
       ipopt_status = Ipopt::Unrecoverable_Exception;
     }
     sol.iterations += nlp->iterations();
+    ++sol.pairing_iterations;
     const bool have_iterate = nlp->finalized() && nlp->x().size() == nf && nlp->lambda().size() == qp.b.size() &&
                               nlp->x().allFinite() && nlp->lambda().allFinite();
     if (have_iterate) {
@@ -414,34 +413,34 @@ FomSolution IpoptQpSolver::solve(const Param& mu, const FomSolution* warm) const
         gap(s) = (qp.b(r) - ax(r)) / contact.weights()(s);
       }
     }
-    const Status status = map_status(ipopt_status, nlp->nlp_error(), opt.acceptable_tol);
-    if (status != Status::Success || !have_iterate) {
-      sol.status = status == Status::Success ? Status::NumericalIssue : status;
+    out.status = map_status(ipopt_status, nlp->nlp_error(), opt.acceptable_tol);
+    if (out.status != Status::Success || !have_iterate) {
+      if (out.status == Status::Success) out.status = Status::NumericalIssue;
       std::ostringstream msg;
       msg << "Ipopt returned " << ipopt_status_name(ipopt_status) << " after " << nlp->iterations()
           << " iterations in pairing iteration " << sol.pairing_iterations;
       if (!error.empty()) msg << " (" << error << ")";
       sol.message = msg.str();
-      break;
+      return out;
     }
-    if (!contact.has_pairing()) {
-      converged = true;
-      break;
-    }
-    // Fixed point certified when re-pairing at the solution reproduces the pairing used.
-    const Eigen::VectorXd f_s = contact.restrict_to_surface(u);
-    if (contact.search(f_s).same_as(pairing, opt.pairing_tolerance)) {
-      converged = true;
-      break;
-    }
-    x = mixer.next(x, f_s);
-    pairing = contact.search(x);
-  }
-  if (!converged && sol.status == Status::Success) {
-    sol.status = Status::NoConvergence;
-    sol.message = "contact pairing did not settle in " + std::to_string(opt.max_pairing_iterations) +
-                  " fixed-point iterations";
-  }
+    out.surface_displacement = contact.restrict_to_surface(u);
+    // The stopping test reads the rows that carry force: an interior-point method
+    // leaves multipliers ≈ barrier parameter / slack on the others.
+    out.lambda = sol.lambda;
+    const double lmax = sol.lambda.size() ? sol.lambda.maxCoeff() : 0.0;
+    for (int s = 0; s < nc; ++s)
+      if (!(sol.lambda(s) > opt.active_tolerance * lmax)) out.lambda(s) = 0.0;
+    return out;
+  };
+  fom::PairingFixedPointOptions fixed_point;
+  fixed_point.max_iterations = opt.max_pairing_iterations;
+  fixed_point.tolerance = opt.pairing_tolerance;
+  fixed_point.anderson_depth = opt.anderson_depth;
+  const fom::PairingFixedPointResult fp =
+      fom::solve_pairing_fixed_point(contact, problem.displacement_scale(), x, pairing, fixed_point, solve_at);
+  sol.status = fp.status;
+  if (fp.status != Status::Success && fp.solution.status == Status::Success)  // the cap, not a failed solve
+    sol.message = fom::pairing_no_convergence_message(fp, fixed_point);
   sol.u = u;
   const double lmax = sol.lambda.size() ? sol.lambda.maxCoeff() : 0.0;
   // Interior-point multipliers are never exactly zero: a row is active when its pressure

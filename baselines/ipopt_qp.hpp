@@ -32,7 +32,10 @@ struct IpoptOptions {
   int max_iterations = 3000;        ///< Ipopt `max_iter` per QP solve (default 3000)
   int print_level = 0;              ///< Ipopt `print_level`; 0 with `sb = yes` silences Ipopt (default 0)
   int max_pairing_iterations = 300;  ///< cap of the pairing fixed point (default 300)
-  double pairing_tolerance = 1e-12; ///< max change of ξ and normals to stop (default 1e-12)
+  /// Stopping tolerance of the pairing fixed point, as in fom::ActiveSetSolver
+  /// (fom::pairing_change(), on the rows whose pressure exceeds active_tolerance times
+  /// the largest) (default 1e-12).
+  double pairing_tolerance = 1e-12;
   /// Anderson acceleration depth of the pairing fixed point, as in fom::ActiveSetSolver
   /// (0: plain iteration, whose rate is ≈ 0.8 on `hertz` d = 0.3) (default 5).
   int anderson_depth = 5;
@@ -64,9 +67,8 @@ struct IpoptOptions {
 /// \f$ \tfrac12 u_0^T K_{ff} u_0 - f_f^T u_0 \f$ has the constant Hessian \f$ K_{ff} \f$ (lower
 /// triangle), the constraints are \f$ C_{\cdot f}\, u_{0,f} \le g - C u_{lift} \f$ for paired
 /// rows touching a free dof; other rows are dropped and get \f$ \lambda_s = 0 \f$. The pairing
-/// fixed point (Anderson-accelerated) starts from the unconstrained solution, as the
-/// active-set solver does (or from `warm`), and stops when re-pairing at the solution
-/// reproduces the pairing used, Pairing::same_as to `pairing_tolerance`.
+/// fixed point is the active-set solver's (fom/pairing_fixed_point.hpp: Anderson-accelerated,
+/// one stopping test); it starts from the unconstrained solution (or from `warm`).
 class IpoptQpSolver {
  public:
   explicit IpoptQpSolver(const fom::Problem& problem, IpoptOptions options = {});

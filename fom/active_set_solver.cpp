@@ -3,9 +3,9 @@
 #include <Eigen/CholmodSupport>
 #include <chrono>
 
-#include "core/anderson.hpp"
 #include "core/errors.hpp"
 #include "core/stopwatch.hpp"
+#include "fom/pairing_fixed_point.hpp"
 #include "fom/rigid_bodies.hpp"
 
 namespace contactrom::fom {
@@ -38,19 +38,99 @@ Eigen::MatrixXd delassus(const ConstraintMatrix& c, const std::vector<int>& rows
   return g;
 }
 
-bool pairing_settled(const ConstraintMatrix& c, const Eigen::VectorXd& g, const ConstraintMatrix& c_next,
-                     const Eigen::VectorXd& g_next, const Eigen::VectorXd& u_s, const Eigen::VectorXd& lambda,
-                     const Eigen::VectorXd& w, double u_scale, double tol) {
-  const Eigen::VectorXd force = c.transpose() * lambda;
-  const double force_scale = std::max(force.norm(), 1e-300);
-  if ((c_next.transpose() * lambda - force).norm() > tol * force_scale) return false;
-  const Eigen::VectorXd v = (c * u_s - g).cwiseQuotient(w), v_next = (c_next * u_s - g_next).cwiseQuotient(w);
-  for (int s = 0; s < v.size(); ++s) {
-    if (v_next(s) > tol * u_scale) return false;  // penetration under the new pairing
-    if ((lambda(s) > 0.0 || v(s) > -tol * u_scale) && std::abs(v_next(s) - v(s)) > tol * u_scale) return false;
+/// The dual QP of one pairing on a working set W of rows (see
+/// ActiveSetOptions::working_set_margin): rows active or, at the iterate x, within
+/// the margin of contact. The QP is solved on W; rows outside W are then checked at
+/// the solution and the violated ones join W (repeat), so λ solves the QP of all
+/// rows while the Delassus matrix is only |W| x |W|. `lambda` carries the
+/// multipliers from one pairing to the next (working set and warm start).
+class WorkingSetQp {
+ public:
+  WorkingSetQp(const Problem& problem, const Condensation& cond, const ActiveSetOptions& options,
+               Eigen::VectorXd u0_s, Eigen::VectorXd lambda)
+      : m_contact(problem.contact()), m_cond(cond), m_options(options), m_qp(options.qp),
+        m_margin(options.working_set_margin * problem.displacement_scale()), m_u0_s(std::move(u0_s)),
+        m_lambda(std::move(lambda)) {}
+
+  /// Solves at the pairing whose operator is c, g; adds the QP's iterations to `iterations`.
+  PairedSolution solve(const Pairing& pairing, const ConstraintMatrix& c, const Eigen::VectorXd& g,
+                       const Eigen::VectorXd& x, int& iterations) {
+    PairedSolution out;
+    const int nc = m_contact.num_constraints();
+    const Eigen::VectorXd h = c * m_u0_s - g;
+    select_working_set(pairing, c * x - g);
+    // Rows outside W must not penetrate at the QP's solution, to the QP's tolerance
+    // (relative to |h|∞; W's part of h is no larger).
+    const double tol = m_options.qp.relative_tolerance * (nc > 0 ? h.cwiseAbs().maxCoeff() : 0.0);
+    for (;;) {
+      const Eigen::VectorXd lambda_w = solve_on_working_set(c, h, iterations);
+      if (!m_w_rows.empty() && m_qp.info() != Status::Success) {
+        out.status = m_qp.info();
+        break;
+      }
+      out.surface_displacement = m_u0_s - m_sct * lambda_w;
+      if (!grow_working_set(pairing, c * out.surface_displacement - g, tol)) {
+        m_lambda.setZero();
+        for (size_t a = 0; a < m_w_rows.size(); ++a) m_lambda(m_w_rows[a]) = lambda_w(a);
+        break;
+      }
+      for (Eigen::Index a = 0; a < lambda_w.size(); ++a) m_lambda(m_w_rows[a]) = lambda_w(a);
+      m_w_rows.clear();
+      for (int s = 0; s < nc; ++s)
+        if (m_in_w[s]) m_w_rows.push_back(s);
+    }
+    out.lambda = m_lambda;
+    return out;
   }
-  return true;
-}
+
+  /// Status of the last failed QP (for the message).
+  Status qp_info() const { return m_qp.info(); }
+
+ private:
+  bool paired(const Pairing& pairing, int s) const { return !m_contact.has_pairing() || pairing.segment[s] >= 0; }
+
+  void select_working_set(const Pairing& pairing, const Eigen::VectorXd& gap) {
+    const int nc = m_contact.num_constraints();
+    const bool all_rows = m_options.working_set_margin < 0.0;
+    m_in_w.assign(nc, 0);
+    m_w_rows.clear();
+    for (int s = 0; s < nc; ++s)
+      if (paired(pairing, s) && (all_rows || m_lambda(s) > 0.0 || gap(s) > -m_margin * m_contact.weights()(s)))
+        m_in_w[s] = 1, m_w_rows.push_back(s);
+  }
+
+  /// λ_W of the QP on W (G_W = C_W S C_Wᵀ, h_W), warm-started from the current λ;
+  /// leaves S C_Wᵀ in m_sct.
+  Eigen::VectorXd solve_on_working_set(const ConstraintMatrix& c, const Eigen::VectorXd& h, int& iterations) {
+    delassus_parts(c, m_w_rows, m_cond.s, m_sct);
+    const int nw = static_cast<int>(m_w_rows.size());
+    if (nw == 0) return Eigen::VectorXd();
+    const Eigen::MatrixXd g_w = delassus(c, m_w_rows, m_sct);
+    Eigen::VectorXd h_w(nw), warm_w(nw);
+    for (int a = 0; a < nw; ++a) h_w(a) = h(m_w_rows[a]), warm_w(a) = m_lambda(m_w_rows[a]);
+    Eigen::VectorXd lambda_w = m_qp.solve(g_w, h_w, {}, warm_w);
+    iterations += m_qp.iterations();
+    return lambda_w;
+  }
+
+  /// Adds the paired rows outside W that penetrate (gap v > tol); returns whether any did.
+  bool grow_working_set(const Pairing& pairing, const Eigen::VectorXd& v, double tol) {
+    bool grown = false;
+    for (int s = 0; s < m_contact.num_constraints(); ++s)
+      if (!m_in_w[s] && paired(pairing, s) && v(s) > tol) m_in_w[s] = 1, grown = true;
+    return grown;
+  }
+
+  const ContactModel& m_contact;
+  const Condensation& m_cond;
+  const ActiveSetOptions& m_options;
+  DualQpSolver m_qp;
+  double m_margin;
+  Eigen::VectorXd m_u0_s, m_lambda;
+  std::vector<char> m_in_w;
+  std::vector<int> m_w_rows;
+  Eigen::MatrixXd m_sct;  // S C_Wᵀ, n_s x |W|
+};
 
 }  // namespace
 
@@ -100,6 +180,12 @@ bool condense(const Problem& problem, const Param& mu, Condensation& out, const 
   for (int t = 0; t < nt; ++t) cond.z_load.col(t) += problem.lifting_terms()[t];
   out = std::move(cond);
   return true;
+}
+
+Eigen::MatrixXd unconstrained_load_responses(const Problem& problem, const Param& mu) {
+  Condensation cond;
+  if (!condense(problem, mu, cond)) throw InputError(singular_stiffness_message(problem));
+  return std::move(cond.z_load);
 }
 
 Eigen::VectorXd Condensation::surface_response(const Eigen::VectorXd& surface_force) const {
@@ -163,124 +249,44 @@ FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) con
 FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& mu, const FomSolution* warm) const {
   const auto t0 = std::chrono::steady_clock::now();
   const ContactModel& contact = m_problem.contact();
-  const std::vector<int>& surf = contact.surface_dofs();
-  const int nc = contact.num_constraints();
   FomSolution sol;
   sol.mu = mu;
-
+  // 1. The unconstrained solution u0(μ): a combination of the condensed load terms.
   const Eigen::VectorXd u0 = cond.z_load * m_problem.load_coefficients(mu);
-  Eigen::VectorXd u0_s(surf.size());
-  for (size_t j = 0; j < surf.size(); ++j) u0_s(j) = u0(surf[j]);
-
-  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(nc);
-  // Start from the unconstrained solution, or from a previous solution if given.
-  const bool use_warm = warm && warm->lambda.size() == nc && warm->u.size() == m_problem.num_dofs();
-  if (use_warm) lambda = warm->lambda;
-  Eigen::VectorXd x = use_warm ? contact.restrict_to_surface(warm->u) : u0_s;
-  Pairing pairing = contact.search(x);
-
-  DualQpSolver qp(m_options.qp);
-  ConstraintMatrix c;
-  Eigen::VectorXd g;
-  Eigen::MatrixXd sct;  // S C_Wᵀ, n_s x |W|
-  const double margin = m_options.working_set_margin * m_problem.displacement_scale();
-  const bool all_rows = m_options.working_set_margin < 0.0;
-  bool converged = false;
-  // Fixed point x -> F(x) on the surface displacement: pairing from x, exact dual
-  // QP for that pairing, F(x) = resulting surface displacement. Anderson
-  // acceleration (Walker & Ni 2011, type II) on x; the QP is always solved exactly,
-  // so the extrapolated x only chooses the pairing.
-  AndersonMixer mixer(m_options.anderson_depth);
-  for (int it = 0; it < m_options.max_pairing_iterations; ++it) {
-    ++sol.pairing_iterations;
-    contact.assemble(pairing, c, g);
-    const Eigen::VectorXd h = c * u0_s - g;
-    // Working set W: the rows that are active or, at the current iterate x,
-    // within the margin of contact. The QP is solved on W; rows outside W are
-    // then checked at the solution and the violated ones join W (repeat), so
-    // λ solves the QP of all rows while the Delassus matrix is only |W| x |W|.
-    auto paired = [&](int s) { return !contact.has_pairing() || pairing.segment[s] >= 0; };
-    std::vector<char> in_w(nc, 0);
-    std::vector<int> w_rows;
-    {
-      const Eigen::VectorXd gap = c * x - g;
-      for (int s = 0; s < nc; ++s)
-        if (paired(s) && (all_rows || lambda(s) > 0.0 || gap(s) > -margin * contact.weights()(s)))
-          in_w[s] = 1, w_rows.push_back(s);
-    }
-    // Rows outside W must not penetrate at the QP's solution, to the QP's tolerance
-    // (relative to |h|∞; W's part of h is no larger).
-    const double tol = m_options.qp.relative_tolerance * (nc > 0 ? h.cwiseAbs().maxCoeff() : 0.0);
-    Eigen::VectorXd lambda_w, f;
-    bool qp_ok = true;
-    for (;;) {
-      delassus_parts(c, w_rows, cond.s, sct);
-      const Eigen::MatrixXd g_w = delassus(c, w_rows, sct);
-      const int nw = static_cast<int>(w_rows.size());
-      Eigen::VectorXd h_w(nw), warm_w(nw);
-      for (int a = 0; a < nw; ++a) h_w(a) = h(w_rows[a]), warm_w(a) = lambda(w_rows[a]);
-      if (nw > 0) {
-        lambda_w = qp.solve(g_w, h_w, {}, warm_w);
-        sol.iterations += qp.iterations();
-      } else {
-        lambda_w.resize(0);
-      }
-      if (nw > 0 && qp.info() != Status::Success) {
-        qp_ok = false;
-        break;
-      }
-      f = u0_s - sct * lambda_w;
-      const Eigen::VectorXd v = c * f - g;
-      bool grown = false;
-      for (int s = 0; s < nc; ++s)
-        if (!in_w[s] && paired(s) && v(s) > tol) in_w[s] = 1, grown = true;
-      if (!grown) break;
-      for (int a = 0; a < nw; ++a) lambda(w_rows[a]) = lambda_w(a);
-      w_rows.clear();
-      for (int s = 0; s < nc; ++s)
-        if (in_w[s]) w_rows.push_back(s);
-    }
-    if (!qp_ok) {
-      sol.status = qp.info();
-      sol.message = "dual active-set QP failed: " + std::string(to_string(qp.info()));
-      break;
-    }
-    lambda.setZero();
-    for (size_t a = 0; a < w_rows.size(); ++a) lambda(w_rows[a]) = lambda_w(a);
-    if (!contact.has_pairing()) {
-      converged = true;
-      break;
-    }
-    // Converged when re-pairing at F(x) no longer changes the KKT system of
-    // this solution: the forces Cᵀλ, the gaps of active/penetrating rows and
-    // the penetration, each to `pairing_tolerance` (relative).
-    const Pairing next = contact.search_rows(f, nullptr, &pairing);
-    ConstraintMatrix c_next;
-    Eigen::VectorXd g_next;
-    contact.assemble(next, c_next, g_next);
-    if (pairing_settled(c, g, c_next, g_next, f, lambda, contact.weights(), m_problem.displacement_scale(),
-                        m_options.pairing_tolerance)) {
-      converged = true;
-      break;
-    }
-    x = mixer.next(x, f);
-    pairing = contact.search_rows(x, nullptr, &next);
-  }
-  if (!converged && sol.status == Status::Success) {
-    sol.status = Status::NoConvergence;
-    sol.message = "contact pairing did not settle in " + std::to_string(m_options.max_pairing_iterations) +
-                  " fixed-point iterations";
-  }
-  // The constraint operator of the returned solution is the one λ was solved with;
-  // on convergence the pairing recomputed from u agrees with it to the tolerance.
-  sol.active = static_cast<int>((lambda.array() > 0.0).count());
-  // u = u0 − K⁻¹ E_s Cᵀλ: one solve with the factor.
+  const Eigen::VectorXd u0_s = contact.restrict_to_surface(u0);
+  // 2. Start from u0, or from a previous solution (its u, λ) if one fits.
+  const bool use_warm = warm && warm->lambda.size() == contact.num_constraints() && warm->u.size() == m_problem.num_dofs();
+  const Eigen::VectorXd x = use_warm ? contact.restrict_to_surface(warm->u) : u0_s;
+  WorkingSetQp qp(m_problem, cond, m_options, u0_s,
+                  use_warm ? warm->lambda : Eigen::VectorXd::Zero(contact.num_constraints()));
+  // 3. The pairing fixed point around the exact dual QP of each pairing.
+  const PairingFixedPointResult fp = solve_pairing_fixed_point(
+      contact, m_problem.displacement_scale(), x, contact.search(x), pairing_options(),
+      [&](const Pairing& pairing, const ConstraintMatrix& c, const Eigen::VectorXd& g, const Eigen::VectorXd& xk) {
+        return qp.solve(pairing, c, g, xk, sol.iterations);
+      });
+  // 4. The displacement u = u0 − K⁻¹ E_s Cᵀλ (one solve with the factor).
+  sol.pairing_iterations = fp.iterations;
+  sol.lambda = fp.solution.lambda;
+  sol.pairing = fp.pairing;
+  sol.active = static_cast<int>((sol.lambda.array() > 0.0).count());
   sol.u = u0;
-  if (sol.active > 0) sol.u -= cond.surface_response(c.transpose() * lambda);
-  sol.lambda = lambda;
-  sol.pairing = pairing;
+  if (sol.active > 0) sol.u -= cond.surface_response(fp.c.transpose() * sol.lambda);
+  sol.status = fp.status;
+  if (fp.solution.status != Status::Success)
+    sol.message = "dual active-set QP failed: " + std::string(to_string(fp.solution.status));
+  else if (fp.status != Status::Success)
+    sol.message = pairing_no_convergence_message(fp, pairing_options());
   sol.time_s = seconds_since(t0);
   return sol;
+}
+
+PairingFixedPointOptions ActiveSetSolver::pairing_options() const {
+  PairingFixedPointOptions o;
+  o.max_iterations = m_options.max_pairing_iterations;
+  o.tolerance = m_options.pairing_tolerance;
+  o.anderson_depth = m_options.anderson_depth;
+  return o;
 }
 
 }  // namespace contactrom::fom

@@ -19,8 +19,9 @@
 ///     The dual QP runs on a working set W of rows (active, or within
 ///     working_set_margin·U of contact at the current iterate): G_W = C_W S C_Wᵀ,
 ///     then rows outside W that penetrate join W and the QP is solved again, so λ
-///     is the QP solution of all rows at a cost set by |W|. The pairing fixed point is
-///     Anderson-accelerated; each search is seeded by the previous pairing.
+///     is the QP solution of all rows at a cost set by |W|. The pairing fixed point
+///     (fom/pairing_fixed_point.hpp) is Anderson-accelerated; each search is seeded
+///     by the previous pairing.
 /// solve() is const and thread-safe (no factorisation state is touched per query
 /// when the stiffness is parameter-independent).
 #include <Eigen/Dense>
@@ -28,6 +29,7 @@
 
 #include "fom/contact_model.hpp"
 #include "fom/dual_qp.hpp"
+#include "fom/pairing_fixed_point.hpp"
 #include "fom/problem.hpp"
 #include "fom/sparse_cholesky.hpp"
 
@@ -52,7 +54,8 @@ struct ActiveSetOptions {
   int max_pairing_iterations = 300;  ///< cap of the pairing fixed point, default 300
   /// The pairing loop stops when re-pairing at the current solution changes the
   /// contact forces Cᵀλ (relative to |Cᵀλ|), the gaps of active rows and the
-  /// penetration (relative to the displacement scale) by at most this; default 1e-12.
+  /// penetration (relative to the displacement scale) by at most this
+  /// (fom::pairing_change()); default 1e-12.
   double pairing_tolerance = 1e-12;
   /// The dual QP is solved on a working set: rows active or with a gap above
   /// −margin·U at the current iterate (U: displacement scale), grown until no
@@ -83,6 +86,12 @@ struct Condensation {
 /// Returns false (and leaves `out` untouched) if the factorisation fails.
 bool condense(const Problem& problem, const Param& mu, Condensation& out, const std::vector<int>* order = nullptr);
 
+/// \brief The unconstrained solution of each load term at `mu`, lifting included
+/// (Condensation::z_load, n x n_terms): column k is
+/// \f$ L_k + K_{ff}^{-1}(f_{ext,k} - K L_k)_f \f$, the harmonic lifting of the
+/// reduced model. \throws InputError if K(μ) is singular on the free dofs.
+Eigen::MatrixXd unconstrained_load_responses(const Problem& problem, const Param& mu);
+
 /// \brief Custom active-set FOM solver; see the file comment.
 class ActiveSetSolver {
  public:
@@ -99,6 +108,7 @@ class ActiveSetSolver {
 
  private:
   FomSolution solve_with(const Condensation& cond, const Param& mu, const FomSolution* warm) const;
+  PairingFixedPointOptions pairing_options() const;
 
   const Problem& m_problem;
   ActiveSetOptions m_options;

@@ -6,32 +6,18 @@
 #include <cmath>
 #include <limits>
 
+#include "fom/active_set_solver.hpp"
 #include "rom/pod.hpp"
 
 namespace contactrom::rom {
 namespace {
 
-/// Unconstrained FOM responses L̃_k = L_k + K_ff⁻¹ (f_ext,k − K L_k)_f at μ̄.
+/// Unconstrained FOM responses L̃_k = L_k + K_ff⁻¹ (f_ext,k − K L_k)_f at μ̄: the
+/// load responses of the FOM's condensation.
 std::vector<Eigen::VectorXd> harmonic_offsets(const fom::Problem& problem) {
-  const fom::Param mid = 0.5 * (problem.param_lower() + problem.param_upper());
-  const fom::SparseMatrix k = problem.stiffness(mid);
-  const std::vector<int>& free = problem.free_dofs();
-  const int n = problem.num_dofs(), nf = static_cast<int>(free.size());
-  std::vector<int> index(n, -1);
-  for (int i = 0; i < nf; ++i) index[free[i]] = i;
-  Eigen::SimplicialLDLT<fom::SparseMatrix> ldlt(fom::free_block(k, index, nf));
-  if (ldlt.info() != Eigen::Success)
-    throw InputError("stiffness of '" + problem.name() + "' is singular on the free dofs; cannot build the lifting");
+  const Eigen::MatrixXd z = fom::unconstrained_load_responses(problem, 0.5 * (problem.param_lower() + problem.param_upper()));
   std::vector<Eigen::VectorXd> out;
-  for (int t = 0; t < problem.num_load_terms(); ++t) {
-    const Eigen::VectorXd r = problem.external_load_terms()[t] - k * problem.lifting_terms()[t];
-    Eigen::VectorXd rf(nf);
-    for (int i = 0; i < nf; ++i) rf(i) = r(free[i]);
-    const Eigen::VectorXd x = ldlt.solve(rf);
-    Eigen::VectorXd l = problem.lifting_terms()[t];
-    for (int i = 0; i < nf; ++i) l(free[i]) += x(i);
-    out.push_back(l);
-  }
+  for (Eigen::Index t = 0; t < z.cols(); ++t) out.push_back(z.col(t));
   return out;
 }
 

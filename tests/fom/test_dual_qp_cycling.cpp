@@ -33,12 +33,12 @@ double lcp_violation(const MatrixXd& g, const VectorXd& h, const VectorXd& lambd
 BOOST_AUTO_TEST_CASE(solutions_satisfy_the_lcp_with_and_without_the_lawson_hanson_fallback) {
   std::mt19937_64 gen(2024);
   int fallbacks = 0;
-  for (int trial = 0; trial < 400; ++trial) {
-    const int n = 3 + trial % 8;
-    // G = AᵀA with strongly correlated columns: far from an M-matrix.
-    MatrixXd a = contactrom::test::gaussian(n + 2, n, gen);
-    a.col(0) += 2.0 * a.col(n - 1);
-    const MatrixXd g = a.transpose() * a;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int n = 3 + trial % 6;
+    // G = AᵀA + 10⁻³ I with a square Gaussian A: SPD, far from an M-matrix, often
+    // ill-conditioned (PDAS cycles on about one problem in a few thousand).
+    const MatrixXd a = contactrom::test::gaussian(n, n, gen);
+    const MatrixXd g = a.transpose() * a + 1e-3 * MatrixXd::Identity(n, n);
     const VectorXd h = contactrom::test::gaussian(n, 1, gen).col(0);
     DualQpSolver qp;
     const VectorXd lambda = qp.solve(g, h, {}, VectorXd());
@@ -46,18 +46,17 @@ BOOST_AUTO_TEST_CASE(solutions_satisfy_the_lcp_with_and_without_the_lawson_hanso
     BOOST_TEST(lcp_violation(g, h, lambda) < 1e-9, "trial " << trial << (qp.used_fallback() ? " (fallback)" : ""));
     fallbacks += qp.used_fallback() ? 1 : 0;
   }
-  BOOST_TEST_MESSAGE(fallbacks << " of 400 problems went to Lawson-Hanson");
+  BOOST_TEST_MESSAGE(fallbacks << " of 20000 problems went to Lawson-Hanson");
   BOOST_TEST(fallbacks > 0);
 }
 
 BOOST_AUTO_TEST_CASE(rows_that_are_not_eligible_stay_at_zero_in_the_fallback_too) {
   std::mt19937_64 gen(7);
   int checked = 0;
-  for (int trial = 0; trial < 400 && checked < 20; ++trial) {
-    const int n = 6;
-    MatrixXd a = contactrom::test::gaussian(n + 1, n, gen);
-    a.col(0) += 2.0 * a.col(n - 1);
-    const MatrixXd g = a.transpose() * a;
+  for (int trial = 0; trial < 50000 && checked < 3; ++trial) {
+    const int n = 4;
+    const MatrixXd a = contactrom::test::gaussian(n, n, gen);
+    const MatrixXd g = a.transpose() * a + 1e-3 * MatrixXd::Identity(n, n);
     const VectorXd h = contactrom::test::gaussian(n, 1, gen).col(0);
     std::vector<char> eligible(n, 1);
     eligible[1] = 0;
@@ -65,6 +64,15 @@ BOOST_AUTO_TEST_CASE(rows_that_are_not_eligible_stay_at_zero_in_the_fallback_too
     const VectorXd lambda = qp.solve(g, h, eligible, VectorXd());
     BOOST_REQUIRE(qp.info() == Status::Success);
     BOOST_TEST(lambda(1) == 0.0);
+    // The LCP of the eligible rows.
+    const std::vector<int> rows = {0, 2, 3};
+    MatrixXd g_e(3, 3);
+    VectorXd h_e(3), lambda_e(3);
+    for (int i = 0; i < 3; ++i) {
+      h_e(i) = h(rows[i]), lambda_e(i) = lambda(rows[i]);
+      for (int j = 0; j < 3; ++j) g_e(i, j) = g(rows[i], rows[j]);
+    }
+    BOOST_TEST(lcp_violation(g_e, h_e, lambda_e) < 1e-9);
     checked += qp.used_fallback() ? 1 : 0;
   }
   BOOST_TEST(checked > 0);

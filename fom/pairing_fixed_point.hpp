@@ -1,0 +1,130 @@
+#pragma once
+/// \file pairing_fixed_point.hpp
+/// \brief The contact pairing fixed point shared by the FOM solvers
+/// (fom::ActiveSetSolver, baselines::IpoptQpSolver): the constraint operator
+/// \f$ C(u), g(u) \f$ of node-to-segment contact depends on the deformed
+/// configuration, so the QP "minimise the energy subject to \f$ C u_s \le g \f$" is
+/// solved at a fixed pairing and the pairing is recomputed from its solution until
+/// it no longer changes the problem.
+///
+/// Algorithm, on the surface displacement \f$ x \f$ (n_s):
+///  1. pair at \f$ x \f$ (ContactModel::search_rows, seeded by the previous
+///     pairing) and assemble \f$ C, g \f$;
+///  2. solve at that pairing (the caller's exact QP solve) →
+///     \f$ \lambda \f$ and the surface displacement \f$ F(x) \f$ of the solution;
+///  3. re-pair at \f$ F(x) \f$ → \f$ C', g' \f$ and stop when the KKT system of the
+///     solution is unchanged (pairing_change() ≤ `tolerance`);
+///  4. otherwise \f$ x \leftarrow \f$ Anderson mixing of \f$ x, F(x) \f$
+///     (AndersonMixer, Walker & Ni 2011, type II, depth `anderson_depth`) and go to 1.
+///
+/// The QP is always solved exactly: the extrapolated \f$ x \f$ only chooses the
+/// pairing, so a converged result is a KKT point of its own pairing whatever the
+/// acceleration did. Models without pairing (obstacles) take one solve.
+///
+/// Stopping test (pairing_change()): with \f$ v = (C u_s - g)/w \f$ and
+/// \f$ v' = (C' u_s - g')/w \f$ the gaps per tributary length w under the old and new
+/// pairing, U the problem's displacement scale,
+/// \f[ r = \max\Big( \frac{\|C'^T\lambda - C^T\lambda\|}{\|C^T\lambda\|},\;
+///     \max_{s \in A} \frac{|v'_s - v_s|}{U},\; \max_s \frac{\max(v'_s, 0)}{U} \Big), \f]
+/// A the rows that carry pressure (\f$ \lambda_s > 0 \f$) or are within
+/// tolerance·U of contact: the contact forces, the gaps that matter and the
+/// penetration must each be unchanged to `tolerance` (relative).
+#include <Eigen/Dense>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "core/anderson.hpp"
+#include "core/errors.hpp"
+#include "fom/contact_model.hpp"
+
+namespace contactrom::fom {
+
+/// \brief Options of solve_pairing_fixed_point() (documented defaults).
+struct PairingFixedPointOptions {
+  int max_iterations = 300;   ///< cap on the solves (pairing iterations). Default 300.
+  double tolerance = 1e-12;   ///< stop when pairing_change() ≤ this (relative). Default 1e-12.
+  int anderson_depth = 10;    ///< Anderson depth (0: plain fixed-point iteration). Default 10.
+};
+
+/// \brief What the solve at a fixed pairing returns to the fixed point.
+struct PairedSolution {
+  Status status = Status::Success;         ///< anything but Success stops the fixed point
+  Eigen::VectorXd surface_displacement;    ///< \f$ F(x) \f$: u on the surface dofs at the solution (n_s)
+  Eigen::VectorXd lambda;                  ///< pressure per constraint row (n_c); > 0 marks the rows that carry force
+};
+
+/// \brief Outcome of solve_pairing_fixed_point().
+struct PairingFixedPointResult {
+  /// Success when pairing_change() ≤ tolerance, NoConvergence at the cap, else the
+  /// status of the failing solve (solution.status then says which solve failed:
+  /// it is Success when the cap was reached).
+  Status status = Status::Success;
+  int iterations = 0;  ///< solves done
+  /// pairing_change() of the last iterate (0 without pairing, ∞ if a solve failed first).
+  double residual = std::numeric_limits<double>::infinity();
+  Pairing pairing;           ///< the pairing the last solution was computed with
+  ConstraintMatrix c;        ///< its constraint operator
+  Eigen::VectorXd g;         ///< its gap offsets
+  PairedSolution solution;   ///< the last solve's result
+};
+
+/// \brief The stopping test of the pairing fixed point (see the file comment):
+/// how much re-pairing at `u_s` (constraint operator `c_next`, `g_next`) changes the
+/// KKT system of the solution `u_s`, `lambda` computed with `c`, `g`; relative.
+/// \param weights tributary length per row (ContactModel::weights())
+/// \param u_scale displacement scale U of the problem
+/// \param tolerance rows within tolerance·U of contact count as touching
+double pairing_change(const ConstraintMatrix& c, const Eigen::VectorXd& g, const ConstraintMatrix& c_next,
+                      const Eigen::VectorXd& g_next, const Eigen::VectorXd& u_s, const Eigen::VectorXd& lambda,
+                      const Eigen::VectorXd& weights, double u_scale, double tolerance);
+
+/// \brief Runs the pairing fixed point (see the file comment) from the surface
+/// displacement `x` and its pairing `pairing`.
+/// \param solve_at `PairedSolution(const Pairing&, const ConstraintMatrix& c, const
+///   Eigen::VectorXd& g, const Eigen::VectorXd& x)`: the exact solve at the pairing
+///   whose operator is c, g; x is the iterate the pairing was computed from.
+template <class SolveAtPairing>
+PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, double u_scale, Eigen::VectorXd x,
+                                                  Pairing pairing, const PairingFixedPointOptions& options,
+                                                  SolveAtPairing&& solve_at) {
+  PairingFixedPointResult out;
+  AndersonMixer mixer(options.anderson_depth);
+  ConstraintMatrix c_next;
+  Eigen::VectorXd g_next;
+  out.status = Status::NoConvergence;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    ++out.iterations;
+    contact.assemble(pairing, out.c, out.g);
+    out.solution = solve_at(pairing, out.c, out.g, x);
+    out.pairing = pairing;
+    if (out.solution.status != Status::Success) {
+      out.status = out.solution.status;
+      return out;
+    }
+    if (!contact.has_pairing()) {
+      out.residual = 0.0;
+      out.status = Status::Success;
+      return out;
+    }
+    const Eigen::VectorXd& f = out.solution.surface_displacement;
+    Pairing next = contact.search_rows(f, nullptr, &pairing);
+    contact.assemble(next, c_next, g_next);
+    out.residual = pairing_change(out.c, out.g, c_next, g_next, f, out.solution.lambda, contact.weights(), u_scale,
+                                  options.tolerance);
+    if (out.residual <= options.tolerance) {
+      out.status = Status::Success;
+      return out;
+    }
+    x = mixer.next(x, f);
+    pairing = contact.search_rows(x, nullptr, &next);
+  }
+  return out;
+}
+
+/// \brief The message of a fixed point that reached its cap: "contact pairing did
+/// not settle in N fixed-point iterations (last change r > tolerance t)".
+std::string pairing_no_convergence_message(const PairingFixedPointResult& result,
+                                           const PairingFixedPointOptions& options);
+
+}  // namespace contactrom::fom
