@@ -10,13 +10,8 @@ namespace contactrom::fom {
 
 bool DualQpSolver::solve_on(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<int>& set,
                             Eigen::VectorXd& z) const {
-  const int m = static_cast<int>(set.size());
-  Eigen::MatrixXd gs(m, m);
-  Eigen::VectorXd hs(m);
-  for (int a = 0; a < m; ++a) {
-    hs(a) = h(set[a]);
-    for (int b = 0; b < m; ++b) gs(a, b) = g(set[a], set[b]);
-  }
+  const Eigen::MatrixXd gs = g(set, set);
+  const Eigen::VectorXd hs = h(set);
   Eigen::LLT<Eigen::MatrixXd> llt(gs);
   if (llt.info() == Eigen::Success) {
     z = llt.solve(hs);
@@ -94,12 +89,8 @@ Eigen::VectorXd DualQpSolver::lawson_hanson(const Eigen::MatrixXd& g, const Eige
   for (int i = 0; i < n; ++i)
     if (eligible[i]) rows.push_back(i);
   const int m = static_cast<int>(rows.size());
-  Eigen::MatrixXd g_e(m, m);
-  Eigen::VectorXd h_e(m);
-  for (int a = 0; a < m; ++a) {
-    h_e(a) = h(rows[a]);
-    for (int b = 0; b < m; ++b) g_e(a, b) = g(rows[a], rows[b]);
-  }
+  const Eigen::MatrixXd g_e = g(rows, rows);
+  const Eigen::VectorXd h_e = h(rows);
   Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
   const int budget = m_options.max_iterations - m_iterations;
   if (budget <= 0) {
