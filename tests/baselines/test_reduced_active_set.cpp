@@ -108,15 +108,7 @@ BOOST_AUTO_TEST_CASE(reduced_penetration_by_hand) {
 BOOST_AUTO_TEST_CASE(agrees_with_the_greedy_on_a_snapshot_rom) {
   // Rope of 8 elements, 9 FOM snapshots, POD basis: the greedy and the full
   // dictionary solve the same reduced QP (û unique since K̂ is positive definite).
-  fom::ProblemOptions po;
-  po.rope_elements = 8;
-  const auto problem = fom::make_rope_problem(po);
-  rom::OfflineOptions off;
-  off.threads = 1;
-  const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, 9, off);
-  rom::ReducedModelOptions ro;
-  ro.delta = 1e-12;
-  const rom::ReducedModel model(*problem, db, ro);
+  const rom::ReducedModel& model = *test::rope_snapshot_rom().model;
   std::vector<int> all(static_cast<size_t>(model.dictionary_size()));
   for (size_t c = 0; c < all.size(); ++c) all[c] = static_cast<int>(c);
   const ReducedActiveSet block("full-dictionary", model, all);

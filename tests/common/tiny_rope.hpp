@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "fom/problem.hpp"
+#include "rom/offline.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::test {
@@ -67,6 +68,34 @@ inline Eigen::MatrixXd unit_rope_dictionary() {
   Eigen::MatrixXd d = Eigen::MatrixXd::Zero(5, 3);
   d(1, 0) = 1.0, d(2, 1) = 3.0, d(3, 2) = 1.0;
   return d;
+}
+
+/// A ROM of the rope of 8 elements built from its FOM snapshots (the 9 training
+/// values of γ, δ = 1e-12), with the rope's constraint operator (constant: C = −diag(w),
+/// g = −wψ on every dof). Built once per test program.
+struct RopeSnapshotRom {
+  std::unique_ptr<fom::Problem> problem;
+  rom::SnapshotDatabase db;
+  std::unique_ptr<rom::ReducedModel> model;
+  fom::ConstraintMatrix c;
+  Eigen::VectorXd g;
+  RopeSnapshotRom() {
+    fom::ProblemOptions options;
+    options.rope_elements = 8;
+    problem = fom::make_rope_problem(options);
+    rom::OfflineOptions off;
+    off.threads = 1;
+    db = rom::generate_snapshots(*problem, 9, off);
+    rom::ReducedModelOptions ro;
+    ro.delta = 1e-12;
+    model = std::make_unique<rom::ReducedModel>(*problem, db, ro);
+    problem->contact().assemble(problem->contact().search(Eigen::VectorXd::Zero(problem->num_dofs())), c, g);
+  }
+};
+
+inline const RopeSnapshotRom& rope_snapshot_rom() {
+  static const RopeSnapshotRom rom;
+  return rom;
 }
 
 }  // namespace contactrom::test

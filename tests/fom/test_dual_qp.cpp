@@ -46,6 +46,17 @@ double kkt_violation(const MatrixXd& g, const VectorXd& h, const VectorXd& lambd
   return violation;
 }
 
+/// The rows and columns `set` of G, and the rows `set` of h.
+void principal(const MatrixXd& g, const VectorXd& h, const std::vector<int>& set, MatrixXd& gs, VectorXd& hs) {
+  const int m = static_cast<int>(set.size());
+  gs.resize(m, m);
+  hs.resize(m);
+  for (int a = 0; a < m; ++a) {
+    hs(a) = h(set[a]);
+    for (int b = 0; b < m; ++b) gs(a, b) = g(set[a], set[b]);
+  }
+}
+
 /// The LCP solution by enumeration of every active set S: λ_S = G_SS⁻¹ h_S ≥ 0 and
 /// w ≥ 0 off S. For a positive definite G exactly one S qualifies (up to rows with
 /// λᵢ = wᵢ = 0); the first one found is returned, `found` counts them.
@@ -58,12 +69,9 @@ VectorXd brute_force(const MatrixXd& g, const VectorXd& h, int& found) {
     for (int i = 0; i < n; ++i)
       if (mask & (1u << i)) set.push_back(i);
     const int m = static_cast<int>(set.size());
-    MatrixXd gs(m, m);
-    VectorXd hs(m);
-    for (int a = 0; a < m; ++a) {
-      hs(a) = h(set[a]);
-      for (int b = 0; b < m; ++b) gs(a, b) = g(set[a], set[b]);
-    }
+    MatrixXd gs;
+    VectorXd hs;
+    principal(g, h, set, gs, hs);
     VectorXd lambda = VectorXd::Zero(n);
     if (m > 0) {
       const VectorXd z = gs.llt().solve(hs);
@@ -201,12 +209,9 @@ BOOST_AUTO_TEST_CASE(ineligible_rows_stay_at_zero) {
     for (int i = 0; i < n; ++i)
       if (eligible[static_cast<size_t>(i)]) keep.push_back(i);
     const int k = static_cast<int>(keep.size());
-    MatrixXd gk(k, k);
-    VectorXd hk(k);
-    for (int a = 0; a < k; ++a) {
-      hk(a) = h(keep[a]);
-      for (int b = 0; b < k; ++b) gk(a, b) = g(keep[a], keep[b]);
-    }
+    MatrixXd gk;
+    VectorXd hk;
+    principal(g, h, keep, gk, hk);
     int found = 0;
     const VectorXd expected = brute_force(gk, hk, found);
     DualQpSolver solver;

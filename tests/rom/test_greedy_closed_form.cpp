@@ -185,38 +185,8 @@ BOOST_AUTO_TEST_CASE(a_satisfied_start_needs_no_column) {
   BOOST_TEST(r.lambda.norm() == 0.0);
 }
 
-namespace {
-
-/// A ROM of the rope of 8 elements from its FOM snapshots (9 training values of γ).
-struct SnapshotRom {
-  std::unique_ptr<fom::Problem> problem;
-  rom::SnapshotDatabase db;
-  std::unique_ptr<rom::ReducedModel> model;
-  fom::ConstraintMatrix c;  // the rope's constant constraint operator, all dofs
-  Eigen::VectorXd g;
-  SnapshotRom() {
-    fom::ProblemOptions options;
-    options.rope_elements = 8;
-    problem = fom::make_rope_problem(options);
-    rom::OfflineOptions off;
-    off.threads = 1;
-    db = rom::generate_snapshots(*problem, 9, off);
-    rom::ReducedModelOptions ro;
-    ro.delta = 1e-12;
-    model = std::make_unique<rom::ReducedModel>(*problem, db, ro);
-    problem->contact().assemble(problem->contact().search(VectorXd::Zero(problem->num_dofs())), c, g);
-  }
-};
-
-const SnapshotRom& snapshot_rom() {
-  static const SnapshotRom s;
-  return s;
-}
-
-}  // namespace
-
 BOOST_AUTO_TEST_CASE(training_parameter_reproduces_its_snapshot) {
-  const SnapshotRom& s = snapshot_rom();
+  const test::RopeSnapshotRom& s = test::rope_snapshot_rom();
   for (const auto& init : {rom::WarmStart::Cell, rom::WarmStart::Empty}) {
     rom::GreedyOptions options;
     options.init = init;
@@ -243,7 +213,7 @@ BOOST_AUTO_TEST_CASE(converged_result_meets_the_reduced_kkt_conditions) {
   // Between the training values: K̂û − f̂ + Ĉ_Iᵀλ̂ = 0, λ̂ ≥ 0, every column's reduced
   // violation D_dᵀ(Cu − g) ≤ τ and = 0 on the selected ones. The rope's constraint is
   // linear (C = −diag(w), g = −wψ on every dof), so Ĉ = D_dᵀ C Φ is formed densely here.
-  const SnapshotRom& s = snapshot_rom();
+  const test::RopeSnapshotRom& s = test::rope_snapshot_rom();
   const rom::ReducedModel& m = *s.model;
   const fom::ConstraintMatrix& c = s.c;
   const VectorXd& g = s.g;
