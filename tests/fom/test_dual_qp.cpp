@@ -2,7 +2,8 @@
 // min_{λ ≥ 0} ½λᵀGλ − hᵀλ: closed forms (one row, diagonal G, a 2 × 2 case solved by
 // hand), the edge cases no contact and full contact, the KKT conditions and
 // agreement with a brute-force enumeration of all 2ⁿ active sets on seeded random
-// QPs, rows that may not become active, semi-definite G, and honest statuses.
+// QPs, a cycle of the primal–dual active set that hands over to Lawson–Hanson, rows
+// that may not become active, semi-definite G, and honest statuses.
 #define BOOST_TEST_MODULE fom_dual_qp
 #include <boost/test/unit_test.hpp>
 
@@ -192,6 +193,26 @@ BOOST_AUTO_TEST_CASE(random_qps_agree_with_brute_force_enumeration) {
     }
   }
   BOOST_TEST_MESSAGE("Lawson-Hanson fallback used in " << fallbacks << " of 200 random QPs");
+}
+
+BOOST_AUTO_TEST_CASE(a_pdas_cycle_falls_back_to_lawson_hanson) {
+  // G (positive definite, not an M-matrix) and h below make the primal–dual active
+  // set cycle: it starts from the penetrating rows {1, 2}; there λ₂ = −68/1420 < 0
+  // and w₀ = −0.24 < 0, so the next set is {0, 1}; there λ₀ = −28/532 and
+  // λ₁ = −30/532 are both negative and w₂ > 0, so the next set is ∅; at λ = 0 rows 1
+  // and 2 penetrate again. The repeated set hands over to Lawson–Hanson, whose
+  // result must be the LCP solution.
+  const MatrixXd g = (MatrixXd(3, 3) << 181, -98, -93, -98, 56, 62, -93, 62, 94).finished();
+  const VectorXd h = (VectorXd(3) << -4, 2, 1).finished();
+  DualQpSolver solver;
+  const VectorXd lambda = solver.solve(g, h, {}, VectorXd());
+  BOOST_TEST(solver.used_fallback());
+  BOOST_TEST(solver.info() == Status::Success);
+  BOOST_TEST(kkt_violation(g, h, lambda) <= 1e-12);
+  int found = 0;
+  const VectorXd expected = brute_force(g, h, found);
+  BOOST_TEST(found == 1);
+  BOOST_TEST((lambda - expected).norm() <= 1e-12 * std::max(expected.norm(), 1.0));
 }
 
 BOOST_AUTO_TEST_CASE(ineligible_rows_stay_at_zero) {

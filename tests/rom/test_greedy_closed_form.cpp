@@ -142,6 +142,20 @@ BOOST_AUTO_TEST_CASE(every_step_of_alg1_by_hand) {
   BOOST_TEST(r.iterations >= 5);
 }
 
+BOOST_AUTO_TEST_CASE(threshold_scalings) {
+  // Absolute: τ itself, or δ of the model when τ < 0. Relative: τ·U·max_p Σ_s w_s|D[s,p]|
+  // with U = 0.5 (the rope's displacement scale) and the largest column force
+  // 3·¼ = 0.75 (the middle column).
+  rom::GreedyOptions o;
+  o.tau = 0.01;
+  BOOST_TEST(rom::greedy_threshold(hand_model(), o) == 0.01);
+  o.tau = -1.0;
+  BOOST_TEST(rom::greedy_threshold(hand_model(), o) == hand_model().delta());
+  o.tau = 0.01;
+  o.tau_scaling = rom::TauScaling::Relative;
+  BOOST_TEST(std::abs(rom::greedy_threshold(hand_model(), o) - 0.01 * 0.5 * 0.75) <= 1e-17);
+}
+
 BOOST_AUTO_TEST_CASE(hand_solution_is_the_fom_solution) {
   // Φ = I and a dictionary spanning every contact row of the solution: the ROM is the
   // FOM, so the FOM's solution is the hand one above.
