@@ -2,7 +2,7 @@
 """Regenerate the greedy active-set studies of the paper with the contactrom CLI.
 
     tools/experiments.py [--exe PATH] [--out RESULTS_DIR] [--figures DIR] [--quick]
-                         [--only hertz|ironing|ironing2[,...]] [--threads T]
+                         [--only hertz|ironing|ironing2[,...]] [--threads T] [--replot]
 
 Stages (each builds every snapshot database once and reuses it for all δ):
 
@@ -23,6 +23,9 @@ one CSV per (problem, training set, δ) with the per-parameter rows of
 timings.csv and summary.md (markdown tables); the PNG figures go to --figures
 (default docs/figures, or RESULTS_DIR/figures with --quick so that a smoke run
 never overwrites the committed figures).
+
+--replot runs nothing and redraws the hertz and ironing figures (all but the
+reconstructions, which need the CLI) from the results of an earlier run in RESULTS_DIR.
 
 --quick is a smoke mode (≈ 25 s on 2 busy cores; the full run ≈ 3 min): hertz
 12/30, ironing levels 3/4, ironing2 level 2, δ = 1e-8 only; every code path
@@ -46,6 +49,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter  # noqa: E402
 import numpy as np  # noqa: E402
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -231,8 +235,9 @@ def save_figure(fig, path):
 def evolution_figure(records, deltas, xlabel, path, n_contact, title, fom_time=None):
     """Six small panels against the number of snapshots (log axis), one line per δ:
     (a) mean primal error, (b) mean dual error, (c) primal rank, (d) mean iterations,
-    (e) time per query (mean solid, median dotted, the FOM solve as a reference line),
-    (f) time per iteration. A grey line marks as many snapshots as contact dofs."""
+    (e) time per query (median solid, mean dotted: a query slowed by another job moves
+    the mean only; the FOM solve as a reference line), (f) time per iteration, the same.
+    A grey line marks as many snapshots as contact dofs."""
     ns = sorted({r["n"] for r in records})
     get = {(r["n"], r["delta"]): r for r in records}
     snaps = [get[(n, deltas[0])]["snapshots"] for n in ns]
@@ -240,9 +245,9 @@ def evolution_figure(records, deltas, xlabel, path, n_contact, title, fom_time=N
               ("mean_dual_error", 1.0, None, "(b) mean dual error", "relative L² error", True),
               ("primal_rank", 1.0, None, "(c) primal rank", "POD modes", False),
               ("mean_iterations", 1.0, None, "(d) iterations per query", "mean iterations", False),
-              ("mean_time_s", 1e6, "median_time_s", "(e) time per query", "time (µs)", True),
-              ("mean_time_per_iteration_s", 1e6, "median_time_per_iteration_s", "(f) time per iteration",
-               "time (µs)", False)]
+              ("median_time_s", 1e6, "mean_time_s", "(e) time per query", "time (µs)", True),
+              ("median_time_per_iteration_s", 1e6, "mean_time_per_iteration_s", "(f) time per iteration",
+               "time (µs)", True)]
     fig, axes = plt.subplots(2, 3, figsize=(11, 6.4))
     for a, (key, scale, key2, ttl, ylabel, logy) in zip(axes.flat, panels):
         for delta in deltas:
@@ -250,7 +255,7 @@ def evolution_figure(records, deltas, xlabel, path, n_contact, title, fom_time=N
             a.plot(snaps, [scale * get[(n, delta)][key] for n in ns], "o-", color=c)
             if key2:
                 a.plot(snaps, [scale * get[(n, delta)][key2] for n in ns], "s:", color=c, ms=3)
-        if key == "mean_time_s" and fom_time:
+        if key == "median_time_s" and fom_time:
             a.axhline(1e6 * fom_time, color="k", ls="--", lw=1.2)
         if n_contact <= max(snaps):
             a.axvline(n_contact, color="0.6", ls="-.", lw=1)
@@ -260,6 +265,10 @@ def evolution_figure(records, deltas, xlabel, path, n_contact, title, fom_time=N
         a.minorticks_off()
         if logy:
             a.set_yscale("log")
+            if key2:  # times: label 1, 2, 5 × 10^k, since they span few decades
+                a.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+                a.yaxis.set_major_formatter(FormatStrFormatter("%g"))
+                a.yaxis.set_minor_formatter(NullFormatter())
         else:
             a.set_ylim(bottom=0)
         a.set_title(ttl, fontsize=10)
@@ -268,15 +277,15 @@ def evolution_figure(records, deltas, xlabel, path, n_contact, title, fom_time=N
     for a in axes[1]:
         a.set_xlabel(xlabel)
     handles = [Line2D([], [], color=DELTA_COLORS.get(d), marker="o", label=f"δ = {d:.0e}") for d in deltas]
-    handles.append(Line2D([], [], color="0.3", ls="-", label="mean"))
-    handles.append(Line2D([], [], color="0.3", marker="s", ms=3, ls=":", label="median (e, f)"))
+    handles.append(Line2D([], [], color="0.3", ls="-", label="mean (a–d), median (e, f)"))
+    handles.append(Line2D([], [], color="0.3", marker="s", ms=3, ls=":", label="mean (e, f)"))
     if fom_time:
-        handles.append(Line2D([], [], color="k", ls="--", label=f"FOM solve, offline mean ({1e6 * fom_time:.0f} µs)"))
+        handles.append(Line2D([], [], color="k", ls="--", label=f"FOM solve, offline-stage mean ({1e6 * fom_time:.0f} µs)"))
     if n_contact <= max(snaps):
         handles.append(Line2D([], [], color="0.6", ls="-.", label=f"snapshots = contact dofs ({n_contact})"))
     fig.suptitle(f"{title}: greedy ROM against the training set", fontsize=11)
-    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
-    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     fig.savefig(path, dpi=DPI)
     plt.close(fig)
 
@@ -389,23 +398,58 @@ def reconstruction_figure(examples, db, path):
 # ----------------------------------------------------------------------------- stages
 
 
-def stage_hertz(runner, cfg, timings, md):
-    sizes, deltas = cfg["hertz_sizes"], cfg["deltas"]
-    records, rows, dbs = run_study(runner, cfg["out"], "hertz", "train", sizes, deltas, timings)
-    t = time.time()
-    fig = cfg["figures"]
-    with h5py.File(dbs[sizes[0]], "r") as f:
-        n_contact = f["dual"].shape[1]
+def contact_dofs(db):
+    with h5py.File(db, "r") as f:
+        return f["dual"].shape[1]
+
+
+def hertz_figures(cfg, records, rows, dbs):
+    """The Hertz figures drawn from the study's results (all but the reconstructions)."""
+    sizes, deltas, fig = sorted(dbs), sorted({r["delta"] for r in records}, reverse=True), cfg["figures"]
     fom_time = float(np.mean([r["mean_fom_time_s"] for r in records]))
-    evolution_figure(records, deltas, "training snapshots", os.path.join(fig, "hertz_evolution.png"), n_contact,
-                     "Hertz", fom_time)
+    evolution_figure(records, deltas, "training snapshots", os.path.join(fig, "hertz_evolution.png"),
+                     contact_dofs(dbs[sizes[0]]), "Hertz", fom_time)
     error_curves_figure(rows, sizes, deltas, os.path.join(fig, "hertz_error_curves.png"))
     n_sp = 30 if 30 in sizes else sizes[0]
     d_sp = 1e-8 if 1e-8 in deltas else deltas[0]
     sparsity_figure(rows[(n_sp, d_sp)], dbs[n_sp], os.path.join(fig, "hertz_sparsity_train30.png"),
                     f"Hertz: snapshots selected by the greedy, {n_sp} snapshots, δ = {d_sp:.0e}", "d")
-    spy_figure(dbs[n_sp], os.path.join(fig, "hertz_dictionary_spy.png"),
-               f"Hertz dual dictionary, {n_sp} snapshots")
+    spy_figure(dbs[n_sp], os.path.join(fig, "hertz_dictionary_spy.png"), f"Hertz dual dictionary, {n_sp} snapshots")
+
+
+def ironing_figures(cfg, records, rows, dbs):
+    """The ironing figures drawn from the study's results."""
+    levels, deltas, fig = sorted(dbs), sorted({r["delta"] for r in records}, reverse=True), cfg["figures"]
+    fom_time = float(np.mean([r["mean_fom_time_s"] for r in records]))
+    evolution_figure(records, deltas, "training snapshots (nested level L)", os.path.join(fig, "ironing_evolution.png"),
+                     contact_dofs(dbs[levels[0]]), "Ironing", fom_time)
+    lv = 5 if 5 in levels else levels[-1]
+    d_sp = 1e-8 if 1e-8 in deltas else deltas[0]
+    sparsity_figure(rows[(lv, d_sp)], dbs[lv], os.path.join(fig, "ironing_sparsity_level5.png"),
+                    f"Ironing: snapshots selected by the greedy, level {lv}, δ = {d_sp:.0e}", "d_x")
+
+
+def load_study(outdir, problem, kind):
+    """The records, rows and databases a run of `run_study` left in `outdir` (for --replot)."""
+    path = os.path.join(outdir, f"{problem}_summary.csv")
+    if not os.path.exists(path):
+        sys.exit(f"experiments.py --replot: {path} is missing; run the {problem} stage first")
+    integers = {"n", "snapshots", "primal_rank", "validation_size", "nonconverged"}
+    with open(path, newline="") as f:
+        records = [{k: (v if k in {"problem", "kind", "statuses"} else int(v) if k in integers else float(v))
+                    for k, v in r.items()} for r in csv.DictReader(f)]
+    rows = {(r["n"], r["delta"]): read_rows(os.path.join(outdir, problem, f"{kind}{r['n']}_delta{dtag(r['delta'])}.csv"))
+            for r in records}
+    dbs = {r["n"]: os.path.join(outdir, "db", f"{problem}_{kind}{r['n']}.h5") for r in records}
+    return records, rows, dbs
+
+
+def stage_hertz(runner, cfg, timings, md):
+    sizes, deltas = cfg["hertz_sizes"], cfg["deltas"]
+    records, rows, dbs = run_study(runner, cfg["out"], "hertz", "train", sizes, deltas, timings)
+    t = time.time()
+    fig = cfg["figures"]
+    hertz_figures(cfg, records, rows, dbs)
     # Reconstruction examples, 12 snapshots, as in the paper.
     n_rec = 12 if 12 in sizes else sizes[0]
     d_rec = 1e-10 if 1e-10 in deltas else deltas[-1]
@@ -437,16 +481,7 @@ def stage_ironing(runner, cfg, timings, md):
     levels, deltas = cfg["ironing_levels"], cfg["deltas"]
     records, rows, dbs = run_study(runner, cfg["out"], "ironing", "level", levels, deltas, timings)
     t = time.time()
-    fig = cfg["figures"]
-    with h5py.File(dbs[levels[0]], "r") as f:
-        n_contact = f["dual"].shape[1]
-    fom_time = float(np.mean([r["mean_fom_time_s"] for r in records]))
-    evolution_figure(records, deltas, "training snapshots (nested level L)", os.path.join(fig, "ironing_evolution.png"),
-                     n_contact, "Ironing", fom_time)
-    lv = 5 if 5 in levels else levels[-1]
-    d_sp = 1e-8 if 1e-8 in deltas else deltas[0]
-    sparsity_figure(rows[(lv, d_sp)], dbs[lv], os.path.join(fig, "ironing_sparsity_level5.png"),
-                    f"Ironing: snapshots selected by the greedy, level {lv}, δ = {d_sp:.0e}", "d_x")
+    ironing_figures(cfg, records, rows, dbs)
     timings.append(("ironing figures", time.time() - t))
     md.append("### Ironing (nested levels " + "/".join(map(str, levels)) + ")\n\n"
               + markdown_summary(records, "level") + "\n")
@@ -554,6 +589,9 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="fast smoke mode (few training sets, δ=1e-8 only)")
     ap.add_argument("--only", help="comma-separated subset of hertz,ironing,ironing2")
     ap.add_argument("--threads", type=int, default=os.cpu_count() or 1, help="threads for offline/FOM references")
+    ap.add_argument("--replot", action="store_true",
+                    help="run nothing: redraw the hertz and ironing figures (all but the reconstructions) from the "
+                         "results of an earlier run in RESULTS_DIR")
     args = ap.parse_args(argv)
 
     stages = ["hertz", "ironing", "ironing2"]
@@ -574,6 +612,12 @@ def main(argv=None):
         cfg = {"deltas": DELTAS, "hertz_sizes": [12, 30, 60, 120], "ironing_levels": [3, 4, 5, 6, 7],
                "ironing2_levels": [2, 3, 4, 5]}
     cfg.update(out=out, figures=figures)
+    if args.replot:
+        for stage, kind, draw in [("hertz", "train", hertz_figures), ("ironing", "level", ironing_figures)]:
+            if stage in stages:
+                draw(cfg, *load_study(out, stage, kind))
+        log(f"figures redrawn from {out} in {figures}")
+        return
     runner = Runner(exe, args.threads)
     log(f"contactrom: {exe}; results -> {out}; figures -> {figures}; stages {stages}; "
         f"{'quick' if args.quick else 'full'} mode; {args.threads} threads")
