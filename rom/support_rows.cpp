@@ -102,4 +102,11 @@ void SupportOperators::rebuild(const fom::ContactModel& contact, const SupportRo
   contact.assemble_rows(pairing, support.rows, c, g);
 }
 
+void SupportOperators::seed(const fom::SearchMemory& memory) {
+  if (!m_partial) return;
+  const int certified = m_memory.certified, searched = m_memory.searched;
+  m_memory = memory;  // reuses the storage of an earlier query's memory
+  m_memory.certified = certified, m_memory.searched = searched;
+}
+
 }  // namespace contactrom::rom

@@ -59,6 +59,11 @@ struct SupportOperators {
   /// Searches the support rows at u_s, seeded by the current pairing, and assembles
   /// C_R and g_R there.
   void rebuild(const fom::ContactModel& contact, const SupportRows& support, const Eigen::VectorXd& u_surface);
+  /// Starts the memory from `memory` (e.g. ReducedModel::snapshot_search_memory of
+  /// the training snapshot nearest to the query) instead of nothing, so that the
+  /// first rebuild settles the rows that cannot have changed segment since. The
+  /// operators are those of a full search either way. Ignored without `partial`.
+  void seed(const fom::SearchMemory& memory);
   /// Rows settled by the memory and rows searched in full, over the rebuilds so far.
   int certified_rows() const { return m_memory.certified; }
   int searched_rows() const { return m_memory.searched; }
