@@ -177,8 +177,15 @@ GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& optio
 /// Per-query quantities shared by both schedules.
 struct GreedyActiveSet::Query {
   Query(const GreedyActiveSet& solver, const fom::Param& mu)
-      : solver(solver), k_inv(solver.m_model, mu), operators(solver.m_options.time_operators),
-        ops(solver.m_options.rebuild == OperatorRebuild::Partial) {}
+      : solver(solver), k_inv(solver.m_model, mu), operators(solver.m_options.time_operators), ops(thread_operators()) {
+    ops.reset(solver.m_options.rebuild == OperatorRebuild::Partial);
+  }
+  /// The operators' storage of the calling thread, reused by its queries (the
+  /// pairing, the search memory and C_R hold a few dozen arrays).
+  static SupportOperators& thread_operators() {
+    thread_local SupportOperators ops;
+    return ops;
+  }
   const GreedyActiveSet& solver;
   ReducedStiffnessInverse k_inv;  // K̂(μ)⁻¹
   OperatorClock operators;  // time spent building the contact operators (optional)
@@ -187,7 +194,7 @@ struct GreedyActiveSet::Query {
   Eigen::VectorXd u_start;  // starting û (GreedyOptions::init)
   std::vector<int> start_columns;  // starting selection
   int nearest = -1;  // training snapshot nearest to the start (−1: none)
-  SupportOperators ops;  // pairing, C_R and g_R at the last rebuild point, and the search memory
+  SupportOperators& ops;  // pairing, C_R and g_R at the last rebuild point, and the search memory
   // Outcome, filled by the schedule: final û, the selection and its multipliers.
   Eigen::VectorXd u_hat, lambda_i;
   std::vector<int> selected;
@@ -278,7 +285,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
     return res;
   }
   q.lift_s = m_model.surface_lifting(mu);
-  q.u_free = q.k_inv.solve(m_model.reduced_rhs(mu));
+  q.k_inv.apply(m_model.reduced_rhs(mu), q.u_free);
   warm_start_point(m_model, m_options.init, mu, q.u_free, q.start_columns, q.u_start, &q.nearest);
   // The first search starts from the one made offline at the nearest training snapshot.
   if (q.nearest >= 0) q.ops.seed(m_model.snapshot_search_memory(q.nearest));
@@ -340,28 +347,23 @@ struct GreedyActiveSet::Interleaved {
   // Ĉ_I, K̂⁻¹Ĉ_Iᵀ and S in storage that only grows: the leading |I| rows/columns are used.
   RowMajorMatrix c_hat_i;
   Eigen::MatrixXd w, schur;
+  SupportRows::RowsScratch rows;  // rows of C_R Φ_s shared by the selected columns
   std::vector<int> active, solved;  // the selection, and the one of the last solve
   std::vector<char> in_active;
   fom::AndersonMixer mixer;  // of the rebuild point while the selection stays the same
   SelectionHistory seen;     // selections of the query so far
-  bool pending = false;      // settled in the sense of Alg. 1: to be confirmed at û's fresh pairing
-  bool at_iterate = false;   // selection unchanged and x = û: the next rebuild is û's fresh pairing
-  bool candidate = false;    // û confirmed there, kept in u_kept, lambda_kept
-  Eigen::VectorXd u_kept, lambda_kept;
+  bool pending = false;  // settled in the sense of Alg. 1: to be confirmed at û's fresh pairing
   int removed = -1, added = -1;  // the last step's change (positions in `solved` / columns)
   double max_violation = 0.0;
 
-  /// After a rebuild at x: confirms û at its fresh pairing when x = û. Returns true
-  /// when Alg. 1 had settled and û is confirmed (converged); otherwise an iterate
-  /// confirmed while its selection is unchanged is kept as a candidate.
+  /// After a rebuild at x = û where Alg. 1 had settled: Alg. 1 judged û with the
+  /// operators of the previous point; whether every column (selected ones included)
+  /// is within τ at the pairing of û itself. If not, iterating goes on with these
+  /// operators.
   bool confirm() {
-    candidate = false;
-    if (!pending && !at_iterate) return false;
-    const bool ok = q.confirmed(u_s, gap, violation);
-    if (pending && ok) return true;
+    if (!pending) return false;
     pending = false;
-    if (ok && at_iterate) candidate = true, u_kept = u_hat, lambda_kept = lambda_i;
-    return false;
+    return q.confirmed(u_s, gap, violation);
   }
 
   /// Step 2: the saddle-point system on I by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ,
@@ -375,9 +377,7 @@ struct GreedyActiveSet::Interleaved {
     // Rows of Ĉ_I = D_Iᵀ C_R Φ_s and entries of ĝ_I = D_Iᵀ (g_R − C_R u_off,s), from
     // the rows where each selected column is non-zero.
     q.operators.start();
-    for (int i = 0; i < na; ++i)
-      rhs(i) = g.m_support.reduced_row(active[i], q.ops.c, q.ops.g, g.m_model.surface_basis_rows(), q.lift_s,
-                                       c_hat_i.row(i));
+    g.m_support.reduced_rows(active, q.ops.c, q.ops.g, g.m_model.surface_basis_rows(), q.lift_s, c_hat_i, rhs, rows);
     q.operators.stop();
     if (na == 0) {
       u_hat = q.u_free;
@@ -394,17 +394,6 @@ struct GreedyActiveSet::Interleaved {
     }
     solved = active;
     return u_hat.allFinite() && lambda_i.allFinite();
-  }
-
-  /// Beyond Alg. 1: the candidate (confirmed at its own pairing) is a fixed point of
-  /// its selection to ε when the solve on that pairing keeps λ̂ ≥ 0 and moves û by at
-  /// most ε‖û‖; it is then the result, without a rebuild at the new û.
-  bool candidate_settled() {
-    if (!candidate || most_negative(lambda_i) >= 0 || !q.small_step(u_hat, x)) return false;
-    if (g.m_options.trace) *g.m_options.trace << "greedy: the confirmed previous iterate is settled; returned\n";
-    u_hat.swap(u_kept);
-    lambda_i.swap(lambda_kept);
-    return true;
   }
 
   /// Step 3: one change — remove the most negative multiplier, else add the column
@@ -444,7 +433,6 @@ struct GreedyActiveSet::Interleaved {
       x = mixer.next(x, u_hat);
       if (x != u_hat) q.surface_displacement(x, u_s);  // else u_s is û's already
     }
-    at_iterate = !changed && !pending && x == u_hat;
   }
 
   /// One line per iteration for GreedyOptions::trace.
@@ -497,10 +485,6 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
       break;
     }
     res.iterations = k + 1;
-    if (s.candidate_settled()) {
-      res.converged = true;
-      break;
-    }
     // 3. One change.
     const bool changed = s.one_change();
     s.trace(k, changed);
