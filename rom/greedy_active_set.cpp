@@ -332,14 +332,21 @@ Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur
 /// The interleaved schedule's state between its steps (paper Alg. 1 with the
 /// safeguards of the file comment).
 struct GreedyActiveSet::Interleaved {
-  Interleaved(const GreedyActiveSet& solver, Query& q)
-      : g(solver), q(q), u_hat(q.u_start), x(q.u_start), active(q.start_columns),
-        in_active(static_cast<size_t>(solver.m_model.dictionary_size()), 0), mixer(solver.m_options.anderson_depth) {
+  /// Starts a query: the warm start's selection and û, x = û. The state of a thread
+  /// is reused by its queries (storage only: every field is set here or before use).
+  void start(const GreedyActiveSet& solver, Query& query) {
+    g = &solver, q = &query;
+    u_hat = q->u_start, x = q->u_start, active = q->start_columns;
+    in_active.assign(static_cast<size_t>(g->m_model.dictionary_size()), 0);
     for (int p : active) in_active[static_cast<size_t>(p)] = 1;
-    q.surface_displacement(u_hat, u_s);
+    mixer = fom::AndersonMixer(g->m_options.anderson_depth);
+    seen.clear();
+    solved.clear(), lambda_i.resize(0);
+    pending = false, removed = added = -1, max_violation = 0.0;
+    q->surface_displacement(u_hat, u_s);
   }
-  const GreedyActiveSet& g;
-  Query& q;
+  const GreedyActiveSet* g = nullptr;
+  Query* q = nullptr;
   Eigen::VectorXd u_hat, lambda_i;
   Eigen::VectorXd x;    // where the operators are built (û^{k−1} in Alg. 1)
   Eigen::VectorXd u_s;  // Φ_s x + u_off,s
@@ -350,7 +357,7 @@ struct GreedyActiveSet::Interleaved {
   SupportRows::RowsScratch rows;  // rows of C_R Φ_s shared by the selected columns
   std::vector<int> active, solved;  // the selection, and the one of the last solve
   std::vector<char> in_active;
-  fom::AndersonMixer mixer;  // of the rebuild point while the selection stays the same
+  fom::AndersonMixer mixer{0};  // of the rebuild point while the selection stays the same
   SelectionHistory seen;     // selections of the query so far
   bool pending = false;  // settled in the sense of Alg. 1: to be confirmed at û's fresh pairing
   int removed = -1, added = -1;  // the last step's change (positions in `solved` / columns)
@@ -363,34 +370,34 @@ struct GreedyActiveSet::Interleaved {
   bool confirm() {
     if (!pending) return false;
     pending = false;
-    return q.confirmed(u_s, gap, violation);
+    return q->confirmed(u_s, gap, violation);
   }
 
   /// Step 2: the saddle-point system on I by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ,
   /// with the operators of the last rebuild. False on a non-finite value.
   bool solve() {
-    const int na = static_cast<int>(active.size()), r = g.m_model.primal_rank();
+    const int na = static_cast<int>(active.size()), r = g->m_model.primal_rank();
     if (c_hat_i.rows() < na) {
       const int cap = std::max(2 * static_cast<int>(c_hat_i.rows()), std::max(na, 4));
       c_hat_i.resize(cap, r), w.resize(r, cap), schur.resize(cap, cap), rhs.resize(cap);
     }
     // Rows of Ĉ_I = D_Iᵀ C_R Φ_s and entries of ĝ_I = D_Iᵀ (g_R − C_R u_off,s), from
     // the rows where each selected column is non-zero.
-    q.operators.start();
-    g.m_support.reduced_rows(active, q.ops.c, q.ops.g, g.m_model.surface_basis_rows(), q.lift_s, c_hat_i, rhs, rows);
-    q.operators.stop();
+    q->operators.start();
+    g->m_support.reduced_rows(active, q->ops.c, q->ops.g, g->m_model.surface_basis_rows(), q->lift_s, c_hat_i, rhs, rows);
+    q->operators.stop();
     if (na == 0) {
-      u_hat = q.u_free;
+      u_hat = q->u_free;
       lambda_i.resize(0);
     } else {
       const auto c_hat = c_hat_i.topRows(na);
       auto w_i = w.leftCols(na);
-      q.k_inv.apply(c_hat.transpose(), w_i);  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
+      q->k_inv.apply(c_hat.transpose(), w_i);  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
       schur.topLeftCorner(na, na).noalias() = c_hat * w_i;
-      for (int i = 0; i < na; ++i) rhs(i) = c_hat.row(i).dot(q.u_free) - rhs(i);  // Ĉ_I K̂⁻¹ f̂ − ĝ_I
+      for (int i = 0; i < na; ++i) rhs(i) = c_hat.row(i).dot(q->u_free) - rhs(i);  // Ĉ_I K̂⁻¹ f̂ − ĝ_I
       // |I| > r: min-norm
-      lambda_i = schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), g.m_options.singular_tolerance);
-      u_hat.noalias() = q.u_free - w_i * lambda_i;
+      lambda_i = schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), g->m_options.singular_tolerance);
+      u_hat.noalias() = q->u_free - w_i * lambda_i;
     }
     solved = active;
     return u_hat.allFinite() && lambda_i.allFinite();
@@ -400,7 +407,7 @@ struct GreedyActiveSet::Interleaved {
   /// most violated beyond τ (Ĉ û − ĝ = D_dᵀ (C_s u_s − g) for every column, with the
   /// operators of step 1). Returns whether the selection changed.
   bool one_change() {
-    q.surface_displacement(u_hat, u_s);
+    q->surface_displacement(u_hat, u_s);
     added = -1;
     max_violation = 0.0;
     removed = most_negative(lambda_i);
@@ -409,10 +416,10 @@ struct GreedyActiveSet::Interleaved {
       active.erase(active.begin() + removed);
       return true;
     }
-    g.m_support.violation(q.ops.c, q.ops.g, u_s, gap, violation);
+    g->m_support.violation(q->ops.c, q->ops.g, u_s, gap, violation);
     if (violation.size() > 0) max_violation = violation.maxCoeff();
-    q.offer(max_violation, u_hat, lambda_i, solved);
-    added = most_violated(violation, in_active, g.m_threshold);
+    q->offer(max_violation, u_hat, lambda_i, solved);
+    added = most_violated(violation, in_active, g->m_threshold);
     if (added < 0) return false;
     in_active[static_cast<size_t>(added)] = 1;
     active.push_back(added);
@@ -425,19 +432,19 @@ struct GreedyActiveSet::Interleaved {
   /// fixed point, like the FOM's): x is Anderson-accelerated. A changed selection
   /// restarts the history; a settled û is confirmed at itself.
   void next_rebuild_point(bool changed) {
-    pending = !changed && q.small_step(u_hat, x);
+    pending = !changed && q->small_step(u_hat, x);
     if (changed || pending) {
-      mixer = fom::AndersonMixer(g.m_options.anderson_depth);
+      mixer = fom::AndersonMixer(g->m_options.anderson_depth);
       x = u_hat;
     } else {
       x = mixer.next(x, u_hat);
-      if (x != u_hat) q.surface_displacement(x, u_s);  // else u_s is û's already
+      if (x != u_hat) q->surface_displacement(x, u_s);  // else u_s is û's already
     }
   }
 
   /// One line per iteration for GreedyOptions::trace.
   void trace(int k, bool changed) const {
-    std::ostream* out = g.m_options.trace;
+    std::ostream* out = g->m_options.trace;
     if (!out) return;
     const int na = static_cast<int>(solved.size());
     *out << "greedy k=" << k + 1 << " |I|=" << na << " min(lambda)=" << (na ? lambda_i.minCoeff() : 0.0)
@@ -457,17 +464,18 @@ struct GreedyActiveSet::Interleaved {
   /// nested schedule settles the steps on frozen operators first; it goes on from
   /// here with the rebuilds left (k + 1 made).
   void hand_over_to_nested(OnlineResult& res, int k) {
-    if (g.m_options.trace) *g.m_options.trace << "greedy: selection revisited, nested schedule from here\n";
-    q.u_start = u_hat;
-    q.start_columns = active;
+    if (g->m_options.trace) *g->m_options.trace << "greedy: selection revisited, nested schedule from here\n";
+    q->u_start = u_hat;
+    q->start_columns = active;
     const int done = res.iterations;
-    g.solve_nested(q, res, g.m_options.max_iterations - k - 1);
+    g->solve_nested(*q, res, g->m_options.max_iterations - k - 1);
     res.iterations += done;
   }
 };
 
 void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
-  Interleaved s(*this, q);
+  thread_local Interleaved s;  // its storage serves the thread's next queries
+  s.start(*this, q);
   const int k_max = m_options.max_iterations;
   for (int k = 0; k <= k_max; ++k) {
     // 1. Contact operators at x, from the surface rows only. Beyond Alg. 1, an
