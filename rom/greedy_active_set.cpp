@@ -343,6 +343,8 @@ struct GreedyActiveSet::Interleaved {
     seen.clear();
     solved.clear(), lambda_i.resize(0);
     pending = false, removed = added = -1, max_violation = 0.0;
+    const int r = g->m_model.primal_rank();
+    if (c_hat_i.cols() != r) c_hat_i.resize(0, r), w.resize(r, 0);  // another model: grown again by solve()
     q->surface_displacement(u_hat, u_s);
   }
   const GreedyActiveSet* g = nullptr;
