@@ -38,7 +38,10 @@
 /// Each rebuild searches the contact pairs with a memory of the previous searches
 /// (GreedyOptions::rebuild, fom::SearchMemory): rows that cannot have changed master
 /// segment skip the search of the whole chain, with the same operators as a full search.
-/// Only Ĉ_I (|I| rows) is formed; the violation of all m columns is evaluated as
+/// With a warm start, the first search starts from the memory of the one made offline
+/// at the nearest training snapshot (ReducedModel::snapshot_search_memory).
+/// Only Ĉ_I (|I| rows) is formed, from the rows of C_R Φ_s on the union of the selected
+/// columns' supports (SupportRows::reduced_rows); the violation of all m columns is evaluated as
 /// \f$ D_d^T (C_s u_s - g) \f$, which equals \f$ \hat C\hat u - \hat g \f$. Every
 /// operation costs O(n_s r + n_c (r |I| + m) + r²|I|): nothing scales with the mesh
 /// beyond the contact surface. The returned (û, λ̂_I) solve the saddle-point system
