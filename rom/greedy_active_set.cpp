@@ -99,19 +99,20 @@ WarmStart parse_warm_start(const std::string& method, const std::string& text) {
 }
 
 void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Param& mu,
-                      const Eigen::VectorXd& u_free, std::vector<int>& columns, Eigen::VectorXd& u_hat) {
+                      const Eigen::VectorXd& u_free, std::vector<int>& columns, Eigen::VectorXd& u_hat,
+                      int* nearest) {
   columns.clear();
+  if (nearest) *nearest = -1;
   if (init == WarmStart::Empty || model.dictionary_size() == 0) {
     u_hat = u_free;
     return;
   }
   std::vector<ReducedModel::StencilPoint> stencil = model.interpolation_stencil(mu);
-  if (init == WarmStart::Nearest) {
-    const auto heaviest = std::max_element(stencil.begin(), stencil.end(), [](const auto& a, const auto& b) {
-      return a.weight < b.weight;
-    });
-    stencil = {{heaviest->column, 1.0}};
-  }
+  const auto heaviest = std::max_element(stencil.begin(), stencil.end(), [](const auto& a, const auto& b) {
+    return a.weight < b.weight;
+  });
+  if (nearest) *nearest = heaviest->column;
+  if (init == WarmStart::Nearest) stencil = {{heaviest->column, 1.0}};
   // (A quadratic stencil for û, tried on hertz 30, needed more pairing updates on
   // average: the solutions are not smooth in μ where nodes enter contact.)
   if (init != WarmStart::Primal)
@@ -175,18 +176,55 @@ GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& optio
 
 /// Per-query quantities shared by both schedules.
 struct GreedyActiveSet::Query {
-  Query(const ReducedModel& model, const fom::Param& mu, bool time_operators)
-      : k_inv(model, mu), operators(time_operators) {}
+  Query(const GreedyActiveSet& solver, const fom::Param& mu)
+      : solver(solver), k_inv(solver.m_model, mu), operators(solver.m_options.time_operators), ops(thread_operators()) {
+    ops.reset(solver.m_options.rebuild == OperatorRebuild::Partial);
+  }
+  /// The operators' storage of the calling thread, reused by its queries (the
+  /// pairing, the search memory and C_R hold a few dozen arrays).
+  static SupportOperators& thread_operators() {
+    thread_local SupportOperators ops;
+    return ops;
+  }
+  const GreedyActiveSet& solver;
   ReducedStiffnessInverse k_inv;  // K̂(μ)⁻¹
   OperatorClock operators;  // time spent building the contact operators (optional)
   Eigen::VectorXd lift_s;  // surface lifting u_off,s(μ)
   Eigen::VectorXd u_free;  // unconstrained reduced solution K̂⁻¹ f̂
   Eigen::VectorXd u_start;  // starting û (GreedyOptions::init)
   std::vector<int> start_columns;  // starting selection
+  int nearest = -1;  // training snapshot nearest to the start (−1: none)
+  SupportOperators& ops;  // pairing, C_R and g_R at the last rebuild point, and the search memory
   // Outcome, filled by the schedule: final û, the selection and its multipliers.
   Eigen::VectorXd u_hat, lambda_i;
   std::vector<int> selected;
   bool best_iterate_returned = false;  // not converged: the best iterate replaced the last one
+
+  /// u_s = Φ_s x + u_off,s: the only place the primal enters the contact operators.
+  void surface_displacement(const Eigen::VectorXd& x, Eigen::VectorXd& u_s) {
+    operators.start();
+    u_s.noalias() = solver.m_model.surface_basis() * x;
+    u_s += lift_s;
+    operators.stop();
+  }
+  /// Step 1: the pairing, C_R and g_R of the support rows at u_s.
+  void rebuild(const Eigen::VectorXd& u_s) {
+    operators.start();
+    ops.rebuild(solver.m_model.problem().contact(), solver.m_support, u_s);
+    operators.stop();
+  }
+  /// Whether every column's violation at u_s, with the operators of the last rebuild
+  /// (its fresh pairing when they were built at u_s), is within τ; left in `violation`.
+  bool confirmed(const Eigen::VectorXd& u_s, Eigen::VectorXd& gap, Eigen::VectorXd& violation) const {
+    solver.m_support.violation(ops.c, ops.g, u_s, gap, violation);
+    const double worst = violation.size() > 0 ? violation.maxCoeff() : 0.0;
+    if (solver.m_options.trace) *solver.m_options.trace << "greedy check at fresh pairing: max(violation)=" << worst << "\n";
+    return worst <= solver.m_threshold;
+  }
+  /// Whether û moved by at most ε‖û‖ from x (Alg. 1's test).
+  bool small_step(const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x) const {
+    return (u_hat - x).norm() <= solver.m_options.step_tolerance * u_hat.norm();
+  }
 
   /// Best iterate with λ̂ ≥ 0 so far (smallest largest violation), for the iteration cap.
   struct {
@@ -196,7 +234,7 @@ struct GreedyActiveSet::Query {
     std::vector<int> selected;
   } best;
   void offer(double max_violation, const Eigen::VectorXd& u, const Eigen::VectorXd& l, const std::vector<int>& s) {
-    if (best.valid && max_violation >= best.violation) return;
+    if (!solver.m_options.best_iterate_on_failure || (best.valid && max_violation >= best.violation)) return;
     best.valid = true;
     best.violation = max_violation;
     best.u_hat = u;
@@ -217,6 +255,15 @@ struct GreedyActiveSet::Query {
   }
 };
 
+namespace {
+
+void numerical_issue(OnlineResult& res) {
+  res.status = Status::NumericalIssue;
+  res.message = "reduced saddle-point solve produced a non-finite value";
+}
+
+}  // namespace
+
 OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
@@ -227,7 +274,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
 
   // K̂(μ)⁻¹ through the offline factor when K̂(μ) = θ₀(μ) K̂₀, else a per-query
   // factorisation of the r × r matrix.
-  Query q(m_model, mu, m_options.time_operators);
+  Query q(*this, mu);
   if (!q.k_inv.ok()) {
     res.status = Status::NumericalIssue;
     res.message = "Cholesky factorisation of the reduced stiffness failed";
@@ -238,8 +285,10 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
     return res;
   }
   q.lift_s = m_model.surface_lifting(mu);
-  q.u_free = q.k_inv.solve(m_model.reduced_rhs(mu));
-  warm_start_point(m_model, m_options.init, mu, q.u_free, q.start_columns, q.u_start);
+  q.k_inv.apply(m_model.reduced_rhs(mu), q.u_free);
+  warm_start_point(m_model, m_options.init, mu, q.u_free, q.start_columns, q.u_start, &q.nearest);
+  // The first search starts from the one made offline at the nearest training snapshot.
+  if (q.nearest >= 0) q.ops.seed(m_model.snapshot_search_memory(q.nearest));
 
   if (m_options.schedule == GreedySchedule::Nested)
     solve_nested(q, res, m_options.max_iterations);
@@ -280,297 +329,295 @@ Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur
   return schur.completeOrthogonalDecomposition().solve(rhs);
 }
 
-bool GreedyActiveSet::confirmed(const Eigen::VectorXd& violation) const {
-  const double worst = violation.size() > 0 ? violation.maxCoeff() : 0.0;
-  if (m_options.trace) *m_options.trace << "greedy check at fresh pairing: max(violation)=" << worst << "\n";
-  return worst <= m_threshold;
-}
-
-void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
-  const fom::ContactModel& contact = m_model.problem().contact();
-  const Eigen::MatrixXd& phi_s = m_model.surface_basis();
-  const RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
-  const int r = m_model.primal_rank(), m = m_model.dictionary_size();
-  const Eigen::VectorXd &u_free = q.u_free, &lift_s = q.lift_s;
-
-  Eigen::VectorXd u_hat = q.u_start, lambda_i, v, violation, rhs;
+/// The interleaved schedule's state between its steps (paper Alg. 1 with the
+/// safeguards of the file comment).
+struct GreedyActiveSet::Interleaved {
+  /// Starts a query: the warm start's selection and û, x = û. The state of a thread
+  /// is reused by its queries (storage only: every field is set here or before use).
+  void start(const GreedyActiveSet& solver, Query& query) {
+    g = &solver, q = &query;
+    u_hat = q->u_start, x = q->u_start, active = q->start_columns;
+    in_active.assign(static_cast<size_t>(g->m_model.dictionary_size()), 0);
+    for (int p : active) in_active[static_cast<size_t>(p)] = 1;
+    mixer = fom::AndersonMixer(g->m_options.anderson_depth);
+    seen.clear();
+    solved.clear(), lambda_i.resize(0);
+    pending = false, removed = added = -1, max_violation = 0.0;
+    const int r = g->m_model.primal_rank();
+    if (c_hat_i.cols() != r) c_hat_i.resize(0, r), w.resize(r, 0);  // another model: grown again by solve()
+    q->surface_displacement(u_hat, u_s);
+  }
+  const GreedyActiveSet* g = nullptr;
+  Query* q = nullptr;
+  Eigen::VectorXd u_hat, lambda_i;
+  Eigen::VectorXd x;    // where the operators are built (û^{k−1} in Alg. 1)
+  Eigen::VectorXd u_s;  // Φ_s x + u_off,s
+  Eigen::VectorXd gap, violation, rhs;
   // Ĉ_I, K̂⁻¹Ĉ_Iᵀ and S in storage that only grows: the leading |I| rows/columns are used.
   RowMajorMatrix c_hat_i;
   Eigen::MatrixXd w, schur;
-  SupportOperators ops(m_options.rebuild == OperatorRebuild::Partial);  // pairing, C_R and g_R at the previous iterate
-  std::vector<int> active = q.start_columns, solved;
-  std::vector<char> in_active(m, 0);
-  for (int p : active) in_active[p] = 1;
-  // Surface displacement of the current iterate, u_s = Φ_s û + u_off,s: the only
-  // place the primal enters the contact operators.
-  Eigen::VectorXd u_s = phi_s * u_hat + lift_s;
-  // Where the operators are built (x = û^{k−1} in Alg. 1), and the Anderson mixer
-  // of that point while the selection stays the same.
-  Eigen::VectorXd x = u_hat;
-  fom::AndersonMixer mixer(m_options.anderson_depth);
+  SupportRows::RowsScratch rows;  // rows of C_R Φ_s shared by the selected columns
+  std::vector<int> active, solved;  // the selection, and the one of the last solve
+  std::vector<char> in_active;
+  fom::AndersonMixer mixer{0};  // of the rebuild point while the selection stays the same
+  SelectionHistory seen;     // selections of the query so far
+  bool pending = false;  // settled in the sense of Alg. 1: to be confirmed at û's fresh pairing
+  int removed = -1, added = -1;  // the last step's change (positions in `solved` / columns)
+  double max_violation = 0.0;
 
-  bool pending = false;  // converged in the sense of Alg. 1, to be confirmed
-  SelectionHistory seen;  // selections of the query so far
-  for (int k = 0; k <= m_options.max_iterations; ++k) {
-    // 1. Contact operators at the previous iterate, from the surface rows only.
-    q.operators.start();
-    ops.rebuild(contact, m_support, u_s);
-    q.operators.stop();
-    if (pending) {
-      // Alg. 1 found no change and a settled û^k, but judged û^k with the operators
-      // of û^{k−1}. Confirm at the pairing of û^k itself that no dictionary column
-      // is violated by more than τ (selected columns included), so the returned
-      // solution meets the reduced constraint at its own pairing; else go on.
-      m_support.violation(ops.c, ops.g, u_s, v, violation);
-      if (confirmed(violation)) {
-        res.converged = true;
-        break;
-      }
-      pending = false;
-    }
-    if (k == m_options.max_iterations) break;
-    const int na = static_cast<int>(active.size());
+  /// After a rebuild at x = û where Alg. 1 had settled: Alg. 1 judged û with the
+  /// operators of the previous point; whether every column (selected ones included)
+  /// is within τ at the pairing of û itself. If not, iterating goes on with these
+  /// operators.
+  bool confirm() {
+    if (!pending) return false;
+    pending = false;
+    return q->confirmed(u_s, gap, violation);
+  }
+
+  /// Step 2: the saddle-point system on I by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ,
+  /// with the operators of the last rebuild. False on a non-finite value.
+  bool solve() {
+    const int na = static_cast<int>(active.size()), r = g->m_model.primal_rank();
     if (c_hat_i.rows() < na) {
       const int cap = std::max(2 * static_cast<int>(c_hat_i.rows()), std::max(na, 4));
       c_hat_i.resize(cap, r), w.resize(r, cap), schur.resize(cap, cap), rhs.resize(cap);
     }
     // Rows of Ĉ_I = D_Iᵀ C_R Φ_s and entries of ĝ_I = D_Iᵀ (g_R − C_R u_off,s), from
     // the rows where each selected column is non-zero.
-    q.operators.start();
-    for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], ops.c, ops.g, phi_s_rows, lift_s, c_hat_i.row(i));
-    q.operators.stop();
-
-    // 2. Saddle-point system by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ.
+    q->operators.start();
+    g->m_support.reduced_rows(active, q->ops.c, q->ops.g, g->m_model.surface_basis_rows(), q->lift_s, c_hat_i, rhs, rows);
+    q->operators.stop();
     if (na == 0) {
-      u_hat = u_free;
+      u_hat = q->u_free;
       lambda_i.resize(0);
     } else {
       const auto c_hat = c_hat_i.topRows(na);
       auto w_i = w.leftCols(na);
-      q.k_inv.apply(c_hat.transpose(), w_i);  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
+      q->k_inv.apply(c_hat.transpose(), w_i);  // K̂⁻¹ Ĉ_Iᵀ, r × |I|
       schur.topLeftCorner(na, na).noalias() = c_hat * w_i;
-      for (int i = 0; i < na; ++i) rhs(i) = c_hat.row(i).dot(u_free) - rhs(i);  // Ĉ_I K̂⁻¹ f̂ − ĝ_I
+      for (int i = 0; i < na; ++i) rhs(i) = c_hat.row(i).dot(q->u_free) - rhs(i);  // Ĉ_I K̂⁻¹ f̂ − ĝ_I
       // |I| > r: min-norm
-      lambda_i = schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), m_options.singular_tolerance);
-      u_hat.noalias() = u_free - w_i * lambda_i;
+      lambda_i = schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), g->m_options.singular_tolerance);
+      u_hat.noalias() = q->u_free - w_i * lambda_i;
     }
     solved = active;
-    res.iterations = k + 1;
-    if (!u_hat.allFinite() || !lambda_i.allFinite()) {
-      res.status = Status::NumericalIssue;
-      res.message = "reduced saddle-point solve produced a non-finite value";
+    return u_hat.allFinite() && lambda_i.allFinite();
+  }
+
+  /// Step 3: one change — remove the most negative multiplier, else add the column
+  /// most violated beyond τ (Ĉ û − ĝ = D_dᵀ (C_s u_s − g) for every column, with the
+  /// operators of step 1). Returns whether the selection changed.
+  bool one_change() {
+    q->surface_displacement(u_hat, u_s);
+    added = -1;
+    max_violation = 0.0;
+    removed = most_negative(lambda_i);
+    if (removed >= 0) {
+      in_active[static_cast<size_t>(active[removed])] = 0;
+      active.erase(active.begin() + removed);
+      return true;
+    }
+    g->m_support.violation(q->ops.c, q->ops.g, u_s, gap, violation);
+    if (violation.size() > 0) max_violation = violation.maxCoeff();
+    q->offer(max_violation, u_hat, lambda_i, solved);
+    added = most_violated(violation, in_active, g->m_threshold);
+    if (added < 0) return false;
+    in_active[static_cast<size_t>(added)] = 1;
+    active.push_back(added);
+    return true;
+  }
+
+  /// Step 4: Alg. 1's test (selection stable, û settled), then the next rebuild
+  /// point. While the selection is unchanged and û still moves, the operators' fixed
+  /// point in x is smooth and plain substitution may oscillate (the pairing's own
+  /// fixed point, like the FOM's): x is Anderson-accelerated. A changed selection
+  /// restarts the history; a settled û is confirmed at itself.
+  void next_rebuild_point(bool changed) {
+    pending = !changed && q->small_step(u_hat, x);
+    if (changed || pending) {
+      mixer = fom::AndersonMixer(g->m_options.anderson_depth);
+      x = u_hat;
+    } else {
+      x = mixer.next(x, u_hat);
+      if (x != u_hat) q->surface_displacement(x, u_s);  // else u_s is û's already
+    }
+  }
+
+  /// One line per iteration for GreedyOptions::trace.
+  void trace(int k, bool changed) const {
+    std::ostream* out = g->m_options.trace;
+    if (!out) return;
+    const int na = static_cast<int>(solved.size());
+    *out << "greedy k=" << k + 1 << " |I|=" << na << " min(lambda)=" << (na ? lambda_i.minCoeff() : 0.0)
+         << " max(violation)=" << max_violation << " step=" << (u_hat - x).norm() / std::max(u_hat.norm(), 1e-300)
+         << " -> ";
+    if (removed >= 0)
+      *out << "remove " << solved[static_cast<size_t>(removed)];
+    else if (changed)
+      *out << "add " << added;
+    else
+      *out << "no change";
+    *out << "\n";
+  }
+
+  /// A one-change step brought back a selection met before: one change per rebuild
+  /// is cycling (each rebuild moves the operators under the steps, paper §4.1). The
+  /// nested schedule settles the steps on frozen operators first; it goes on from
+  /// here with the rebuilds left (k + 1 made).
+  void hand_over_to_nested(OnlineResult& res, int k) {
+    if (g->m_options.trace) *g->m_options.trace << "greedy: selection revisited, nested schedule from here\n";
+    q->u_start = u_hat;
+    q->start_columns = active;
+    const int done = res.iterations;
+    g->solve_nested(*q, res, g->m_options.max_iterations - k - 1);
+    res.iterations += done;
+  }
+};
+
+void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
+  thread_local Interleaved s;  // its storage serves the thread's next queries
+  s.start(*this, q);
+  const int k_max = m_options.max_iterations;
+  for (int k = 0; k <= k_max; ++k) {
+    // 1. Contact operators at x, from the surface rows only. Beyond Alg. 1, an
+    //    iterate is returned only once the operators rebuilt at it confirm that no
+    //    dictionary column (selected ones included) is violated by more than τ.
+    q.rebuild(s.u_s);
+    if (s.confirm()) {
+      res.converged = true;
       break;
     }
-    q.operators.start();
-    u_s.noalias() = phi_s * u_hat;
-    u_s += lift_s;
-    q.operators.stop();
-
-    // 3. One change: remove the most negative multiplier, else add the column most
-    //    correlated with the thresholded violation.
-    bool changed = false;
-    double max_violation = 0.0;
-    const int remove = most_negative(lambda_i);
-    if (remove >= 0) {
-      in_active[active[remove]] = 0;
-      active.erase(active.begin() + remove);
-      changed = true;
-    } else {
-      // Ĉ û − ĝ for every column = D_dᵀ (C_s u_s − g), from the support rows, with
-      // the operators of step 1.
-      m_support.violation(ops.c, ops.g, u_s, v, violation);
-      if (m > 0) max_violation = violation.maxCoeff();
-      if (m_options.best_iterate_on_failure) q.offer(max_violation, u_hat, lambda_i, solved);
-      const int add = most_violated(violation, in_active, m_threshold);
-      if (add >= 0) {
-        in_active[add] = 1;
-        active.push_back(add);
-        changed = true;
-      }
+    if (k == k_max) break;
+    // 2. Saddle-point system on I.
+    if (!s.solve()) {
+      numerical_issue(res);
+      break;
     }
-
-    // 4. Converged when the active set is stable and û no longer moves.
-    const double step = (u_hat - x).norm(), size = u_hat.norm();
-    if (m_options.trace) {
-      *m_options.trace << "greedy k=" << k + 1 << " |I|=" << na << " min(lambda)=" << (na ? lambda_i.minCoeff() : 0.0)
-                       << " max(violation)=" << max_violation << " step=" << step / std::max(size, 1e-300) << " -> ";
-      if (remove >= 0)
-        *m_options.trace << "remove " << solved[remove];
-      else if (changed)
-        *m_options.trace << "add " << active.back();
-      else
-        *m_options.trace << "no change";
-      *m_options.trace << "\n";
-    }
-    if (!changed && step <= m_options.step_tolerance * size) pending = true;
-    next_rebuild_point(changed || pending, u_hat, x, mixer, u_s, q);
-    if (changed && m_options.nested_on_cycle && k + 1 < m_options.max_iterations && revisits(seen, solved, active)) {
-      // A selection came back: one change per rebuild is cycling (each rebuild
-      // moves the operators under the steps, paper §4.1). The nested schedule
-      // settles the steps on frozen operators first; it goes on from here.
-      if (m_options.trace) *m_options.trace << "greedy: selection revisited, nested schedule from here\n";
-      q.u_start = u_hat;
-      q.start_columns = active;
-      const int done = res.iterations;
-      solve_nested(q, res, m_options.max_iterations - k - 1);
-      res.iterations += done;
-      return;
-    }
+    res.iterations = k + 1;
+    // 3. One change.
+    const bool changed = s.one_change();
+    s.trace(k, changed);
+    // 4. Settled (to be confirmed) or the next rebuild point; on a cycle, the nested schedule.
+    s.next_rebuild_point(changed);
+    if (changed && m_options.nested_on_cycle && k + 1 < k_max && revisits(s.seen, s.solved, s.active))
+      return s.hand_over_to_nested(res, k);
   }
-
-  q.finish(!res.converged && res.status == Status::Success, u_hat, lambda_i, solved);
+  q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i, s.solved);
 }
 
-void GreedyActiveSet::next_rebuild_point(bool plain, const Eigen::VectorXd& u_hat, Eigen::VectorXd& x,
-                                         fom::AndersonMixer& mixer, Eigen::VectorXd& u_s, Query& q) const {
-  // The selection is unchanged and û still moves: the operators' fixed point in x
-  // is smooth there, and plain substitution may oscillate (the pairing's own
-  // fixed point, like the FOM's); Anderson acceleration extrapolates it. A
-  // changed selection restarts the history; a settled û is confirmed at itself.
-  if (plain) {
-    mixer = fom::AndersonMixer(m_options.anderson_depth);
-    x = u_hat;
-    return;
+/// The nested schedule's state between its steps.
+struct GreedyActiveSet::Nested {
+  Nested(const GreedyActiveSet& solver, Query& q)
+      : g(solver), q(q), dr(solver.m_support.basis), x(q.u_start), u_hat(q.u_start),
+        in_active(static_cast<size_t>(solver.m_model.dictionary_size()), 0), mixer(solver.m_options.anderson_depth) {
+    for (int p : q.start_columns) {  // filled by make_column once the operators exist
+      in_active[static_cast<size_t>(p)] = 1;
+      cols.emplace_back();
+      cols.back().p = p;
+    }
   }
-  x = mixer.next(x, u_hat);
-  q.operators.start();
-  u_s.noalias() = m_model.surface_basis() * x;
-  u_s += q.lift_s;
-  q.operators.stop();
-}
-
-void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds) const {
-  const fom::ContactModel& contact = m_model.problem().contact();
-  const Eigen::MatrixXd& phi_s = m_model.surface_basis();
-  const RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
-  const Eigen::MatrixXd& dr = m_support.basis;  // D_d on the support rows R, |R| × m
-  const int r = m_model.primal_rank(), m = m_model.dictionary_size();
-  const Eigen::VectorXd &u_free = q.u_free, &lift_s = q.lift_s;
-
-  // A selected column p with the operators frozen: its row Ĉ_p = d_pᵀ A of Ĉ_I,
-  // w_p = K̂⁻¹ Ĉ_pᵀ and z_p = D_dᵀ C_s Φ_s w_p, the change of every column's
-  // violation per unit λ̂_p (û = u_free − Σ λ̂_p w_p).
+  /// A selected column p with the operators frozen: its row Ĉ_p = d_pᵀ A of Ĉ_I,
+  /// w_p = K̂⁻¹ Ĉ_pᵀ and z_p = D_dᵀ C_s Φ_s w_p, the change of every column's
+  /// violation per unit λ̂_p (û = u_free − Σ λ̂_p w_p).
   struct Column {
     int p;
     Eigen::RowVectorXd c_hat;
     Eigen::MatrixXd w;  // r × 1
     Eigen::VectorXd z;
   };
+  const GreedyActiveSet& g;
+  Query& q;
+  const Eigen::MatrixXd& dr;  // D_d on the support rows R, |R| × m
   std::vector<Column> cols, spare;  // selected columns; removed ones, kept for their storage
-  RowMajorMatrix a;  // A = C_R Φ_s (|R| × r)
+  RowMajorMatrix a;        // A = C_R Φ_s (|R| × r)
   Eigen::VectorXd b;       // C_R u_off,s − g_R: A û + b is the gap on R
   Eigen::VectorXd v_free;  // every column's violation at u_free, D_Rᵀ (A u_free + b)
-  Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x = q.u_start, u_hat = q.u_start;
+  Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x, u_hat, u_s;
   Eigen::MatrixXd schur;
-  SupportOperators ops(m_options.rebuild == OperatorRebuild::Partial);  // pairing, C_R and g_R at the rebuild point x
-  Eigen::VectorXd u_s;
-  std::vector<char> in_active(m, 0);
+  std::vector<char> in_active;
   std::vector<int> solved;
   SelectionHistory seen;  // selections met on the current operators
-  fom::AndersonMixer mixer(m_options.anderson_depth);
-  for (int p : q.start_columns) {  // filled by make_column once the operators exist
-    in_active[p] = 1;
-    cols.emplace_back();
-    cols.back().p = p;
-  }
+  fom::AndersonMixer mixer;
+  bool pending = false;  // settled: to be confirmed at the fresh pairing of û
+  bool finite = true;    // every solve so far gave finite values
+  int solves = 0;
 
-  // Fills `col` for dictionary column p on the current operators (its vectors keep
-  // their storage from one rebuild to the next).
-  auto make_column = [&](Column& col, int p) {
+  /// Fills `col` for dictionary column p on the current operators (its vectors keep
+  /// their storage from one rebuild to the next).
+  void make_column(Column& col, int p) {
     col.p = p;
     q.operators.start();  // Ĉ_p is the operator; w_p and z_p belong to the solve
-    col.c_hat.setZero(r);
-    for (int i : m_support.column_support[static_cast<size_t>(p)]) col.c_hat.noalias() += dr(i, p) * a.row(i);
+    col.c_hat.setZero(g.m_model.primal_rank());
+    for (int i : g.m_support.column_support[static_cast<size_t>(p)]) col.c_hat.noalias() += dr(i, p) * a.row(i);
     q.operators.stop();
     q.k_inv.apply(col.c_hat.transpose(), col.w);
     aw.noalias() = a * col.w.col(0);
     col.z.noalias() = dr.transpose() * aw;
-  };
+  }
 
-  bool pending = false;  // settled: to be confirmed at the fresh pairing of û
-  int solves = 0;
-  for (int rebuild = 0;; ++rebuild) {
-    // 1. Operators at x (surface rows only), A = C_R Φ_s and b.
+  /// After a rebuild: A = C_R Φ_s, b = C_R u_off,s − g_R, every column's violation at
+  /// u_free, and the selected columns' vectors.
+  void freeze_operators() {
     q.operators.start();
-    u_s.noalias() = phi_s * x;
-    u_s += lift_s;
-    ops.rebuild(contact, m_support, u_s);
+    g.m_support.gap_operator(q.ops.c, q.ops.g, g.m_model.surface_basis_rows(), q.lift_s, a, b);
     q.operators.stop();
-    if (pending) {  // x = û: is every column (selected ones included) within τ here?
-      m_support.violation(ops.c, ops.g, u_s, gap, violation);
-      if (confirmed(violation)) {
-        res.converged = true;
-        break;
-      }
-      pending = false;
-    }
-    if (rebuild >= max_rebuilds || solves >= m_options.max_solves) break;
-    q.operators.start();
-    m_support.gap_operator(ops.c, ops.g, phi_s_rows, lift_s, a, b);  // A = C_R Φ_s, b = C_R u_off,s − g_R
-    q.operators.stop();
-    gap.noalias() = a * u_free;
+    gap.noalias() = a * q.u_free;
     gap += b;
     v_free.noalias() = dr.transpose() * gap;
     for (auto& col : cols) make_column(col, col.p);
+  }
 
-    // 2–3. One-change steps on the frozen operators until nothing changes, a
-    //      selection comes back (cycle) or the solve cap is reached.
+  /// Step 2 on frozen operators: û, λ̂_I and every column's violation from the
+  /// columns' vectors. False on a non-finite value.
+  bool solve() {
+    const int na = static_cast<int>(cols.size());
+    u_hat = q.u_free;
+    violation = v_free;
+    lambda_i.resize(na);
+    if (na > 0) {
+      if (schur.rows() < na) {  // storage that only grows; the leading |I| entries are used
+        const int cap = std::max(2 * static_cast<int>(schur.rows()), std::max(na, 4));
+        schur.resize(cap, cap), rhs.resize(cap);
+      }
+      for (int i = 0; i < na; ++i) {
+        rhs(i) = v_free(cols[i].p);  // Ĉ_i u_free − ĝ_i
+        for (int j = 0; j <= i; ++j) schur(i, j) = schur(j, i) = cols[i].c_hat.dot(cols[j].w.col(0));
+      }
+      lambda_i = schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), g.m_options.singular_tolerance);
+      for (int i = 0; i < na; ++i) {
+        u_hat.noalias() -= lambda_i(i) * cols[i].w.col(0);
+        violation.noalias() -= lambda_i(i) * cols[i].z;
+      }
+    }
+    ++solves;
+    solved.resize(static_cast<size_t>(na));
+    for (int i = 0; i < na; ++i) solved[static_cast<size_t>(i)] = cols[i].p;
+    return u_hat.allFinite() && lambda_i.allFinite();
+  }
+
+  /// Steps 2–3 repeated on the frozen operators until nothing changes, a selection
+  /// comes back (a cycle: rebuild) or the solve cap is reached. Returns whether the
+  /// selection changed.
+  bool settle(int rebuild) {
     bool changed = false;
     seen.clear();
-    while (solves < m_options.max_solves) {
-      const int na = static_cast<int>(cols.size());
-      u_hat = u_free;
-      violation = v_free;
-      lambda_i.resize(na);
-      if (na > 0) {
-        if (schur.rows() < na) {  // storage that only grows; the leading |I| entries are used
-          const int cap = std::max(2 * static_cast<int>(schur.rows()), std::max(na, 4));
-          schur.resize(cap, cap), rhs.resize(cap);
-        }
-        for (int i = 0; i < na; ++i) {
-          rhs(i) = v_free(cols[i].p);  // Ĉ_i u_free − ĝ_i
-          for (int j = 0; j <= i; ++j) schur(i, j) = schur(j, i) = cols[i].c_hat.dot(cols[j].w.col(0));
-        }
-        lambda_i = schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), m_options.singular_tolerance);
-        for (int i = 0; i < na; ++i) {
-          u_hat.noalias() -= lambda_i(i) * cols[i].w.col(0);
-          violation.noalias() -= lambda_i(i) * cols[i].z;
-        }
-      }
-      ++solves;
-      solved.resize(static_cast<size_t>(na));
-      for (int i = 0; i < na; ++i) solved[static_cast<size_t>(i)] = cols[i].p;
-      if (!u_hat.allFinite() || !lambda_i.allFinite()) {
-        res.status = Status::NumericalIssue;
-        res.message = "reduced saddle-point solve produced a non-finite value";
-        break;
-      }
-
+    while (solves < g.m_options.max_solves) {
+      if (!(finite = solve())) break;
       const int remove = most_negative(lambda_i);
-      const double max_violation = m > 0 ? violation.maxCoeff() : 0.0;
+      const double max_violation = violation.size() > 0 ? violation.maxCoeff() : 0.0;
       int add = -1;
       if (remove < 0) {
-        if (m_options.best_iterate_on_failure) q.offer(max_violation, u_hat, lambda_i, solved);
-        add = most_violated(violation, in_active, m_threshold);
+        q.offer(max_violation, u_hat, lambda_i, solved);
+        add = most_violated(violation, in_active, g.m_threshold);
       }
-      if (m_options.trace) {
-        *m_options.trace << "greedy rebuild=" << rebuild << " solve=" << solves << " |I|=" << na
-                         << " min(lambda)=" << (na ? lambda_i.minCoeff() : 0.0) << " max(violation)=" << max_violation
-                         << " -> ";
-        if (remove >= 0)
-          *m_options.trace << "remove " << cols[remove].p;
-        else if (add >= 0)
-          *m_options.trace << "add " << add;
-        else
-          *m_options.trace << "no change";
-        *m_options.trace << "\n";
-      }
+      trace_step(rebuild, remove, add, max_violation);
       if (remove >= 0) {
-        in_active[cols[remove].p] = 0;
+        in_active[static_cast<size_t>(cols[remove].p)] = 0;
         spare.push_back(std::move(cols[remove]));
         cols.erase(cols.begin() + remove);
       } else if (add >= 0) {
-        in_active[add] = 1;
+        in_active[static_cast<size_t>(add)] = 1;
         if (spare.empty()) spare.emplace_back();
         cols.push_back(std::move(spare.back()));
         spare.pop_back();
@@ -579,29 +626,71 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds
         break;
       }
       changed = true;
-      // This selection was met before on these operators: rebuild them.
-      if (seen.revisits(cols, [](const Column& col) { return col.p; })) break;
+      if (seen.revisits(cols, [](const Column& col) { return col.p; })) break;  // met on these operators
     }
-    if (res.status != Status::Success) break;
+    return changed;
+  }
 
-    // 4. Settled on these operators and û close to where they were built: confirm
-    //    at the pairing of û itself; else rebuild at the (accelerated) new point.
+  /// Step 4: settled on these operators and û close to where they were built:
+  /// confirm at û's own pairing; else rebuild at the new point, Anderson-accelerated
+  /// while the selection is unchanged (a smooth fixed point in x).
+  void next_rebuild_point(bool changed, int rebuild) {
     const double step = (u_hat - x).norm(), size = u_hat.norm();
-    if (m_options.trace)
-      *m_options.trace << "greedy rebuild=" << rebuild << " step=" << step / std::max(size, 1e-300) << "\n";
-    if (!changed && step <= m_options.step_tolerance * size) {
+    if (g.m_options.trace)
+      *g.m_options.trace << "greedy rebuild=" << rebuild << " step=" << step / std::max(size, 1e-300) << "\n";
+    if (!changed && step <= g.m_options.step_tolerance * size) {
       pending = true;
       x = u_hat;
     } else if (!changed) {
-      x = mixer.next(x, u_hat);  // same selection: a smooth fixed point in x
+      x = mixer.next(x, u_hat);
     } else {
-      mixer = fom::AndersonMixer(m_options.anderson_depth);
+      mixer = fom::AndersonMixer(g.m_options.anderson_depth);
       x = u_hat;
     }
   }
-  res.iterations = solves;
 
-  q.finish(!res.converged && res.status == Status::Success, u_hat, lambda_i, solved);
+  void trace_step(int rebuild, int remove, int add, double max_violation) const {
+    std::ostream* out = g.m_options.trace;
+    if (!out) return;
+    const int na = static_cast<int>(cols.size());
+    *out << "greedy rebuild=" << rebuild << " solve=" << solves << " |I|=" << na
+         << " min(lambda)=" << (na ? lambda_i.minCoeff() : 0.0) << " max(violation)=" << max_violation << " -> ";
+    if (remove >= 0)
+      *out << "remove " << cols[remove].p;
+    else if (add >= 0)
+      *out << "add " << add;
+    else
+      *out << "no change";
+    *out << "\n";
+  }
+};
+
+void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds) const {
+  Nested s(*this, q);
+  for (int rebuild = 0;; ++rebuild) {
+    // 1. Operators at x (surface rows only); a settled û is confirmed at its own pairing.
+    q.surface_displacement(s.x, s.u_s);
+    q.rebuild(s.u_s);
+    if (s.pending) {
+      if (q.confirmed(s.u_s, s.gap, s.violation)) {
+        res.converged = true;
+        break;
+      }
+      s.pending = false;
+    }
+    if (rebuild >= max_rebuilds || s.solves >= m_options.max_solves) break;
+    s.freeze_operators();
+    // 2–3. One-change steps on the frozen operators.
+    const bool changed = s.settle(rebuild);
+    if (!s.finite) {
+      numerical_issue(res);
+      break;
+    }
+    // 4. Settled, or the next rebuild point.
+    s.next_rebuild_point(changed, rebuild);
+  }
+  res.iterations = s.solves;
+  q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i, s.solved);
 }
 
 }  // namespace contactrom::rom

@@ -38,7 +38,10 @@
 /// Each rebuild searches the contact pairs with a memory of the previous searches
 /// (GreedyOptions::rebuild, fom::SearchMemory): rows that cannot have changed master
 /// segment skip the search of the whole chain, with the same operators as a full search.
-/// Only Ĉ_I (|I| rows) is formed; the violation of all m columns is evaluated as
+/// With a warm start, the first search starts from the memory of the one made offline
+/// at the nearest training snapshot (ReducedModel::snapshot_search_memory).
+/// Only Ĉ_I (|I| rows) is formed, from the rows of C_R Φ_s on the union of the selected
+/// columns' supports (SupportRows::reduced_rows); the violation of all m columns is evaluated as
 /// \f$ D_d^T (C_s u_s - g) \f$, which equals \f$ \hat C\hat u - \hat g \f$. Every
 /// operation costs O(n_s r + n_c (r |I| + m) + r²|I|): nothing scales with the mesh
 /// beyond the contact surface. The returned (û, λ̂_I) solve the saddle-point system
@@ -114,8 +117,11 @@ WarmStart parse_warm_start(const std::string& method, const std::string& text);
 
 /// \brief The starting point of `init` at μ: the selected dictionary columns (empty
 /// for Empty and Primal) and the reduced displacement (u_free for Empty).
+/// \param nearest if given, set to the heaviest stencil point's column (whose
+///   ReducedModel::snapshot_search_memory seeds the first contact search), −1 for Empty
 void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Param& mu,
-                      const Eigen::VectorXd& u_free, std::vector<int>& columns, Eigen::VectorXd& u_hat);
+                      const Eigen::VectorXd& u_free, std::vector<int>& columns, Eigen::VectorXd& u_hat,
+                      int* nearest = nullptr);
 
 /// \brief Settings of GreedyActiveSet (documented defaults).
 struct GreedyOptions {
@@ -185,17 +191,13 @@ class GreedyActiveSet final : public OnlineSolver {
   double m_threshold = 0.0;
   SupportRows m_support;  // contact rows R where D_d is not zero, D_d restricted to R
 
-  struct Query;  // the per-query quantities both schedules share
+  struct Query;        // the per-query quantities both schedules share
+  struct Interleaved;  // the interleaved schedule's state between its steps
+  struct Nested;       // the nested schedule's state between its steps
   void solve_interleaved(Query& q, OnlineResult& res) const;
   /// \param max_rebuilds cap on the operator rebuilds (k_max, or what the
   /// interleaved schedule left of it when it hands over on a cycle)
   void solve_nested(Query& q, OnlineResult& res, int max_rebuilds) const;
-  /// Every column's violation at the fresh pairing of the returned û is within τ.
-  bool confirmed(const Eigen::VectorXd& violation) const;
-  /// Interleaved schedule: the point x where the next operators are built, and its
-  /// surface displacement u_s — û itself when `plain`, else Anderson-accelerated.
-  void next_rebuild_point(bool plain, const Eigen::VectorXd& u_hat, Eigen::VectorXd& x, fom::AndersonMixer& mixer,
-                          Eigen::VectorXd& u_s, Query& q) const;
 };
 
 /// \brief The threshold τ that GreedyActiveSet applies with `options` (defaulted to δ

@@ -168,6 +168,14 @@ void ReducedModel::derive() {
   m_lift_s.resize(ns, nt);
   for (int k = 0; k < nt; ++k)
     for (int a = 0; a < ns; ++a) m_lift_s(a, k) = m_offset[k](surf[a]);
+  // The contact search at every reduced snapshot, over all rows (a query's support
+  // rows are a subset): one full search per column, offline.
+  m_snapshot_memory.assign(static_cast<size_t>(dictionary_size()), fom::SearchMemory());
+  fom::Pairing pairing;
+  for (int p = 0; p < dictionary_size(); ++p) {
+    const Eigen::VectorXd u_s = m_phi_s * m_snapshot_coords.col(p) + surface_lifting(m_dict_params[static_cast<size_t>(p)]);
+    m_problem.contact().search_rows(u_s, nullptr, nullptr, m_snapshot_memory[static_cast<size_t>(p)], pairing);
+  }
   if (m_k_hat.size() == 1) {
     m_k_llt.compute(m_k_hat[0]);
     m_single_ok = m_k_llt.info() == Eigen::Success;

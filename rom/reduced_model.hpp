@@ -119,6 +119,15 @@ class ReducedModel {
   /// \f$ \hat u_p = \Phi^T (u_p - u_{off}(\mu_p)) \f$ (r × m): the best reduced
   /// approximation of each training solution, used to warm-start the online methods.
   const Eigen::MatrixXd& snapshot_coordinates() const { return m_snapshot_coords; }
+  /// \brief What the contact search of every row leaves at dictionary column p's
+  /// reduced snapshot, \f$ u_s = \Phi_s \hat u_p + u_{off,s}(\mu_p) \f$ (fom::SearchMemory:
+  /// closest segment, clearance and the displacements they were found at). An online
+  /// query that starts near μ_p copies it into its own memory, so that its first
+  /// search settles the rows that cannot have changed segment instead of searching
+  /// the whole master chain — with the same pairing as a full search. Derived from
+  /// the other data (not stored in a reduced-model file); empty memories when the
+  /// contact model has no pairing.
+  const fom::SearchMemory& snapshot_search_memory(int p) const { return m_snapshot_memory[static_cast<size_t>(p)]; }
 
   /// \brief One training parameter of an interpolation stencil and its weight.
   struct StencilPoint {
@@ -178,12 +187,13 @@ class ReducedModel {
   std::vector<int> m_dict_snapshots;
   std::vector<fom::Param> m_dict_params;
   Eigen::MatrixXd m_snapshot_coords;  // Φᵀ primal, r × m
+  std::vector<fom::SearchMemory> m_snapshot_memory;  // contact search at each reduced snapshot
   // Training parameters as a tensor grid: sorted distinct values per dimension and
   // the dictionary column at each grid node (−1: none), first dimension fastest.
   std::vector<std::vector<double>> m_grid_values;
   std::vector<int> m_grid_columns;
   void build_parameter_grid();
-  void derive();  // surface rows, snapshot coordinates, grid, factor of Φᵀ K₀ Φ
+  void derive();  // surface rows, snapshot coordinates and search memories, grid, factor of Φᵀ K₀ Φ
   std::vector<Eigen::VectorXd> m_offset;  // L̃_k
   std::vector<Eigen::MatrixXd> m_k_hat;   // Φᵀ K_q Φ
   Eigen::MatrixXd m_f_hat;                // column k: Φᵀ f_ext,k

@@ -92,6 +92,55 @@ double SupportRows::reduced_row(int p, const fom::ConstraintMatrix& c_r, const E
   return g_hat;
 }
 
+void SupportRows::reduced_rows(const std::vector<int>& columns, const fom::ConstraintMatrix& c_r,
+                               const Eigen::VectorXd& g_r, const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s,
+                               RowMajorMatrix& c_hat, Eigen::VectorXd& g_hat, RowsScratch& scratch) const {
+  const Eigen::Index r = phi_s.cols(), nr = static_cast<Eigen::Index>(rows.size());
+  if (columns.size() < 2) {  // nothing to share
+    for (size_t i = 0; i < columns.size(); ++i) {
+      const auto at = static_cast<Eigen::Index>(i);
+      g_hat(at) = reduced_row(columns[i], c_r, g_r, phi_s, lift_s, c_hat.row(at));
+    }
+    return;
+  }
+  if (scratch.a.rows() != nr || scratch.a.cols() != r) {
+    scratch.a.resize(nr, r), scratch.b.resize(nr);
+    scratch.stamp.assign(static_cast<size_t>(nr), 0), scratch.call = 0;
+  }
+  if (++scratch.call == 0) std::fill(scratch.stamp.begin(), scratch.stamp.end(), 0), scratch.call = 1;
+  const int* outer = c_r.outerIndexPtr();
+  const int* inner = c_r.innerIndexPtr();
+  const double* value = c_r.valuePtr();
+  for (size_t i = 0; i < columns.size(); ++i) {
+    const int p = columns[i];
+    const auto at = static_cast<Eigen::Index>(i);
+    double* out = c_hat.row(at).data();
+    std::fill(out, out + r, 0.0);
+    double g_hat_p = 0.0;
+    for (int k : column_support[static_cast<size_t>(p)]) {
+      double* a_k = scratch.a.data() + static_cast<Eigen::Index>(k) * r;
+      if (scratch.stamp[static_cast<size_t>(k)] != scratch.call) {  // first use of row k in this call
+        scratch.stamp[static_cast<size_t>(k)] = scratch.call;
+        row_times_basis<true>(1.0, value + outer[k], inner + outer[k], outer[k + 1] - outer[k], phi_s, a_k);
+        double acc = g_r(k);
+        for (int e = outer[k]; e < outer[k + 1]; ++e) acc -= value[e] * lift_s(inner[e]);
+        scratch.b(k) = acc;
+      }
+      const double wk = basis(k, p);
+      for (Eigen::Index t = 0; t < r; ++t) out[t] += wk * a_k[t];
+      g_hat_p += wk * scratch.b(k);
+    }
+    g_hat(at) = g_hat_p;
+  }
+}
+
+void SupportOperators::reset(bool partial) {
+  m_partial = partial;
+  pairing.segment.clear();
+  m_memory.centre.clear();  // the next search lays the memory out anew, in the same storage
+  m_memory.certified = m_memory.searched = 0;
+}
+
 void SupportOperators::rebuild(const fom::ContactModel& contact, const SupportRows& support,
                                const Eigen::VectorXd& u_surface) {
   if (m_partial)  // an empty hint is ignored
@@ -100,6 +149,13 @@ void SupportOperators::rebuild(const fom::ContactModel& contact, const SupportRo
     contact.search_rows(u_surface, &support.rows, &pairing, m_next);
   std::swap(pairing, m_next);
   contact.assemble_rows(pairing, support.rows, c, g);
+}
+
+void SupportOperators::seed(const fom::SearchMemory& memory) {
+  if (!m_partial) return;
+  const int certified = m_memory.certified, searched = m_memory.searched;
+  m_memory = memory;  // reuses the storage of an earlier query's memory
+  m_memory.certified = certified, m_memory.searched = searched;
 }
 
 }  // namespace contactrom::rom

@@ -42,6 +42,22 @@ struct SupportRows {
   /// \f$ \hat g_p = w_p^T (g_R - C_R u_{off,s}) \f$. O(nnz(w_p) · 6 · r).
   double reduced_row(int p, const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r, const RowMajorMatrix& phi_s,
                      const Eigen::VectorXd& lift_s, Eigen::Ref<Eigen::RowVectorXd> c_hat) const;
+
+  /// Storage of reduced_rows(), reused from one call to the next.
+  struct RowsScratch {
+    RowMajorMatrix a;         ///< rows of C_R Φ_s formed in the current call
+    Eigen::VectorXd b;        ///< the matching entries of g_R − C_R u_off,s
+    std::vector<unsigned> stamp;  ///< per support row: the call that formed it
+    unsigned call = 0;
+  };
+  /// \brief reduced_row() for several columns at once: row i of `c_hat` (r columns,
+  /// at least |columns| rows) and `g_hat(i)` for column columns[i]. The rows of
+  /// \f$ C_R \Phi_s \f$ on the union of the columns' supports are formed once and
+  /// combined per column, O(|∪ supp| · 6 · r + Σ |supp_p| · r) instead of
+  /// O(Σ |supp_p| · 6 · r): the supports of neighbouring training snapshots overlap.
+  void reduced_rows(const std::vector<int>& columns, const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
+                    const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s, RowMajorMatrix& c_hat,
+                    Eigen::VectorXd& g_hat, RowsScratch& scratch) const;
 };
 
 /// \brief Contact operators of the support rows at the current iterate, rebuilt in
@@ -59,6 +75,14 @@ struct SupportOperators {
   /// Searches the support rows at u_s, seeded by the current pairing, and assembles
   /// C_R and g_R there.
   void rebuild(const fom::ContactModel& contact, const SupportRows& support, const Eigen::VectorXd& u_surface);
+  /// Starts the memory from `memory` (e.g. ReducedModel::snapshot_search_memory of
+  /// the training snapshot nearest to the query) instead of nothing, so that the
+  /// first rebuild settles the rows that cannot have changed segment since. The
+  /// operators are those of a full search either way. Ignored without `partial`.
+  void seed(const fom::SearchMemory& memory);
+  /// Forgets the pairing and the memory (keeping their storage), for a new query;
+  /// `partial` as in the constructor.
+  void reset(bool partial);
   /// Rows settled by the memory and rows searched in full, over the rebuilds so far.
   int certified_rows() const { return m_memory.certified; }
   int searched_rows() const { return m_memory.searched; }
