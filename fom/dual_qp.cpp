@@ -33,6 +33,7 @@ Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::Vecto
     m_info = Status::InvalidInput;
     return Eigen::VectorXd::Zero(n);
   }
+  if (n == 0) return Eigen::VectorXd();
   for (int i = 0; i < n; ++i)
     if (!(g(i, i) > 0.0)) eligible[i] = 0;
   const double scale = std::max(h.cwiseAbs().maxCoeff(), 1e-300);
@@ -64,12 +65,15 @@ Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::Vecto
     const Eigen::VectorXd w = g * lambda - h;
     std::vector<char> next(n, 0);
     for (int i = 0; i < n; ++i) next[i] = eligible[i] && (active[i] ? lambda(i) > -tol : w(i) < -tol);
-    if (next == active) {
+    if (next == active && active_gaps_close(w, active, lambda, g, scale)) {
       // Converged: clean round-off negatives (|λ_i| <= tol) on the active set.
       lambda = lambda.cwiseMax(0.0);
       return lambda;
     }
-    if (seen.count(next)) {
+    // A stable active set whose rows still have a gap was solved in the least-squares
+    // sense (G singular on it: dependent rows); PDAS cannot improve on it, and
+    // Lawson–Hanson solves the QP exactly, like a cycle.
+    if (next == active || seen.count(next)) {
       m_fallback = true;
       return lawson_hanson(g, h, eligible);
     }
@@ -77,6 +81,19 @@ Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::Vecto
   }
   m_info = Status::NoConvergence;
   return lambda;
+}
+
+// Complementarity on the active set: w_i = (Gλ − h)_i vanishes on every active row,
+// to a tolerance above the round-off of a Cholesky solve (relative_tolerance ×
+// kGapSlack, against max(|h|∞, |Gλ|∞)). Only a least-squares solve on a singular
+// subsystem misses it.
+bool DualQpSolver::active_gaps_close(const Eigen::VectorXd& w, const std::vector<char>& active,
+                                     const Eigen::VectorXd& lambda, const Eigen::MatrixXd& g, double scale) const {
+  constexpr double kGapSlack = 1e3;
+  const double tol = kGapSlack * m_options.relative_tolerance * std::max(scale, (g * lambda).cwiseAbs().maxCoeff());
+  for (int i = 0; i < static_cast<int>(w.size()); ++i)
+    if (active[i] && std::abs(w(i)) > tol) return false;
+  return true;
 }
 
 // Lawson–Hanson on the rows that may become active (NnlsQp, core/nnls.hpp), started

@@ -13,7 +13,8 @@
 /// terminates finitely for M-matrices but may cycle otherwise; a repeated active
 /// set switches to the Lawson–Hanson primal active-set method (NnlsQp,
 /// core/nnls.hpp, on the rows that may become active), which terminates for any
-/// positive semi-definite G.
+/// positive semi-definite G. So does a stable active set whose rows keep a gap
+/// (G singular on it, dependent rows: PDAS's least-squares step cannot close it).
 #include <Eigen/Dense>
 #include <vector>
 
@@ -49,6 +50,8 @@ class DualQpSolver {
 
  private:
   bool solve_on(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<int>& set, Eigen::VectorXd& z) const;
+  bool active_gaps_close(const Eigen::VectorXd& w, const std::vector<char>& active, const Eigen::VectorXd& lambda,
+                         const Eigen::MatrixXd& g, double scale) const;
   Eigen::VectorXd lawson_hanson(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<char>& eligible);
 
   DualQpOptions m_options;
