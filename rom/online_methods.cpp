@@ -14,8 +14,6 @@
 namespace contactrom::rom {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 /// Methods of contactrom::baselines, named in the message a program gets when it
 /// asks for one of them without linking that library.
 const std::vector<std::string> kBaselineMethods{"cpg", "full-dictionary"};
