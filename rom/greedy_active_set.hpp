@@ -58,7 +58,7 @@
 #include <iosfwd>
 
 #include "fom/anderson.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_solver.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/support_rows.hpp"
 
