@@ -7,6 +7,7 @@
 #include "fom/errors.hpp"
 #include "python/bindings.hpp"
 #include "rom/offline.hpp"
+#include "rom/online_methods.hpp"
 
 namespace contactrom::python {
 namespace {

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "fom/input_values.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/pod.hpp"
 
 namespace contactrom::rom {

@@ -20,6 +20,7 @@
 #include "fom/kkt.hpp"
 #include "rom/convex_hull.hpp"
 #include "rom/offline.hpp"
+#include "rom/online_methods.hpp"
 
 namespace rom = contactrom::rom;
 namespace fom = contactrom::fom;
