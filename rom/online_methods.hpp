@@ -72,7 +72,7 @@ double parse_option_number(const std::string& method, const std::string& key, co
 long long parse_option_integer(const std::string& method, const std::string& key, const std::string& text);
 
 /// \brief Builds the solver registered as `name`, after checking `options` against
-/// the method's declared options (validate_online_options in rom/online_methods.hpp).
+/// the method's declared options (validate_online_options below).
 /// \throws InputError "unknown online method 'x'; expected one of: ..." for an unknown
 /// name, or naming the method, option, value and what was expected.
 std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const ReducedModel& model,
