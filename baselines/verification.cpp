@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <ostream>
 
@@ -61,6 +62,17 @@ void solve_references(const Solver& solver, const fom::Problem& problem, const V
       [&](int done, int total) { report_progress(o, r.reference + " references", done, total); });
 }
 
+/// Errors by the rule of `online` (relative, or absolute against a near-zero
+/// reference); +infinity when verify_solution found the sizes inconsistent.
+fom::ReferenceErrors errors_against_reference(const fom::Problem& problem, const rom::OnlineResult& res,
+                                              const fom::FomSolution& ref, const VerificationReport& report) {
+  if (report.status != Status::Success || !report.has_reference) {
+    const double inf = std::numeric_limits<double>::infinity();
+    return {inf, inf, false};
+  }
+  return fom::reference_errors(problem, res.u, res.lambda, ref.u, ref.lambda);
+}
+
 MethodVerification verify_method(const rom::OnlineSolver& solver, const rom::OnlineSolverOptions& options,
                                  const VerifyOptions& o, const VerifyReport& r) {
   const fom::Problem& problem = solver.model().problem();
@@ -74,7 +86,7 @@ MethodVerification verify_method(const rom::OnlineSolver& solver, const rom::Onl
     VerifyRow& row = m.rows[i];
     row.report = verify_solution(problem, r.params[i], res.u, res.lambda, &r.references[i]);
     m.summary.add(row.report);
-    row.errors = fom::reference_errors(problem, res.u, res.lambda, r.references[i].u, r.references[i].lambda);
+    row.errors = errors_against_reference(problem, res, r.references[i], row.report);
     m.errors.add_errors(row.errors);
     row.reduced_penetration = reduced_penetration(solver.model(), m.dual_columns, res.u);
     row.status = res.status;
