@@ -58,19 +58,6 @@ std::vector<std::string> online_solver_names();
 /// \throws InputError "unknown online method 'x'; expected one of: ...".
 void check_online_method(const std::string& name);
 
-/// \brief Refuses method-specific settings (OnlineSolverOptions::extra) that `method`
-/// does not know. \throws InputError "online method 'm' has no option 'k'; it knows: ...".
-void check_extra_options(const OnlineSolverOptions& options, const std::string& method,
-                         const std::vector<std::string>& known);
-
-/// \brief Value of a method-specific setting (OnlineSolverOptions::extra) as a finite
-/// number. \throws InputError "<method> option <key> = '<text>' is not a number".
-double parse_option_number(const std::string& method, const std::string& key, const std::string& text);
-
-/// \brief Value of a method-specific setting as an integer (the whole text).
-/// \throws InputError "<method> option <key> = '<text>' is not an integer".
-long long parse_option_integer(const std::string& method, const std::string& key, const std::string& text);
-
 /// \brief Builds the solver registered as `name`, after checking `options` against
 /// the method's declared options (validate_online_options below).
 /// \throws InputError "unknown online method 'x'; expected one of: ..." for an unknown

@@ -2,8 +2,8 @@
 /// \file online_solver.hpp
 /// \brief The common interface of the online ROM methods (greedy active set,
 /// convex hull, CPG, full dictionary, ...): one query's result, the solver
-/// interface, the settings the methods share, and the clock of the contact-operator
-/// construction.
+/// interface, the settings the methods share (and the parsing of their
+/// method-specific ones), and the clock of the contact-operator construction.
 ///
 /// Methods are built by name through the registry (rom/online_methods.hpp) and
 /// evaluated against the FOM by rom/online_evaluation.hpp.
@@ -83,6 +83,19 @@ struct OnlineSolverOptions {
   /// Method-specific settings by name (for methods added later), as text.
   std::map<std::string, std::string> extra;
 };
+
+/// \brief Refuses method-specific settings (OnlineSolverOptions::extra) that `method`
+/// does not know. \throws InputError "online method 'm' has no option 'k'; it knows: ...".
+void check_extra_options(const OnlineSolverOptions& options, const std::string& method,
+                         const std::vector<std::string>& known);
+
+/// \brief Value of a method-specific setting (OnlineSolverOptions::extra) as a finite
+/// number. \throws InputError "<method> option <key> = '<text>' is not a number".
+double parse_option_number(const std::string& method, const std::string& key, const std::string& text);
+
+/// \brief Value of a method-specific setting as an integer (the whole text).
+/// \throws InputError "<method> option <key> = '<text>' is not an integer".
+long long parse_option_integer(const std::string& method, const std::string& key, const std::string& text);
 
 /// \brief Accumulates the wall time of the operator-construction phases of one
 /// query into OnlineResult::operator_time_s; does nothing unless enabled.
