@@ -84,7 +84,7 @@ BOOST_AUTO_TEST_CASE(commands_name_the_same_quantity_alike) {
   for (const char* key : {"mean_sparsity", "mean_iterations", "nonconverged", "dictionary_size", "delta", "method"}) {
     BOOST_TEST(online.contains(key), "online lacks " << key);
     BOOST_TEST(hull.contains(key), "hull-report lacks " << key);
-    BOOST_TEST(verify_greedy.contains(key) || verify.contains(key), "verify lacks " << key);
+    BOOST_TEST((verify_greedy.contains(key) || verify.contains(key)), "verify lacks " << key);
   }
   // The same run, the same numbers: verify's errors against the FOM reference are
   // bounded by what online reports over the whole validation set.
