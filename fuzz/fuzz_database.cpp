@@ -10,6 +10,7 @@
 #include <string>
 
 #include "fom/errors.hpp"
+#include "hdf5_open_objects.hpp"
 #include "rom/snapshot_database.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -23,6 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (db.num_snapshots() != static_cast<int>(db.status.size())) __builtin_trap();
   } catch (const contactrom::InputError&) {
   }
+  contactrom::fuzz::require_no_open_hdf5_objects();
   std::remove(path.c_str());
   return 0;
 }

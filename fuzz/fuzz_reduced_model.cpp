@@ -11,6 +11,7 @@
 #include <string>
 
 #include "fom/errors.hpp"
+#include "hdf5_open_objects.hpp"
 #include "rom/reduced_model_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -28,6 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     (void)rom.solve(mu);
   } catch (const contactrom::InputError&) {
   }
+  contactrom::fuzz::require_no_open_hdf5_objects();
   std::remove(path.c_str());
   return 0;
 }

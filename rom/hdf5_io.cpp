@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 
 #include "fom/atomic_file.hpp"
@@ -181,8 +182,41 @@ void write_dataset(hid_t file, hid_t dcpl, const char* name, hid_t file_type, hi
 hid_t create_memory_file(const std::string& label, hid_t fcpl) {
   Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "file access properties");
   check(H5Pset_fapl_core(fapl.id(), std::size_t{1} << 20, false), "file access properties");
+  // The 1.8 file format: superblock version 2 and version-2 object headers, both
+  // with checksums, so a damaged header is refused by HDF5's checksum test before
+  // libhdf5 parses it (the 1.10 library crashes on some damaged version-1 headers).
+  check(H5Pset_libver_bounds(fapl.id(), H5F_LIBVER_V18, H5F_LIBVER_V18), "file access properties");
   return H5Fcreate(label.c_str(), H5F_ACC_TRUNC, fcpl, fapl.id());
 }
+
+namespace {
+
+/// Bob Jenkins' lookup3 hash (hashlittle, public domain), with which HDF5
+/// checksums its metadata (initial value 0).
+std::uint32_t lookup3(const unsigned char* k, size_t length) {
+  auto rot = [](std::uint32_t x, int r) { return (x << r) | (x >> (32 - r)); };
+  auto word = [](const unsigned char* p, size_t n) {
+    std::uint32_t w = 0;
+    for (size_t i = 0; i < n && i < 4; ++i) w |= static_cast<std::uint32_t>(p[i]) << (8 * i);
+    return w;
+  };
+  std::uint32_t a = 0xdeadbeef + static_cast<std::uint32_t>(length), b = a, c = a;
+  while (length > 12) {
+    a += word(k, 4), b += word(k + 4, 4), c += word(k + 8, 4);
+    a -= c, a ^= rot(c, 4), c += b, b -= a, b ^= rot(a, 6), a += c;
+    c -= b, c ^= rot(b, 8), b += a, a -= c, a ^= rot(c, 16), c += b;
+    b -= a, b ^= rot(a, 19), a += c, c -= b, c ^= rot(b, 4), b += a;
+    length -= 12, k += 12;
+  }
+  if (length == 0) return c;
+  a += word(k, length), b += length > 4 ? word(k + 4, length - 4) : 0, c += length > 8 ? word(k + 8, length - 8) : 0;
+  c ^= b, c -= rot(b, 14), a ^= c, a -= rot(c, 11), b ^= a, b -= rot(a, 25);
+  c ^= b, c -= rot(b, 16), a ^= c, a -= rot(c, 4), b ^= a, b -= rot(a, 14);
+  c ^= b, c -= rot(b, 24);
+  return c;
+}
+
+}  // namespace
 
 std::string file_image(hid_t file) {
   check(H5Fflush(file, H5F_SCOPE_GLOBAL), "file flush");
@@ -190,6 +224,15 @@ std::string file_image(hid_t file) {
   if (size < 0) throw Failure("file image");
   std::string image(static_cast<size_t>(size), '\0');
   if (H5Fget_file_image(file, image.data(), image.size()) != size) throw Failure("file image");
+  // libhdf5 1.10 clears the superblock's "open for writing" flag in the image but
+  // keeps the checksum computed with it set; the superblock (version 2 or 3:
+  // signature, 4 bytes, 4 addresses, checksum) gets its checksum recomputed.
+  const auto* bytes = reinterpret_cast<unsigned char*>(image.data());
+  const size_t offsets = image.size() > 9 ? bytes[9] : 0, checked = 12 + 4 * offsets;
+  if (image.size() >= checked + 4 && (bytes[8] == 2 || bytes[8] == 3)) {
+    const std::uint32_t sum = lookup3(bytes, checked);
+    for (int i = 0; i < 4; ++i) image[checked + i] = static_cast<char>((sum >> (8 * i)) & 0xff);
+  }
   return image;
 }
 
@@ -264,6 +307,21 @@ void write_file(const std::string& path, const std::function<void(hid_t file, hi
   write_file_atomically(path, [&image](std::ostream& out) { out.write(image.data(), static_cast<std::streamsize>(image.size())); });
 }
 
+namespace {
+
+/// Version of the HDF5 superblock of `path`: the byte after the signature, which
+/// sits at offset 0, 512, 1024, 2048, ... (after a user block); -1 if not found.
+int superblock_version(const std::string& path) {
+  static const char signature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
+  std::ifstream in(path, std::ios::binary);
+  char head[9];
+  for (std::streamoff offset = 0; in.seekg(offset) && in.read(head, sizeof head); offset = offset ? 2 * offset : 512)
+    if (std::equal(signature, signature + 8, head)) return static_cast<unsigned char>(head[8]);
+  return -1;
+}
+
+}  // namespace
+
 hid_t open_file(const std::string& path, const std::string& label, const std::string& expected_writer) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -272,6 +330,13 @@ hid_t open_file(const std::string& path, const std::string& label, const std::st
   silence();
   if (H5Fis_hdf5(path.c_str()) <= 0)
     throw InputError(label + " '" + path + "' is not an HDF5 file (expected one written by " + expected_writer + ")");
+  // Without checksums (superblock versions 0 and 1) a damaged file reaches
+  // libhdf5's parsers unchecked; contactrom writes version 2.
+  const int version = superblock_version(path);
+  if (version < 2)
+    throw InputError(label + " '" + path + "' has HDF5 superblock version " + std::to_string(version) +
+                     " (no metadata checksums), expected 2 or later as written by " + expected_writer +
+                     "; write it again with " + expected_writer);
   const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (file < 0) throw InputError(label + " '" + path + "' is truncated or corrupt (HDF5 cannot open it)");
   return file;

@@ -112,7 +112,8 @@ void write_dataset(hid_t file, hid_t dcpl, const char* name, hid_t file_type, hi
 
 /// \brief Creates an HDF5 file in memory (core driver, no backing store) with the
 /// file-creation properties `fcpl`: HDF5 never touches the disk, so a full disk
-/// or a failing device cannot leave a half-closed file inside the library.
+/// or a failing device cannot leave a half-closed file inside the library. The
+/// file has HDF5's 1.8 format (superblock version 2, checksummed object headers).
 /// Write it out with file_image() and fom/atomic_file.
 /// \param label name of the file in HDF5's error messages
 hid_t create_memory_file(const std::string& label, hid_t fcpl);
@@ -135,7 +136,9 @@ std::vector<std::string> read_string_list(hid_t loc, const char* name, std::uint
 void write_file(const std::string& path, const std::function<void(hid_t file, hid_t dcpl)>& fill);
 
 /// \brief Opens an existing HDF5 file read-only after checking that it exists, is
-/// not a folder and is HDF5. \param label what the file is ("database",
+/// not a folder, is HDF5 and has a superblock of version 2 or later (the format
+/// create_memory_file() writes: metadata with checksums, so libhdf5 refuses a
+/// damaged object header instead of parsing it). \param label what the file is ("database",
 /// "reduced model"), for the messages, e.g. "reduced model 'x.h5' not found".
 /// \throws InputError (one line naming `path`).
 hid_t open_file(const std::string& path, const std::string& label, const std::string& expected_writer);

@@ -2,7 +2,7 @@
 """Regenerate the greedy active-set studies of the paper with the contactrom CLI.
 
     tools/experiments.py [--exe PATH] [--out RESULTS_DIR] [--figures DIR] [--quick]
-                         [--only hertz|ironing|ironing2[,...]] [--threads T]
+                         [--only hertz|ironing|ironing2[,...]] [--threads T] [--replot]
 
 Stages (each builds every snapshot database once and reuses it for all δ):
 
@@ -24,6 +24,9 @@ timings.csv and summary.md (markdown tables); the PNG figures go to --figures
 (default docs/figures, or RESULTS_DIR/figures with --quick so that a smoke run
 never overwrites the committed figures).
 
+--replot runs nothing and redraws the hertz and ironing figures (all but the
+reconstructions, which need the CLI) from the results of an earlier run in RESULTS_DIR.
+
 --quick is a smoke mode (≈ 25 s on 2 busy cores; the full run ≈ 3 min): hertz
 12/30, ironing levels 3/4, ironing2 level 2, δ = 1e-8 only; every code path
 (tables, all figures) runs. Nothing is added to ctest.
@@ -32,7 +35,6 @@ Use /usr/bin/python3 (numpy, h5py, matplotlib from Debian).
 """
 import argparse
 import csv
-import datetime
 import json
 import os
 import platform
@@ -46,6 +48,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter  # noqa: E402
 import numpy as np  # noqa: E402
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -229,92 +233,97 @@ def save_figure(fig, path):
 
 
 def evolution_figure(records, deltas, xlabel, path, n_contact, title, fom_time=None):
-    """(a) mean errors (bars) + primal rank (lines, right axis), (b) iterations,
-    (c) total time, (d) time per iteration, all vs training set."""
+    """Six small panels against the number of snapshots (log axis), one line per δ:
+    (a) mean primal error, (b) mean dual error, (c) primal rank, (d) mean iterations,
+    (e) time per query (median solid, mean dotted: a query slowed by another job moves
+    the mean only; the FOM solve as a reference line), (f) time per iteration, the same.
+    A grey line marks as many snapshots as contact dofs."""
     ns = sorted({r["n"] for r in records})
     get = {(r["n"], r["delta"]): r for r in records}
-    fig = plt.figure(figsize=(11, 7.2))
-    gs = fig.add_gridspec(2, 3, height_ratios=[1.15, 1])
-    ax = fig.add_subplot(gs[0, :])
-    x = np.arange(len(ns))
-    nb = 2 * len(deltas)
-    w = 0.8 / nb
-    for k, delta in enumerate(deltas):
-        c = DELTA_COLORS.get(delta, None)
-        for j, (key, hatch, lab) in enumerate([("mean_primal_error", "", "primal"), ("mean_dual_error", "//", "dual")]):
-            vals = [get[(n, delta)][key] for n in ns]
-            ax.bar(x + (2 * k + j - nb / 2 + 0.5) * w, vals, w, color=c, hatch=hatch, edgecolor="k", linewidth=0.4,
-                   label=f"{lab}, δ={delta:.0e}")
-    ax.set_yscale("log")
-    ax.set_xticks(x)
     snaps = [get[(n, deltas[0])]["snapshots"] for n in ns]
-    ax.set_xticklabels([(f"{n}" if xlabel.startswith("training") else f"{n} ({s})") +
-                        (" +" if s > n_contact else "") for n, s in zip(ns, snaps)])
-    ax.set_xlabel(xlabel + (f"   (+: more snapshots than the {n_contact} contact dofs)"
-                            if any(s > n_contact for s in snaps) else ""))
-    ax.set_ylabel("mean relative error")
-    ax2 = ax.twinx()
-    for delta in deltas:
-        ax2.plot(x, [get[(n, delta)]["primal_rank"] for n in ns], "o-", color=DELTA_COLORS.get(delta), lw=1.5,
-                 label=f"rank, δ={delta:.0e}")
-    ax2.set_ylabel("primal rank")
-    ax2.set_ylim(bottom=0)
-    h1, l1 = ax.get_legend_handles_labels()
-    h2, l2 = ax2.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, fontsize=7, ncol=1, loc="upper left", bbox_to_anchor=(1.07, 1.0))
-    ax.set_title(f"(a) {title}: mean errors (bars) and primal rank (lines)", fontsize=10)
-    panels = [("mean_iterations", 1.0, "(b) mean iterations", None),
-              ("mean_time_s", 1e6, "(c) mean time per query (µs)", "median_time_s"),
-              ("mean_time_per_iteration_s", 1e6, "(d) mean time per iteration (µs)", "median_time_per_iteration_s")]
-    for col, (key, scale, ttl, key2) in enumerate(panels):
-        a = fig.add_subplot(gs[1, col])
+    panels = [("mean_primal_error", 1.0, None, "(a) mean primal error", "relative H¹ error", True),
+              ("mean_dual_error", 1.0, None, "(b) mean dual error", "relative L² error", True),
+              ("primal_rank", 1.0, None, "(c) primal rank", "POD modes", False),
+              ("mean_iterations", 1.0, None, "(d) iterations per query", "mean iterations", False),
+              ("median_time_s", 1e6, "mean_time_s", "(e) time per query", "time (µs)", True),
+              ("median_time_per_iteration_s", 1e6, "mean_time_per_iteration_s", "(f) time per iteration",
+               "time (µs)", True)]
+    fig, axes = plt.subplots(2, 3, figsize=(11, 6.4))
+    for a, (key, scale, key2, ttl, ylabel, logy) in zip(axes.flat, panels):
         for delta in deltas:
             c = DELTA_COLORS.get(delta)
-            a.plot(ns, [scale * get[(n, delta)][key] for n in ns], "o-", color=c, label=f"δ={delta:.0e}")
+            a.plot(snaps, [scale * get[(n, delta)][key] for n in ns], "o-", color=c)
             if key2:
-                a.plot(ns, [scale * get[(n, delta)][key2] for n in ns], "s:", color=c, ms=3,
-                       label=f"median, δ={delta:.0e}")
-        if xlabel.startswith("training"):
-            a.set_xscale("log")
-            a.set_xticks(ns)
-            a.set_xticklabels([str(n) for n in ns])
-            a.minorticks_off()
+                a.plot(snaps, [scale * get[(n, delta)][key2] for n in ns], "s:", color=c, ms=3)
+        if key == "median_time_s" and fom_time:
+            a.axhline(1e6 * fom_time, color="k", ls="--", lw=1.2)
+        if n_contact <= max(snaps):
+            a.axvline(n_contact, color="0.6", ls="-.", lw=1)
+        a.set_xscale("log")
+        a.set_xticks(snaps)
+        a.set_xticklabels([f"{s}\n(L{n})" if "level" in xlabel else str(s) for n, s in zip(ns, snaps)])
+        a.minorticks_off()
+        if logy:
+            a.set_yscale("log")
+            if key2:  # times: label 1, 2, 5 × 10^k, since they span few decades
+                a.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+                a.yaxis.set_major_formatter(FormatStrFormatter("%g"))
+                a.yaxis.set_minor_formatter(NullFormatter())
         else:
-            a.set_xticks(ns)
-        a.set_xlabel(xlabel.split(" (")[0])
-        a.set_title(ttl + (f"\nFOM (offline mean) ≈ {1e6 * fom_time:.0f} µs" if key == "mean_time_s" and fom_time else ""), fontsize=9)
+            a.set_ylim(bottom=0)
+        a.set_title(ttl, fontsize=10)
+        a.set_ylabel(ylabel)
         a.grid(alpha=0.3)
-        a.set_ylim(bottom=0)
-        a.legend(fontsize=6)
-    save_figure(fig, path)
+    for a in axes[1]:
+        a.set_xlabel(xlabel)
+    handles = [Line2D([], [], color=DELTA_COLORS.get(d), marker="o", label=f"δ = {d:.0e}") for d in deltas]
+    handles.append(Line2D([], [], color="0.3", ls="-", label="mean (a–d), median (e, f)"))
+    handles.append(Line2D([], [], color="0.3", marker="s", ms=3, ls=":", label="mean (e, f)"))
+    if fom_time:
+        handles.append(Line2D([], [], color="k", ls="--", label=f"FOM solve, offline-stage mean ({1e6 * fom_time:.0f} µs)"))
+    if n_contact <= max(snaps):
+        handles.append(Line2D([], [], color="0.6", ls="-.", label=f"snapshots = contact dofs ({n_contact})"))
+    fig.suptitle(f"{title}: greedy ROM against the training set", fontsize=11)
+    fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
 
 
 def error_curves_figure(rows, ns, deltas, path):
     """Per-parameter errors over the validation set: one row of subplots per δ
-    (primal left, dual right), one curve per training size, x where not converged."""
-    fig, axes = plt.subplots(len(deltas), 2, figsize=(9, 2.5 * len(deltas)), squeeze=False, sharex=True)
+    (primal left, dual right), one curve per training size, × where not converged."""
+    fig, axes = plt.subplots(len(deltas), 2, figsize=(9, 2.5 * len(deltas) + 0.5), squeeze=False, sharex=True)
     colors = plt.cm.viridis(np.linspace(0, 0.85, len(ns)))
+    any_bad = False
     for i, delta in enumerate(deltas):
-        for j, (key, name) in enumerate([("primal", "primal H¹ error"), ("dual", "dual L² error")]):
+        for j, (key, name, unit) in enumerate([("primal", "primal error", "relative H¹ error"),
+                                               ("dual", "dual error", "relative L² error")]):
             a = axes[i, j]
             for n, c in zip(ns, colors):
                 rw = rows[(n, delta)]
                 d = np.array([r["params"][0] for r in rw])
                 e = np.array([r[key] for r in rw])
-                a.semilogy(d, e, "-", color=c, lw=1, label=f"{n} snapshots")
+                a.semilogy(d, e, "-", color=c, lw=1)
                 bad = np.array([not r["converged"] for r in rw])
                 if bad.any():
+                    any_bad = True
                     a.semilogy(d[bad], e[bad], "x", color=c, ms=7, mew=1.5)
-            a.set_title(f"{name}, δ={delta:.0e}", fontsize=9)
+            a.set_title(f"{name}, δ = {delta:.0e}", fontsize=9)
+            a.set_ylabel(unit, fontsize=8)
             a.grid(alpha=0.3)
             if i == len(deltas) - 1:
-                a.set_xlabel("d")
-            if i == 0 and j == 0:
-                a.legend(fontsize=7, title="× = not converged", title_fontsize=7)
-    save_figure(fig, path)
+                a.set_xlabel("prescribed displacement d (cylinder radii)")
+    handles = [Line2D([], [], color=c, lw=1, label=f"{n} snapshots") for n, c in zip(ns, colors)]
+    if any_bad:
+        handles.append(Line2D([], [], color="k", marker="x", ls="", ms=7, mew=1.5, label="not converged"))
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
 
 
-def sparsity_figure(rw, db, path, title):
+def sparsity_figure(rw, db, path, title, param_name):
     """Rows = validation parameters, dots at the selected dictionary columns."""
     with h5py.File(db, "r") as f:
         params = np.array(f["parameters"])
@@ -325,8 +334,8 @@ def sparsity_figure(rw, db, path, title):
             a.plot(r["selected"], [i] * len(r["selected"]), "k.", ms=3 if len(rw) < 150 else 2)
     a.set_xlim(-0.5, nsnap - 0.5)
     a.set_ylim(len(rw) - 0.5, -0.5)
-    a.set_xlabel(f"dictionary column (snapshot index, increasing {'d' if params.shape[1] == 1 else 'parameter'})")
-    a.set_ylabel(f"validation parameter index ({len(rw)} queries, increasing)")
+    a.set_xlabel(f"selected dictionary column (snapshot index, in increasing {param_name})")
+    a.set_ylabel(f"validation query ({len(rw)}, in increasing {param_name})")
     a.set_title(title, fontsize=9)
     a.grid(alpha=0.2)
     save_figure(fig, path)
@@ -337,8 +346,8 @@ def spy_figure(db, path, title):
         dual = np.array(f["dual"])  # n_snap x n_c
     fig, a = plt.subplots(figsize=(4, 5.5))
     a.spy(dual.T, markersize=2.5, aspect="auto", precision=0.0)
-    a.set_xlabel(f"dictionary column ({dual.shape[0]} snapshots, increasing d)")
-    a.set_ylabel(f"contact dof ({dual.shape[1]})")
+    a.set_xlabel(f"dictionary column (snapshot index, {dual.shape[0]}, in increasing d)")
+    a.set_ylabel(f"contact dof (slave node index, {dual.shape[1]})")
     a.xaxis.set_ticks_position("bottom")
     a.xaxis.set_label_position("bottom")
     a.set_title(title, fontsize=9)
@@ -375,8 +384,8 @@ def reconstruction_figure(examples, db, path):
             lo, hi = x[support].min(), x[support].max()
             pad = 0.3 * (hi - lo) + 0.02
             a.set_xlim(lo - pad, hi + pad)
-        a.set_xlabel("x (slave surface node)")
-        a.set_ylabel("contact pressure")
+        a.set_xlabel("x of the slave surface node (cylinder radii)")
+        a.set_ylabel("contact pressure λ (units of E)")
         js = ex["json"]
         a.set_title(f"d = {ex['param']}, {js['dictionary_size']} snapshots, δ={js['delta']:.0e}\n"
                     f"dual error {js['dual_error']:.1e}, primal error {js['primal_error']:.1e}, "
@@ -389,23 +398,58 @@ def reconstruction_figure(examples, db, path):
 # ----------------------------------------------------------------------------- stages
 
 
+def contact_dofs(db):
+    with h5py.File(db, "r") as f:
+        return f["dual"].shape[1]
+
+
+def hertz_figures(cfg, records, rows, dbs):
+    """The Hertz figures drawn from the study's results (all but the reconstructions)."""
+    sizes, deltas, fig = sorted(dbs), sorted({r["delta"] for r in records}, reverse=True), cfg["figures"]
+    fom_time = float(np.mean([r["mean_fom_time_s"] for r in records]))
+    evolution_figure(records, deltas, "training snapshots", os.path.join(fig, "hertz_evolution.png"),
+                     contact_dofs(dbs[sizes[0]]), "Hertz", fom_time)
+    error_curves_figure(rows, sizes, deltas, os.path.join(fig, "hertz_error_curves.png"))
+    n_sp = 30 if 30 in sizes else sizes[0]
+    d_sp = 1e-8 if 1e-8 in deltas else deltas[0]
+    sparsity_figure(rows[(n_sp, d_sp)], dbs[n_sp], os.path.join(fig, "hertz_sparsity_train30.png"),
+                    f"Hertz: snapshots selected by the greedy, {n_sp} snapshots, δ = {d_sp:.0e}", "d")
+    spy_figure(dbs[n_sp], os.path.join(fig, "hertz_dictionary_spy.png"), f"Hertz dual dictionary, {n_sp} snapshots")
+
+
+def ironing_figures(cfg, records, rows, dbs):
+    """The ironing figures drawn from the study's results."""
+    levels, deltas, fig = sorted(dbs), sorted({r["delta"] for r in records}, reverse=True), cfg["figures"]
+    fom_time = float(np.mean([r["mean_fom_time_s"] for r in records]))
+    evolution_figure(records, deltas, "training snapshots (nested level L)", os.path.join(fig, "ironing_evolution.png"),
+                     contact_dofs(dbs[levels[0]]), "Ironing", fom_time)
+    lv = 5 if 5 in levels else levels[-1]
+    d_sp = 1e-8 if 1e-8 in deltas else deltas[0]
+    sparsity_figure(rows[(lv, d_sp)], dbs[lv], os.path.join(fig, "ironing_sparsity_level5.png"),
+                    f"Ironing: snapshots selected by the greedy, level {lv}, δ = {d_sp:.0e}", "d_x")
+
+
+def load_study(outdir, problem, kind):
+    """The records, rows and databases a run of `run_study` left in `outdir` (for --replot)."""
+    path = os.path.join(outdir, f"{problem}_summary.csv")
+    if not os.path.exists(path):
+        sys.exit(f"experiments.py --replot: {path} is missing; run the {problem} stage first")
+    integers = {"n", "snapshots", "primal_rank", "validation_size", "nonconverged"}
+    with open(path, newline="") as f:
+        records = [{k: (v if k in {"problem", "kind", "statuses"} else int(v) if k in integers else float(v))
+                    for k, v in r.items()} for r in csv.DictReader(f)]
+    rows = {(r["n"], r["delta"]): read_rows(os.path.join(outdir, problem, f"{kind}{r['n']}_delta{dtag(r['delta'])}.csv"))
+            for r in records}
+    dbs = {r["n"]: os.path.join(outdir, "db", f"{problem}_{kind}{r['n']}.h5") for r in records}
+    return records, rows, dbs
+
+
 def stage_hertz(runner, cfg, timings, md):
     sizes, deltas = cfg["hertz_sizes"], cfg["deltas"]
     records, rows, dbs = run_study(runner, cfg["out"], "hertz", "train", sizes, deltas, timings)
     t = time.time()
     fig = cfg["figures"]
-    with h5py.File(dbs[sizes[0]], "r") as f:
-        n_contact = f["dual"].shape[1]
-    fom_time = float(np.mean([r["mean_fom_time_s"] for r in records]))
-    evolution_figure(records, deltas, "training set size", os.path.join(fig, "hertz_evolution.png"), n_contact,
-                     "Hertz", fom_time)
-    error_curves_figure(rows, sizes, deltas, os.path.join(fig, "hertz_error_curves.png"))
-    n_sp = 30 if 30 in sizes else sizes[0]
-    d_sp = 1e-8 if 1e-8 in deltas else deltas[0]
-    sparsity_figure(rows[(n_sp, d_sp)], dbs[n_sp], os.path.join(fig, "hertz_sparsity_train30.png"),
-                    f"Hertz: snapshots selected by greedy, {n_sp} snapshots, δ={d_sp:.0e}")
-    spy_figure(dbs[n_sp], os.path.join(fig, "hertz_dictionary_spy.png"),
-               f"Hertz dual dictionary, {n_sp} snapshots")
+    hertz_figures(cfg, records, rows, dbs)
     # Reconstruction examples, 12 snapshots, as in the paper.
     n_rec = 12 if 12 in sizes else sizes[0]
     d_rec = 1e-10 if 1e-10 in deltas else deltas[-1]
@@ -437,16 +481,7 @@ def stage_ironing(runner, cfg, timings, md):
     levels, deltas = cfg["ironing_levels"], cfg["deltas"]
     records, rows, dbs = run_study(runner, cfg["out"], "ironing", "level", levels, deltas, timings)
     t = time.time()
-    fig = cfg["figures"]
-    with h5py.File(dbs[levels[0]], "r") as f:
-        n_contact = f["dual"].shape[1]
-    fom_time = float(np.mean([r["mean_fom_time_s"] for r in records]))
-    evolution_figure(records, deltas, "nested level (snapshots)", os.path.join(fig, "ironing_evolution.png"),
-                     n_contact, "Ironing", fom_time)
-    lv = 5 if 5 in levels else levels[-1]
-    d_sp = 1e-8 if 1e-8 in deltas else deltas[0]
-    sparsity_figure(rows[(lv, d_sp)], dbs[lv], os.path.join(fig, "ironing_sparsity_level5.png"),
-                    f"Ironing: snapshots selected by greedy, level {lv}, δ={d_sp:.0e}")
+    ironing_figures(cfg, records, rows, dbs)
     timings.append(("ironing figures", time.time() - t))
     md.append("### Ironing (nested levels " + "/".join(map(str, levels)) + ")\n\n"
               + markdown_summary(records, "level") + "\n")
@@ -525,6 +560,18 @@ def stage_comparison(runner, cfg, dbs, timings, md):
 # ----------------------------------------------------------------------------- main
 
 
+def cpu_model():
+    """The processor's model name as `lscpu` prints it (platform.processor() when lscpu is missing)."""
+    try:
+        out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
+    except OSError:
+        out = ""
+    for line in out.splitlines():
+        if line.startswith("Model name:"):
+            return line.split(":", 1)[1].strip()
+    return platform.processor() or "unknown processor"
+
+
 def find_exe(given):
     if given:
         return given
@@ -542,6 +589,9 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="fast smoke mode (few training sets, δ=1e-8 only)")
     ap.add_argument("--only", help="comma-separated subset of hertz,ironing,ironing2")
     ap.add_argument("--threads", type=int, default=os.cpu_count() or 1, help="threads for offline/FOM references")
+    ap.add_argument("--replot", action="store_true",
+                    help="run nothing: redraw the hertz and ironing figures (all but the reconstructions) from the "
+                         "results of an earlier run in RESULTS_DIR")
     args = ap.parse_args(argv)
 
     stages = ["hertz", "ironing", "ironing2"]
@@ -562,8 +612,13 @@ def main(argv=None):
         cfg = {"deltas": DELTAS, "hertz_sizes": [12, 30, 60, 120], "ironing_levels": [3, 4, 5, 6, 7],
                "ironing2_levels": [2, 3, 4, 5]}
     cfg.update(out=out, figures=figures)
+    if args.replot:
+        for stage, kind, draw in [("hertz", "train", hertz_figures), ("ironing", "level", ironing_figures)]:
+            if stage in stages:
+                draw(cfg, *load_study(out, stage, kind))
+        log(f"figures redrawn from {out} in {figures}")
+        return
     runner = Runner(exe, args.threads)
-    load_start = os.getloadavg()[0]
     log(f"contactrom: {exe}; results -> {out}; figures -> {figures}; stages {stages}; "
         f"{'quick' if args.quick else 'full'} mode; {args.threads} threads")
 
@@ -585,12 +640,9 @@ def main(argv=None):
         for name, sec in timings:
             w.writerow([name, f"{sec:.3f}"])
     version = subprocess.run([exe, "--version"], capture_output=True, text=True).stdout.strip()
-    header = (f"Generated {datetime.datetime.now().isoformat(timespec='seconds')} by "
-              f"`{' '.join(['tools/experiments.py'] + (argv if argv is not None else sys.argv[1:]))}` "
-              f"with {version or exe} on {platform.node()} ({os.cpu_count()} cores, {platform.platform()}); "
-              f"total {total:.1f} s; 1-min load average {load_start:.1f} at the start, "
-              f"{os.getloadavg()[0]:.1f} at the end (other processes share the cores: timings are noisy, "
-              f"the medians are the robust figure).\n\n")
+    header = (f"Generated by `{' '.join(['tools/experiments.py'] + (argv if argv is not None else sys.argv[1:]))}` "
+              f"with {version or exe} on {cpu_model()} ({os.cpu_count()} cores); total {total:.1f} s. "
+              f"Times are per query, on a machine shared with other jobs: the medians are the robust figure.\n\n")
     stage_times = "| stage | seconds |\n|---|---:|\n" + "".join(
         f"| {n} | {s:.1f} |\n" for n, s in timings if n.startswith("stage") or n in {"total", "comparison"})
     with open(os.path.join(out, "summary.md"), "w") as f:

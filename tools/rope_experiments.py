@@ -66,8 +66,8 @@ def column(rows, key, kind=float):
 def plot_chls(rows, path):
     fig, ax = plt.subplots(figsize=(5, 3.5))
     ax.semilogy(column(rows, "gamma"), column(rows, "chls_error"), "o-")
-    ax.set_xlabel(r"$\gamma$")
-    ax.set_ylabel(r"$\epsilon_{\mathtt{CHLS}}$")
+    ax.set_xlabel(r"stiffness $\nu = \gamma$ of the left half")
+    ax.set_ylabel(r"CHLS distance $\epsilon_{\mathtt{CHLS}}$ (relative)")
     ax.set_title("Leave-one-out convex hull least squares (rope)")
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
@@ -83,7 +83,7 @@ def plot_errors(training, validation, path):
         for rows, style, label in ((training, "o", "training"), (validation, "s", "validation")):
             ax.semilogy(column(rows, "gamma"), [max(v, floor) for v in column(rows, key)], style,
                         label=label + " error")
-        ax.set_xlabel(r"$\gamma$")
+        ax.set_xlabel(r"stiffness $\nu = \gamma$ of the left half")
         ax.set_ylabel("relative error")
         ax.set_title(title)
         ax.grid(True, which="both", alpha=0.3)
@@ -91,13 +91,14 @@ def plot_errors(training, validation, path):
         for rows, colour, label in ((training, "C0", "training"), (validation, "C1", "validation")):
             right.plot(column(rows, "gamma"), column(rows, "sparsity", int), "x", color=colour, ms=8,
                        label=label + " sparsity")
-        right.set_ylabel("sparsity")
+        right.set_ylabel("sparsity (selected snapshots)")
         right.set_ylim(0, 5)
         lines = ax.get_legend_handles_labels()
         rlines = right.get_legend_handles_labels()
-        ax.legend(lines[0] + rlines[0], lines[1] + rlines[1], fontsize=7, loc="center right")
-    fig.suptitle(r"Convex hull reconstruction, rope, $\mathbf{B} = \mathrm{svd}(D_p, \delta)$")
-    fig.tight_layout()
+    fig.suptitle(r"Convex hull reconstruction, rope, $\mathbf{B} = \mathrm{svd}(D_p, \delta)$"
+                 "\n(errors of exactly 0 drawn at 1e-17)", fontsize=10)
+    fig.legend(lines[0] + rlines[0], lines[1] + rlines[1], fontsize=8, loc="lower center", ncol=4, frameon=False)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
     fig.savefig(path, dpi=150)
     plt.close(fig)
 

@@ -1,0 +1,123 @@
+// docs/cli.md stays in step with the program: every subcommand that `contactrom --help`
+// lists has a section `## \`name\`` in docs/cli.md, every option its `--help` prints
+// appears in that section, and every online method and method setting of the
+// `--option KEY=VALUE` list appears in the section "Online methods and their settings".
+#define BOOST_TEST_MODULE cli_reference
+#include <boost/test/unit_test.hpp>
+
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/run_command.hpp"
+
+using contactrom::test::run_command;
+using contactrom::test::slurp;
+
+namespace {
+
+const std::string exe = CONTACTROM_EXE;
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+/// The lines of `text` after the line `header` up to the next line that starts
+/// without indentation (CLI11's sections: "Options:", "Subcommands:", ...).
+std::vector<std::string> section_lines(const std::string& text, const std::string& header) {
+  std::vector<std::string> out;
+  bool inside = false;
+  for (const std::string& line : lines_of(text)) {
+    if (line == header) {
+      inside = true;
+      continue;
+    }
+    if (inside && !line.empty() && line[0] != ' ') break;
+    if (inside && !line.empty()) out.push_back(line);
+  }
+  return out;
+}
+
+/// The subcommands `contactrom --help` lists.
+std::vector<std::string> subcommands() {
+  const auto r = run_command(exe + " --help");
+  BOOST_REQUIRE_EQUAL(r.exit_code, 0);
+  std::vector<std::string> names;
+  const std::regex entry(R"(^  ([a-z][a-z-]*)\s)");
+  for (const std::string& line : section_lines(r.out, "Subcommands:")) {
+    std::smatch m;
+    if (std::regex_search(line, m, entry)) names.push_back(m[1]);
+  }
+  return names;
+}
+
+/// The long options a subcommand's `--help` prints under "Options:" (help itself left out).
+std::set<std::string> options_of(const std::string& command) {
+  const auto r = run_command(exe + " " + command + " --help");
+  BOOST_REQUIRE_MESSAGE(r.exit_code == 0, command + " --help exited with " + std::to_string(r.exit_code));
+  std::set<std::string> options;
+  const std::regex option(R"(^\s+(?:-[a-zA-Z],)?(--[a-z][a-z-]*))");
+  for (const std::string& line : section_lines(r.out, "Options:")) {
+    std::smatch m;
+    if (std::regex_search(line, m, option) && m[1] != "--help") options.insert(m[1]);
+  }
+  return options;
+}
+
+/// The text of docs/cli.md from the heading `heading` to the next heading of the same level.
+std::string doc_section(const std::string& doc, const std::string& heading) {
+  const std::size_t begin = doc.find("\n" + heading + "\n");
+  if (begin == std::string::npos) return "";
+  const std::size_t level = heading.find(' ');
+  const std::size_t end = doc.find("\n" + heading.substr(0, level + 1), begin + heading.size() + 1);
+  return doc.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+}
+
+const std::string& cli_doc() {
+  static const std::string doc = slurp(std::string(CONTACTROM_SOURCE_DIR) + "/docs/cli.md");
+  return doc;
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(every_subcommand_and_option_of_the_help_is_in_the_reference) {
+  BOOST_REQUIRE_MESSAGE(!cli_doc().empty(), "docs/cli.md is missing or empty");
+  const std::vector<std::string> names = subcommands();
+  BOOST_TEST(names.size() >= 10u, "contactrom --help lists " << names.size() << " subcommands");
+  for (const std::string& name : names) {
+    const std::string section = doc_section(cli_doc(), "## `" + name + "`");
+    BOOST_TEST(!section.empty(), "docs/cli.md has no section '## `" << name << "`'");
+    if (section.empty()) continue;
+    for (const std::string& option : options_of(name))
+      BOOST_TEST(section.find("`" + option) != std::string::npos,
+                 "docs/cli.md, section " << name << ": option " << option << " is not documented");
+  }
+}
+
+BOOST_AUTO_TEST_CASE(every_online_method_and_setting_of_the_help_is_in_the_reference) {
+  const auto r = run_command(exe + " online --help");
+  BOOST_REQUIRE_EQUAL(r.exit_code, 0);
+  const std::string section = doc_section(cli_doc(), "## Online methods and their settings");
+  BOOST_REQUIRE_MESSAGE(!section.empty(), "docs/cli.md has no section '## Online methods and their settings'");
+  const std::regex method(R"(^  ([a-z][a-z-]*): )"), key(R"(^    ([a-z_]+): )");
+  int methods = 0, keys = 0;
+  for (const std::string& line : section_lines(r.out, "Online methods and their options (--option KEY=VALUE):")) {
+    std::smatch m;
+    if (std::regex_search(line, m, method)) {
+      ++methods;
+      BOOST_TEST(section.find("### `" + m[1].str() + "`") != std::string::npos,
+                 "docs/cli.md: method " << m[1] << " has no heading");
+    } else if (std::regex_search(line, m, key)) {
+      ++keys;
+      BOOST_TEST(section.find("`" + m[1].str() + "`") != std::string::npos,
+                 "docs/cli.md: method setting " << m[1] << " is not documented");
+    }
+  }
+  BOOST_TEST(methods >= 4, "online --help lists " << methods << " methods");
+  BOOST_TEST(keys >= 20, "online --help lists " << keys << " method settings");
+}

@@ -1,0 +1,100 @@
+// What a new user meets first: every command is documented in the README, every
+// help text lists its choices instead of pointing into the sources, the bench
+// table keeps each name apart from its value, and a training size a problem
+// cannot honour is refused rather than silently replaced.
+#define BOOST_TEST_MODULE cli_first_use
+#include <boost/test/unit_test.hpp>
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/run_command.hpp"
+
+using contactrom::test::run_command;
+using contactrom::test::slurp;
+
+namespace {
+
+const std::string kExe = CONTACTROM_EXE;
+
+/// The subcommands listed by `contactrom --help` (lines "  name   description").
+std::vector<std::string> subcommands() {
+  const auto r = run_command(kExe + " --help");
+  BOOST_REQUIRE_EQUAL(r.exit_code, 0);
+  std::vector<std::string> names;
+  std::istringstream in(r.out);
+  bool listing = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("Subcommands:", 0) == 0) {
+      listing = true;
+      continue;
+    }
+    std::smatch m;
+    if (listing && std::regex_match(line, m, std::regex("  ([a-z][a-z-]*) .*"))) names.push_back(m[1]);
+  }
+  return names;
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(every_subcommand_is_listed) {
+  const auto names = subcommands();
+  // The ones a user of the method needs at least; the README test below covers all.
+  for (const char* expected : {"fom", "offline", "online", "reduce", "query", "bench", "hull-report", "sparse"})
+    BOOST_TEST((std::find(names.begin(), names.end(), expected) != names.end()), expected);
+}
+
+BOOST_AUTO_TEST_CASE(readme_documents_every_subcommand) {
+  const std::string readme = slurp(std::string(CONTACTROM_SOURCE_DIR) + "/README.md");
+  BOOST_REQUIRE(!readme.empty());
+  for (const auto& name : subcommands())
+    BOOST_TEST(std::regex_search(readme, std::regex("contactrom +" + name + "( |\n)")),
+               "README.md does not show the subcommand " << name);
+}
+
+BOOST_AUTO_TEST_CASE(help_texts_list_choices_instead_of_pointing_elsewhere) {
+  // A help text that says "see the error text" or names a source file leaves the
+  // user without the list of valid values.
+  const std::regex pointer("see the error|see (rom|fom|baselines|tools)/|\\.(hpp|cpp)\\b");
+  for (const auto& name : subcommands()) {
+    const auto r = run_command(kExe + " " + name + " --help");
+    BOOST_TEST(r.exit_code == 0, name);
+    BOOST_TEST(!std::regex_search(r.out, pointer), name << " --help points elsewhere:\n" << r.out);
+  }
+}
+
+BOOST_AUTO_TEST_CASE(bench_table_keeps_names_and_values_apart) {
+  const auto r = run_command(kExe + " bench --problem rope --repeats 1 --ipopt-queries 1");
+  BOOST_REQUIRE_EQUAL(r.exit_code, 0);
+  std::istringstream in(r.out);
+  int rows = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("  ", 0) != 0) continue;  // headers ("ratios:") start in column 0
+    std::istringstream fields(line);
+    std::string name, value, extra;
+    fields >> name >> value;
+    BOOST_TEST(!(fields >> extra), "more than a name and a value: '" << line << "'");
+    char* end = nullptr;
+    std::strtod(value.c_str(), &end);
+    BOOST_TEST((!value.empty() && *end == '\0'), "no number after the name: '" << line << "'");
+    ++rows;
+  }
+  // Times of the FOM and of several ROMs plus their ratios.
+  BOOST_TEST(rows >= 10);
+}
+
+BOOST_AUTO_TEST_CASE(a_training_size_the_problem_cannot_honour_is_refused) {
+  // rope trains on its listed points: --train 30 must not make 9 snapshots and
+  // record 30.
+  const std::string out = "/tmp/contactrom_first_use_rope30.h5";
+  std::remove(out.c_str());
+  const auto r = run_command(kExe + " offline --problem rope --train 30 --out " + out);
+  BOOST_TEST(r.exit_code == 2);
+  BOOST_TEST(r.out.empty());
+  BOOST_TEST(r.err.find("--train") != std::string::npos, r.err);
+  BOOST_TEST(!std::ifstream(out).good(), "a database was written");
+}
