@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "rom/online_evaluation.hpp"
+#include "rom/online_timing.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::baselines {

@@ -37,7 +37,7 @@
 #include "baselines/reduced_active_set.hpp"
 #include "core/errors.hpp"
 #include "core/nnls.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_solver.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::baselines {

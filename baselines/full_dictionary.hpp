@@ -15,7 +15,7 @@
 #include <memory>
 
 #include "baselines/reduced_active_set.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_solver.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::baselines {

@@ -57,7 +57,7 @@
 
 #include "core/nnls.hpp"
 #include "rom/greedy_active_set.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_solver.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/support_rows.hpp"
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <ostream>
 
@@ -61,6 +62,17 @@ void solve_references(const Solver& solver, const fom::Problem& problem, const V
       [&](int done, int total) { report_progress(o, r.reference + " references", done, total); });
 }
 
+/// Errors by the rule of `online` (relative, or absolute against a near-zero
+/// reference); +infinity when verify_solution found the sizes inconsistent.
+fom::ReferenceErrors errors_against_reference(const fom::Problem& problem, const rom::OnlineResult& res,
+                                              const fom::FomSolution& ref, const VerificationReport& report) {
+  if (report.status != Status::Success || !report.has_reference) {
+    const double inf = std::numeric_limits<double>::infinity();
+    return {inf, inf, false};
+  }
+  return fom::reference_errors(problem, res.u, res.lambda, ref.u, ref.lambda);
+}
+
 MethodVerification verify_method(const rom::OnlineSolver& solver, const rom::OnlineSolverOptions& options,
                                  const VerifyOptions& o, const VerifyReport& r) {
   const fom::Problem& problem = solver.model().problem();
@@ -74,6 +86,8 @@ MethodVerification verify_method(const rom::OnlineSolver& solver, const rom::Onl
     VerifyRow& row = m.rows[i];
     row.report = verify_solution(problem, r.params[i], res.u, res.lambda, &r.references[i]);
     m.summary.add(row.report);
+    row.errors = errors_against_reference(problem, res, r.references[i], row.report);
+    m.errors.add_errors(row.errors);
     row.reduced_penetration = reduced_penetration(solver.model(), m.dual_columns, res.u);
     row.status = res.status;
     row.converged = res.converged;
@@ -91,24 +105,12 @@ MethodVerification verify_method(const rom::OnlineSolver& solver, const rom::Onl
   return m;
 }
 
-}  // namespace
-
-std::vector<fom::Param> subsample(const std::vector<fom::Param>& params, int n) {
-  if (n <= 0 || n >= static_cast<int>(params.size())) return params;
-  std::vector<fom::Param> out;
-  for (int i = 0; i < n; ++i) {
-    const size_t k = n == 1 ? 0 : static_cast<size_t>(std::llround(double(i) * (params.size() - 1) / (n - 1)));
-    out.push_back(params[k]);
-  }
-  return out;
-}
-
-VerifyReport verify(const rom::ReducedModel& model, const std::vector<fom::Param>& params, const VerifyOptions& o) {
+/// Every method's solver, refusing an unknown reference or method, a method named
+/// twice and settings a method refuses.
+std::vector<std::unique_ptr<rom::OnlineSolver>> build_solvers(const rom::ReducedModel& model, const VerifyOptions& o) {
   if (o.reference != "ipopt" && o.reference != "fom")
     throw InputError("reference solver '" + o.reference + "' unknown; expected ipopt or fom");
   if (o.methods.empty()) throw InputError("verify: no online method given; expected at least one");
-  const fom::Problem& problem = model.problem();
-  // Every solver is built (and its settings checked) before the reference solves.
   std::vector<std::unique_ptr<rom::OnlineSolver>> solvers;
   for (size_t s = 0; s < o.methods.size(); ++s) {
     for (size_t k = 0; k < s; ++k)
@@ -116,8 +118,12 @@ VerifyReport verify(const rom::ReducedModel& model, const std::vector<fom::Param
         throw InputError("online method '" + o.methods[s].name + "' named twice; expected each once");
     solvers.push_back(rom::make_online_solver(o.methods[s].name, model, o.methods[s].options));
   }
-  for (const fom::Param& mu : params) problem.check_param(mu);
+  return solvers;
+}
 
+/// The report with the reference solutions, their KKT residuals and wall time.
+VerifyReport reference_report(const fom::Problem& problem, const std::vector<fom::Param>& params,
+                              const VerifyOptions& o) {
   VerifyReport r;
   r.params = params;
   r.reference = o.reference;
@@ -135,28 +141,48 @@ VerifyReport verify(const rom::ReducedModel& model, const std::vector<fom::Param
   r.reference_summary = summarize(r.reference_reports);
   for (const fom::FomSolution& ref : r.references)
     if (ref.status != Status::Success) ++r.reference_failures;
+  return r;
+}
 
+/// Times the FOM and every method, plain and clocking its contact-operator
+/// construction (the paper's convention), in interleaved rounds.
+void time_methods(const rom::ReducedModel& model, const std::vector<std::unique_ptr<rom::OnlineSolver>>& solvers,
+                  const VerifyOptions& o, VerifyReport& r) {
+  std::vector<std::unique_ptr<rom::OnlineSolver>> owned;
+  std::vector<const rom::OnlineSolver*> plain, clocked;
+  for (size_t s = 0; s < solvers.size(); ++s) {
+    rom::OnlineSolverOptions clocked_options = o.methods[s].options;
+    clocked_options.time_operators = true;
+    owned.push_back(rom::make_online_solver(o.methods[s].name, model, clocked_options));
+    plain.push_back(solvers[s].get());
+    clocked.push_back(owned.back().get());
+  }
+  const fom::ActiveSetSolver fom_solver(model.problem());
+  const rom::InterleavedTiming t = rom::time_interleaved(fom_solver, plain, r.params, o.repeats, clocked);
+  r.fom_median_time_s = t.fom_median_s;
+  for (size_t s = 0; s < r.methods.size(); ++s) r.methods[s].timing = t.online[s];
+}
+
+}  // namespace
+
+std::vector<fom::Param> subsample(const std::vector<fom::Param>& params, int n) {
+  if (n <= 0 || n >= static_cast<int>(params.size())) return params;
+  std::vector<fom::Param> out;
+  for (int i = 0; i < n; ++i) {
+    const size_t k = n == 1 ? 0 : static_cast<size_t>(std::llround(double(i) * (params.size() - 1) / (n - 1)));
+    out.push_back(params[k]);
+  }
+  return out;
+}
+
+VerifyReport verify(const rom::ReducedModel& model, const std::vector<fom::Param>& params, const VerifyOptions& o) {
+  const auto solvers = build_solvers(model, o);  // settings checked before the reference solves
+  for (const fom::Param& mu : params) model.problem().check_param(mu);
+  VerifyReport r = reference_report(model.problem(), params, o);
   // Reduced solutions, sequentially per method (timings undisturbed); the residual
   // work after each solve does not enter the reported times.
   for (size_t s = 0; s < solvers.size(); ++s) r.methods.push_back(verify_method(*solvers[s], o.methods[s].options, o, r));
-
-  // Timing: the FOM and every method, plain and clocking its contact-operator
-  // construction (the paper's convention), in interleaved rounds.
-  if (o.bench) {
-    std::vector<std::unique_ptr<rom::OnlineSolver>> owned;
-    std::vector<const rom::OnlineSolver*> plain, clocked;
-    for (size_t s = 0; s < solvers.size(); ++s) {
-      rom::OnlineSolverOptions clocked_options = o.methods[s].options;
-      clocked_options.time_operators = true;
-      owned.push_back(rom::make_online_solver(o.methods[s].name, model, clocked_options));
-      plain.push_back(solvers[s].get());
-      clocked.push_back(owned.back().get());
-    }
-    const fom::ActiveSetSolver fom_solver(problem);
-    const rom::InterleavedTiming t = rom::time_interleaved(fom_solver, plain, params, o.repeats, clocked);
-    r.fom_median_time_s = t.fom_median_s;
-    for (size_t s = 0; s < r.methods.size(); ++s) r.methods[s].timing = t.online[s];
-  }
+  if (o.bench) time_methods(model, solvers, o, r);
   return r;
 }
 
@@ -164,7 +190,7 @@ void write_verify_csv(const std::string& path, const fom::Problem& problem, cons
   write_file_atomically(path, [&](std::ostream& out) {
     out << "method,";
     for (const std::string& name : problem.param_names()) out << name << ',';
-    out << "primal_h1_error,dual_l2_error,active_set_differences,stationarity,penetration,negative_pressure,"
+    out << "primal_error,dual_error,errors,active_set_differences,stationarity,penetration,negative_pressure,"
            "complementarity,reduced_penetration,tau,converged,status,iterations,sparsity,time_s\n";
     auto params_text = [&](size_t i) {
       std::string s;
@@ -177,16 +203,17 @@ void write_verify_csv(const std::string& path, const fom::Problem& problem, cons
     };
     for (size_t i = 0; i < r.params.size(); ++i) {
       const fom::FomSolution& ref = r.references[i];
-      out << r.reference << ',' << params_text(i) << "0,0,0," << kkt_text(r.reference_reports[i].kkt) << ",,,"
+      out << r.reference << ',' << params_text(i) << "0,0,relative,0," << kkt_text(r.reference_reports[i].kkt) << ",,,"
           << (ref.status == Status::Success ? 1 : 0) << ',' << to_string(ref.status) << ',' << ref.iterations << ','
           << ref.active << ',' << fom::format_number(ref.time_s) << '\n';
     }
     for (const MethodVerification& m : r.methods)
       for (size_t i = 0; i < r.params.size(); ++i) {
         const VerifyRow& row = m.rows[i];
-        const fom::SolutionErrors& e = row.report.errors;
-        out << m.name << ',' << params_text(i) << fom::format_number(e.primal_h1) << ',' << fom::format_number(e.dual_l2)
-            << ',' << e.active_set_differences << ',' << kkt_text(row.report.kkt) << ','
+        const fom::ReferenceErrors& e = row.errors;
+        out << m.name << ',' << params_text(i) << fom::format_number(e.primal) << ',' << fom::format_number(e.dual)
+            << ',' << (e.absolute ? "absolute" : "relative") << ',' << row.report.errors.active_set_differences << ','
+            << kkt_text(row.report.kkt) << ','
             << fom::format_number(row.reduced_penetration) << ',' << fom::format_number(m.tau) << ','
             << (row.converged ? 1 : 0) << ',' << to_string(row.status) << ',' << row.iterations << ','
             << row.sparsity << ',' << fom::format_number(row.time_s) << '\n';

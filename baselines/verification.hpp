@@ -30,6 +30,8 @@
 
 #include "baselines/kkt_verifier.hpp"
 #include "rom/online_evaluation.hpp"
+#include "rom/online_solver.hpp"
+#include "rom/online_timing.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::baselines {
@@ -60,6 +62,9 @@ struct VerifyOptions {
 /// \brief Per-parameter outcome of one method.
 struct VerifyRow {
   VerificationReport report;         ///< KKT residuals and errors against the reference
+  /// Errors against the reference: relative, or absolute where the reference
+  /// displacement is near zero (fom::reference_errors, the rule of `online`).
+  fom::ReferenceErrors errors;
   double reduced_penetration = 0.0;  ///< max over the dual columns of W_pᵀ(Cu − g)
   Status status = Status::Success;   ///< the online solve's status
   bool converged = false;            ///< the online solve's stopping criterion was met
@@ -76,6 +81,9 @@ struct MethodVerification {
   double tau = 0.0;                  ///< threshold τ of that constraint
   std::vector<VerifyRow> rows;       ///< one per parameter, in order
   VerificationSummary summary;       ///< maxima and means of the rows' reports
+  /// Means and maxima of the rows' `errors`: relative ones averaged, absolute ones
+  /// (near-zero reference) counted apart.
+  rom::ErrorStatistics errors;
   double max_reduced_penetration = -std::numeric_limits<double>::infinity();  ///< over the rows
   int reduced_violations = 0;        ///< rows whose reduced penetration exceeds τ + slack
   int nonconverged = 0;              ///< rows not converged or not Success
@@ -110,8 +118,8 @@ VerifyReport verify(const rom::ReducedModel& model, const std::vector<fom::Param
                     const VerifyOptions& options = {});
 
 /// \brief Writes the report as CSV (atomically): one row per reference solve, then
-/// one per method and parameter; columns method, the parameters,
-/// primal_h1_error, dual_l2_error, active_set_differences, the four KKT residuals,
+/// one per method and parameter; columns method, the parameters, primal_error,
+/// dual_error, errors (relative or absolute), active_set_differences, the four KKT residuals,
 /// reduced_penetration, tau, converged, status, iterations, sparsity, time_s.
 void write_verify_csv(const std::string& path, const fom::Problem& problem, const VerifyReport& report);
 

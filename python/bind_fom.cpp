@@ -61,15 +61,18 @@ FomResult finish(const fom::Problem& problem, fom::FomSolution solution) {
   return r;
 }
 
-py::dict report_dict(const baselines::VerificationReport& r) {
+/// `errors`: the errors against the reference by the rule of `online` (relative, or
+/// absolute where the reference displacement is near zero); null without a valid one.
+py::dict report_dict(const baselines::VerificationReport& r, const fom::ReferenceErrors* errors) {
   py::dict d;
   d["status"] = to_string(r.status);
   d["message"] = r.message;
   d["kkt"] = kkt_dict(r.kkt);
   if (r.has_reference) {
     py::dict e;
-    e["primal_h1"] = r.errors.primal_h1;
-    e["dual_l2"] = r.errors.dual_l2;
+    e["primal_error"] = errors ? errors->primal : r.errors.primal_h1;
+    e["dual_error"] = errors ? errors->dual : r.errors.dual_l2;
+    e["errors"] = errors && errors->absolute ? "absolute" : "relative";
     e["active_set_differences"] = r.errors.active_set_differences;
     d["errors"] = e;
   } else {
@@ -255,18 +258,23 @@ here when it does not depend on mu) or Ipopt (solver="ipopt").)doc")
         const fom::Param p = to_param(*problem, mu);
         check_sizes(*problem, u, lam);
         baselines::VerificationReport r;
+        fom::ReferenceErrors errors;
         {
           py::gil_scoped_release release;
           r = baselines::verify_solution(*problem, p, u, lam, reference ? &reference->solution : nullptr, degenerate_tol);
+          if (r.has_reference && r.status == Status::Success)
+            errors = fom::reference_errors(*problem, u, lam, reference->solution.u, reference->solution.lambda);
         }
-        return report_dict(r);
+        return report_dict(r, r.has_reference && r.status == Status::Success ? &errors : nullptr);
       },
       py::arg("problem"), py::arg("mu"), py::arg("u"), py::arg("lam"), py::arg("reference") = nullptr,
       py::arg("degenerate_tol") = 1e-8, R"doc(
 KKT verification of a candidate (u, lam) at mu: {'status', 'message', 'kkt': {...},
-'errors': {'primal_h1', 'dual_l2', 'active_set_differences'} or None}. The errors
-are computed against `reference` (a FomSolution, e.g. of FullOrderSolver(problem,
-solver="ipopt")) when one is given.)doc");
+'errors': {'primal_error', 'dual_error', 'errors', 'active_set_differences'} or None}.
+The errors are computed against `reference` (a FomSolution, e.g. of
+FullOrderSolver(problem, solver="ipopt")) when one is given: relative H1 and L2
+errors, or absolute ones where the reference displacement is near zero ('errors'
+says which: 'relative' or 'absolute', as `contactrom online`).)doc");
 }
 
 }  // namespace contactrom::python

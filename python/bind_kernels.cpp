@@ -1,4 +1,4 @@
-// Python bindings of the sparse kernels (rom/nnls.hpp, rom/omp.hpp,
+// Python bindings of the sparse kernels (core/nnls.hpp, rom/omp.hpp,
 // rom/focuss.hpp) on numpy arrays. Shapes and finiteness are checked here, so a
 // wrong input is a ValueError naming it rather than a zero vector with status
 // invalid_input.

@@ -2,10 +2,12 @@
 // database, the reduced model with its online method, and the evaluation of a
 // reduced model against the FOM over a parameter set.
 #include <Python.h>
+#include <variant>
 
 #include "core/errors.hpp"
 #include "python/bindings.hpp"
 #include "rom/offline.hpp"
+#include "rom/online_methods.hpp"
 
 namespace contactrom::python {
 namespace {
@@ -55,30 +57,13 @@ std::unique_ptr<ReducedModel> load_reduced_model(const std::string& path) {
 py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& problem) {
   const int num_params = problem.num_params();
   py::dict d;
-  d["problem"] = problem.name();
-  d["method"] = s.method;
-  d["delta"] = s.delta;
-  d["dictionary_size"] = s.dictionary_size;
-  d["dual_basis_size"] = s.dual_basis_size;
-  d["primal_rank"] = s.primal_rank;
-  d["validation_size"] = s.rows.size();
-  d["mean_primal_error"] = s.mean_primal_error;
-  d["max_primal_error"] = s.max_primal_error;
-  d["mean_dual_error"] = s.mean_dual_error;
-  d["max_dual_error"] = s.max_dual_error;
-  d["mean_sparsity"] = s.mean_sparsity;
-  d["max_sparsity"] = s.max_sparsity;
-  d["mean_iterations"] = s.mean_iterations;
-  d["mean_time_s"] = s.mean_time_s;
-  d["median_time_s"] = s.median_time_s;
-  d["nonconverged"] = s.nonconverged;
-  d["fom_failures"] = s.fom_failures;
-  d["max_kkt"] = s.max_kkt;
+  for (const auto& [key, value] : rom::summary_values(s))
+    std::visit([&d, &k = key](const auto& v) { d[k.c_str()] = v; }, value);
   const py::ssize_t n = static_cast<py::ssize_t>(s.rows.size());
   std::vector<fom::Param> mus;
   py::array_t<double> primal(n), dual(n), time(n);
   py::array_t<int> sparsity(n), iterations(n);
-  py::array_t<bool> converged(n);
+  py::array_t<bool> converged(n), absolute(n);
   py::list status;
   for (py::ssize_t i = 0; i < n; ++i) {
     const rom::EvaluationRow& row = s.rows[i];
@@ -89,6 +74,7 @@ py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& probl
     sparsity.mutable_at(i) = row.sparsity;
     iterations.mutable_at(i) = row.iterations;
     converged.mutable_at(i) = row.converged;
+    absolute.mutable_at(i) = row.absolute_errors;
     status.append(to_string(row.status));
   }
   py::dict rows;
@@ -100,6 +86,7 @@ py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& probl
   rows["time_s"] = time;
   rows["converged"] = converged;
   rows["status"] = status;
+  rows["absolute_errors"] = absolute;
   d["rows"] = rows;
   return d;
 }
@@ -303,9 +290,12 @@ object owns the problem (and the database) it needs.)doc")
           },
           py::arg("params") = py::none(), py::arg("threads") = 0, py::arg("kkt") = false, R"doc(
 Errors against the FOM over `params` (default: the database's validation set, as
-`contactrom online --validation`): the summary of `online --json` plus 'rows',
-the per-parameter arrays (mu, primal_error, dual_error, sparsity, iterations,
-time_s, converged, status).)doc")
+`contactrom online --validation`): the summary of `online --json` (same keys;
+errors of rows whose FOM displacement is near zero are absolute, counted in
+'absolute_error_rows' with their maxima 'max_absolute_primal_error' and
+'max_absolute_dual_error', and left out of the relative means and maxima) plus
+'rows', the per-parameter arrays (mu, primal_error, dual_error, sparsity,
+iterations, time_s, converged, status, absolute_errors).)doc")
       .def("__repr__", [](const ReducedModel& r) {
         return "<contactrom.ReducedModel '" + r.rom->problem().name() + "' " + r.rom->method() + ": rank " +
                std::to_string(r.rom->model().primal_rank()) + ", dictionary " +

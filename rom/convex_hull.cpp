@@ -10,6 +10,7 @@
 
 #include "core/anderson.hpp"
 #include "fom/input_values.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/pod.hpp"
 
 namespace contactrom::rom {

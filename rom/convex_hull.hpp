@@ -67,7 +67,7 @@
 #include "rom/chls.hpp"
 #include "rom/focuss.hpp"
 #include "core/nnls.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_solver.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::rom {

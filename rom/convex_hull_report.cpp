@@ -18,8 +18,10 @@ HullReportRow report_row(const ConvexHullSolver& solver, const fom::Param& mu, c
   row.mu = mu;
   row.result = solver.solve_detailed(mu);
   const OnlineResult& on = row.result.online;
-  row.primal_error = fom::relative_h1_error(problem, on.u, ref.u);
-  row.dual_error = fom::relative_l2_pressure_error(problem, on.lambda, ref.lambda);
+  const fom::ReferenceErrors errors = fom::reference_errors(problem, on.u, on.lambda, ref.u, ref.lambda);
+  row.primal_error = errors.primal;
+  row.dual_error = errors.dual;
+  row.absolute_errors = errors.absolute;
   row.kkt = fom::kkt_residuals(problem, mu, on.u, on.lambda);
   // Absolute compliance: largest penetration (length) and |λᵀ(Cu − g)| = |Σ w_s λ_s gap_s|.
   const Eigen::VectorXd& w = problem.contact().weights();
@@ -39,10 +41,7 @@ void summarize(HullReport& r) {
   for (const HullReportRow& row : r.rows) {
     const OnlineResult& on = row.result.online;
     const double sparsity = static_cast<double>(on.selected.size());
-    r.mean_primal_error += row.primal_error / n;
-    r.max_primal_error = std::max(r.max_primal_error, row.primal_error);
-    r.mean_dual_error += row.dual_error / n;
-    r.max_dual_error = std::max(r.max_dual_error, row.dual_error);
+    r.add_errors({row.primal_error, row.dual_error, row.absolute_errors});
     r.mean_sparsity += sparsity / n;
     r.max_sparsity = std::max(r.max_sparsity, sparsity);
     r.max_sum_violation = std::max(r.max_sum_violation, row.result.sum_violation);
@@ -108,6 +107,39 @@ HullReport convex_hull_report(const ConvexHullSolver& solver, const std::vector<
   return r;
 }
 
+SummaryValues summary_values(const HullReport& r) {
+  SummaryValues v{{"queries", static_cast<long long>(r.rows.size())}};
+  append_error_values(v, r);
+  v.insert(v.end(), {{"mean_sparsity", r.mean_sparsity},
+                     {"max_sparsity", static_cast<long long>(r.max_sparsity)},
+                     {"max_sum_violation", r.max_sum_violation},
+                     {"max_penetration", r.max_penetration},
+                     {"max_penetration_abs", r.max_penetration_abs},
+                     {"max_complementarity", r.max_complementarity},
+                     {"max_complementarity_abs", r.max_complementarity_abs},
+                     {"max_stationarity", r.max_stationarity},
+                     {"max_projected_residual", r.max_projected_residual},
+                     {"mean_iterations", r.mean_iterations},
+                     {"mean_pairing_iterations", r.mean_pairing_iterations},
+                     {"nonconverged", static_cast<long long>(r.nonconverged)}});
+  if (r.timing.queries > 0)
+    v.insert(v.end(), {{"median_time_s", r.timing.median_core_s},
+                       {"median_total_time_s", r.timing.median_total_s},
+                       {"timed_queries", static_cast<long long>(r.timing.queries)}});
+  return v;
+}
+
+SummaryValues summary_values(const DatabaseChls& c) {
+  const ChlsResult& r = c.result;
+  const long long nonconverged =
+      std::count_if(r.status.begin(), r.status.end(), [](Status s) { return s != Status::Success; });
+  return {{"snapshots", static_cast<long long>(c.snapshots.size())},
+          {"max_chls_error", r.max_error},
+          {"mean_chls_error", r.mean_error},
+          {"nonconverged", nonconverged},
+          {"time_s", r.time_s}};
+}
+
 void write_hull_report_csv(const std::string& path, const ConvexHullSolver& solver, const HullReport& report) {
   const ReducedModel& model = solver.model();
   auto selected_text = [&](const OnlineResult& on, bool coefficients) {
@@ -121,13 +153,14 @@ void write_hull_report_csv(const std::string& path, const ConvexHullSolver& solv
   };
   write_file_atomically(path, [&](std::ostream& out) {
     for (const std::string& name : model.problem().param_names()) out << name << ',';
-    out << "primal_h1_error,dual_l2_error,sparsity,sum_violation,penetration,penetration_abs,complementarity,"
+    out << "primal_error,dual_error,errors,sparsity,sum_violation,penetration,penetration_abs,complementarity,"
            "complementarity_abs,stationarity,negative_pressure,projected_residual,iterations,pairing_iterations,"
            "converged,status,time_s,selected,coefficients\n";
     for (const HullReportRow& row : report.rows) {
       const OnlineResult& on = row.result.online;
       for (Eigen::Index k = 0; k < row.mu.size(); ++k) out << fom::format_number(row.mu(k)) << ',';
-      out << fom::format_number(row.primal_error) << ',' << fom::format_number(row.dual_error) << ',' << on.selected.size()
+      out << fom::format_number(row.primal_error) << ',' << fom::format_number(row.dual_error) << ','
+          << (row.absolute_errors ? "absolute" : "relative") << ',' << on.selected.size()
           << ',' << fom::format_number(row.result.sum_violation) << ',' << fom::format_number(row.kkt.penetration) << ','
           << fom::format_number(row.penetration_abs) << ',' << fom::format_number(row.kkt.complementarity) << ','
           << fom::format_number(row.complementarity_abs) << ',' << fom::format_number(row.kkt.stationarity) << ','

@@ -17,6 +17,7 @@
 #include "rom/chls.hpp"
 #include "rom/convex_hull.hpp"
 #include "rom/online_evaluation.hpp"
+#include "rom/online_timing.hpp"
 #include "rom/snapshot_database.hpp"
 
 namespace contactrom::rom {
@@ -42,8 +43,9 @@ void write_chls_csv(const std::string& path, const SnapshotDatabase& db, const D
 struct HullReportRow {
   fom::Param mu;                     ///< parameter
   ConvexHullResult result;           ///< the solve and its statistics
-  double primal_error = 0.0;         ///< relative H¹ error against the FOM
-  double dual_error = 0.0;           ///< relative L²(Γc) error against the FOM
+  double primal_error = 0.0;         ///< relative H¹ error against the FOM (absolute if `absolute_errors`)
+  double dual_error = 0.0;           ///< relative L²(Γc) error against the FOM (absolute if `absolute_errors`)
+  bool absolute_errors = false;      ///< the FOM displacement is near zero (fom::reference_errors)
   fom::KktResiduals kkt;             ///< relative FOM KKT residuals of the ROM solution
   double penetration_abs = 0.0;      ///< largest penetration (length)
   double complementarity_abs = 0.0;  ///< \f$ |\sum_s w_s \lambda_s\, gap_s| \f$ (force × length)
@@ -56,11 +58,9 @@ struct HullReportOptions {
   int repeats = 3;     ///< timing passes with `time`. Default 3.
 };
 
-/// \brief The rows and their means and maxima.
-struct HullReport {
+/// \brief The rows and their means and maxima (errors by the rule of ErrorStatistics).
+struct HullReport : ErrorStatistics {
   std::vector<HullReportRow> rows;  ///< one per parameter, in order
-  double mean_primal_error = 0.0, max_primal_error = 0.0;  ///< over the rows
-  double mean_dual_error = 0.0, max_dual_error = 0.0;      ///< over the rows
   double mean_sparsity = 0.0, max_sparsity = 0.0;          ///< |support of α|
   double max_sum_violation = 0.0;        ///< max \f$ |\mathbf 1^T\alpha - 1| \f$
   double max_penetration = 0.0, max_penetration_abs = 0.0;            ///< relative and absolute
@@ -75,6 +75,18 @@ struct HullReport {
 /// \brief Solves `solver` at every parameter and compares with the FOM.
 HullReport convex_hull_report(const ConvexHullSolver& solver, const std::vector<fom::Param>& params,
                               const HullReportOptions& options = {});
+
+/// \brief The summary of `hull-report --json`: queries, the error entries of
+/// append_error_values, mean_sparsity, max_sparsity, max_sum_violation,
+/// max_penetration, max_penetration_abs, max_complementarity,
+/// max_complementarity_abs, max_stationarity, max_projected_residual,
+/// mean_iterations, mean_pairing_iterations, nonconverged, and with timing
+/// median_time_s, median_total_time_s, timed_queries.
+SummaryValues summary_values(const HullReport& report);
+
+/// \brief The summary of `chls --json`: snapshots, max_chls_error, mean_chls_error,
+/// nonconverged, time_s.
+SummaryValues summary_values(const DatabaseChls& chls);
 
 /// \brief Writes the rows as CSV (atomically): parameter columns, errors, sparsity,
 /// compliance, iterations, status, time, selected snapshots and coefficients.

@@ -61,7 +61,7 @@
 #include <iosfwd>
 
 #include "core/anderson.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_solver.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/support_rows.hpp"
 

@@ -20,15 +20,50 @@
 /// \endcode
 /// The CLI's `--option KEY=VALUE` goes through the same validation
 /// (validate_online_options) and `contactrom online --help` prints
-/// describe_online_methods().
+/// describe_online_methods(). Adding a method: implement OnlineSolver
+/// (rom/online_solver.hpp), then register it with register_online_method()
+/// (declaring its options) or register_online_solver().
+#include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "fom/input_values.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_solver.hpp"
+#include "rom/reduced_model.hpp"
 
 namespace contactrom::rom {
+
+/// \brief Builds an online solver on a reduced model (which must outlive it).
+using OnlineSolverFactory =
+    std::function<std::unique_ptr<OnlineSolver>(const ReducedModel& model, const OnlineSolverOptions& options)>;
+
+/// \brief Registers (or replaces) the factory of method `name`.
+void register_online_solver(const std::string& name, OnlineSolverFactory factory);
+
+/// \brief Registers a method at static-initialisation time. Beware: in a static
+/// library the linker drops an object file that nothing references, together with
+/// its registrar; a registrar in a program's own source file is safe.
+struct OnlineSolverRegistrar {
+  OnlineSolverRegistrar(const std::string& name, OnlineSolverFactory factory) {
+    register_online_solver(name, std::move(factory));
+  }
+};
+
+/// \brief Registered method names, sorted.
+std::vector<std::string> online_solver_names();
+
+/// \brief Refuses a method name that is not registered (before costly work).
+/// \throws InputError "unknown online method 'x'; expected one of: ...".
+void check_online_method(const std::string& name);
+
+/// \brief Builds the solver registered as `name`, after checking `options` against
+/// the method's declared options (validate_online_options below).
+/// \throws InputError "unknown online method 'x'; expected one of: ..." for an unknown
+/// name, or naming the method, option, value and what was expected.
+std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const ReducedModel& model,
+                                                 const OnlineSolverOptions& options = {});
 
 /// \brief Kind of value an option takes.
 enum class OptionType {

@@ -13,6 +13,7 @@
 #include "fom/kkt.hpp"
 #include "rom/dense_csv.hpp"
 #include "rom/hdf5_io.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/problem_record.hpp"
 
 namespace contactrom::rom {

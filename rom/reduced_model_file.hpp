@@ -22,7 +22,7 @@
 #include <string>
 
 #include "fom/problem.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_solver.hpp"
 #include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"

@@ -5,11 +5,13 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <variant>
 
 #include "fom/input_values.hpp"
 #include "fom/kkt.hpp"
 #include "fom/problem.hpp"
 #include "rom/online_evaluation.hpp"
+#include "rom/online_solver.hpp"
 #include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 
@@ -61,6 +63,11 @@ inline nlohmann::json kkt_json(const fom::KktResiduals& k) {
           {"penetration", k.penetration},
           {"negative_pressure", k.negative_pressure},
           {"complementarity", k.complementarity}};
+}
+
+/// Adds a library summary (rom::summary_values and its kin) to the JSON object `j`.
+inline void append_summary_json(nlohmann::json& j, const rom::SummaryValues& values) {
+  for (const auto& [key, value] : values) std::visit([&j, &k = key](const auto& v) { j[k] = v; }, value);
 }
 
 /// Warns on stderr when δ left no POD mode: the reduced displacement is then the

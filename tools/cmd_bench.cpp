@@ -28,7 +28,7 @@
 #include "baselines/benchmark.hpp"
 #include "fom/active_set_solver.hpp"
 #include "rom/offline.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_timing.hpp"
 #include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"

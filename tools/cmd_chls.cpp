@@ -3,7 +3,8 @@
 //   contactrom chls --db DB.h5 [--out FILE.csv] [--json]
 //     Leave-one-out convex-hull least squares (CHLS) of every primal snapshot
 //     against the others; CSV: parameter columns, chls_error, status,
-//     iterations, support. JSON keys: errors (list), max_error, mean_error, ...
+//     iterations, support. JSON keys: chls_error (list), max_chls_error,
+//     mean_chls_error, ... (rom::summary_values; docs/rom.md, "JSON keys").
 //     Plotting is not done here (the CLI stays pure C++): tools/rope_experiments.py
 //     plots the CSV.
 //
@@ -66,15 +67,11 @@ void run_chls(const ChlsArgs& a) {
   if (!a.out.empty()) rom::write_chls_csv(a.out, db, chls);
   nlohmann::json j;
   j["problem"] = db.problem;
-  j["snapshots"] = used.size();
-  j["errors"] = std::vector<double>(r.errors.data(), r.errors.data() + r.errors.size());
+  j["chls_error"] = std::vector<double>(r.errors.data(), r.errors.data() + r.errors.size());
   nlohmann::json params = nlohmann::json::array();
   for (int s : used) params.push_back(param_json(db.parameter(s)));
   j["params"] = params;
-  j["max_error"] = r.max_error;
-  j["mean_error"] = r.mean_error;
-  j["nonconverged"] = std::count_if(r.status.begin(), r.status.end(), [](Status s) { return s != Status::Success; });
-  j["time_s"] = r.time_s;
+  append_summary_json(j, rom::summary_values(chls));
   if (a.json) {
     std::cout << j.dump() << std::endl;
     return;
@@ -155,28 +152,7 @@ void run_hull_report(const HullArgs& a) {
   j["basis"] = a.basis;
   j["projection_rank"] = solver.dictionary().projection_rank();
   j["dictionary_size"] = solver.dictionary().size();
-  j["queries"] = r.rows.size();
-  j["mean_primal_error"] = r.mean_primal_error;
-  j["max_primal_error"] = r.max_primal_error;
-  j["mean_dual_error"] = r.mean_dual_error;
-  j["max_dual_error"] = r.max_dual_error;
-  j["mean_sparsity"] = r.mean_sparsity;
-  j["max_sparsity"] = r.max_sparsity;
-  j["max_sum_violation"] = r.max_sum_violation;
-  j["max_penetration"] = r.max_penetration;
-  j["max_penetration_abs"] = r.max_penetration_abs;
-  j["max_complementarity"] = r.max_complementarity;
-  j["max_complementarity_abs"] = r.max_complementarity_abs;
-  j["max_stationarity"] = r.max_stationarity;
-  j["max_projected_residual"] = r.max_projected_residual;
-  j["mean_iterations"] = r.mean_iterations;
-  j["mean_pairing_iterations"] = r.mean_pairing_iterations;
-  j["nonconverged"] = r.nonconverged;
-  if (a.time) {
-    j["median_time_s"] = r.timing.median_core_s;
-    j["median_total_time_s"] = r.timing.median_total_s;
-    j["timed_queries"] = r.timing.queries;
-  }
+  append_summary_json(j, rom::summary_values(r));
   if (a.json) {
     std::cout << j.dump() << std::endl;
     return;
@@ -191,13 +167,17 @@ void run_hull_report(const HullArgs& a) {
             << std::setw(28) << "dual L2 error" << std::setw(12) << j["mean_dual_error"].get<double>()
             << j["max_dual_error"].get<double>() << "\n"
             << std::setw(28) << "sparsity" << std::setw(12) << j["mean_sparsity"].get<double>()
-            << j["max_sparsity"].get<double>() << "\n"
+            << j["max_sparsity"].get<int>() << "\n"
             << std::setw(28) << "|1'alpha - 1|" << std::setw(12) << "" << j["max_sum_violation"].get<double>() << "\n"
             << std::setw(28) << "penetration (rel / abs)" << std::setw(12) << j["max_penetration"].get<double>()
             << j["max_penetration_abs"].get<double>() << "\n"
             << std::setw(28) << "complementarity (rel / abs)" << std::setw(12) << j["max_complementarity"].get<double>()
             << j["max_complementarity_abs"].get<double>() << "\n"
             << "not converged: " << j["nonconverged"] << " of " << r.rows.size() << "\n";
+  if (r.absolute_error_rows)
+    std::cout << r.absolute_error_rows << " queries with a near-zero FOM displacement left out of the errors "
+              << "(absolute errors: max primal " << r.max_absolute_primal_error << ", max dual "
+              << r.max_absolute_dual_error << "; per query in the CSV)\n";
   if (a.time)
     std::cout << "median online time per query " << j["median_time_s"].get<double>() * 1e6 << " us (with full field "
               << j["median_total_time_s"].get<double>() * 1e6 << " us)\n";

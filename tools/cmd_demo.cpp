@@ -26,6 +26,7 @@
 #include "rom/greedy_active_set.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_evaluation.hpp"
+#include "rom/online_timing.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"

@@ -104,26 +104,7 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
   if (!a.out.empty()) rom::write_evaluation_csv(a.out, problem, s);
 
   nlohmann::json j;
-  j["problem"] = problem.name();
-  j["method"] = s.method;
-  j["delta"] = s.delta;
-  j["dictionary_size"] = s.dictionary_size;
-  j["dual_basis_size"] = s.dual_basis_size;
-  j["primal_rank"] = s.primal_rank;
-  j["validation_size"] = s.rows.size();
-  j["mean_primal_error"] = s.mean_primal_error;
-  j["max_primal_error"] = s.max_primal_error;
-  j["mean_dual_error"] = s.mean_dual_error;
-  j["max_dual_error"] = s.max_dual_error;
-  j["absolute_error_rows"] = s.absolute_error_rows;
-  j["mean_sparsity"] = s.mean_sparsity;
-  j["max_sparsity"] = s.max_sparsity;
-  j["mean_iterations"] = s.mean_iterations;
-  j["mean_time_s"] = s.mean_time_s;
-  j["median_time_s"] = s.median_time_s;
-  j["nonconverged"] = s.nonconverged;
-  j["fom_failures"] = s.fom_failures;
-  if (a.kkt) j["max_kkt"] = s.max_kkt;
+  append_summary_json(j, rom::summary_values(s));
   if (a.json) {
     std::cout << j.dump() << std::endl;
     return;
@@ -143,7 +124,8 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
             << "not converged: " << s.nonconverged << " of " << s.rows.size();
   if (s.absolute_error_rows)
     std::cout << "; " << s.absolute_error_rows << " rows with a near-zero FOM displacement left out of the errors "
-              << "(absolute errors in the CSV)";
+              << "(absolute errors: max primal " << s.max_absolute_primal_error << ", max dual "
+              << s.max_absolute_dual_error << "; per row in the CSV)";
   if (s.fom_failures) std::cout << "; FOM reference failures: " << s.fom_failures;
   if (a.kkt) std::cout << "; max KKT residual " << s.max_kkt;
   std::cout << "\n";

@@ -10,6 +10,7 @@
 #include "core/atomic_file.hpp"
 #include "fom/field_output.hpp"
 #include "fom/kkt.hpp"
+#include "rom/online_timing.hpp"
 #include "rom/reduced_model_file.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/reduced_model_file.hpp"
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"

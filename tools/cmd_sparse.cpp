@@ -1,4 +1,4 @@
-// contactrom sparse — runs one sparse regression kernel (rom/nnls.hpp, rom/omp.hpp,
+// contactrom sparse — runs one sparse regression kernel (core/nnls.hpp, rom/omp.hpp,
 // rom/focuss.hpp) on a dictionary D and a signal x read from CSV files:
 //
 //   contactrom sparse --method nnls|omp|focuss|nnfocuss --dictionary D.csv --signal x.csv

@@ -31,7 +31,7 @@
 #include "fom/parameter_space.hpp"
 #include "rom/greedy_active_set.hpp"
 #include "rom/offline.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_timing.hpp"
 #include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/snapshot_database.hpp"
@@ -86,10 +86,9 @@ nlohmann::json method_json(const baselines::MethodVerification& r, const rom::Re
   j["tau"] = r.tau;
   j["reduced_constraint"] = r.reduced_constraint;
   j["max_kkt"] = kkt_json(r.summary.max_kkt);
-  j["max_primal_error"] = r.summary.max_primal_h1;
-  j["mean_primal_error"] = r.summary.mean_primal_h1;
-  j["max_dual_error"] = r.summary.max_dual_l2;
-  j["mean_dual_error"] = r.summary.mean_dual_l2;
+  rom::SummaryValues errors;
+  rom::append_error_values(errors, r.errors);
+  append_summary_json(j, errors);
   j["max_active_set_differences"] = r.summary.max_active_set_differences;
   j["invalid"] = r.summary.invalid;
   j["max_reduced_penetration"] = r.max_reduced_penetration;
@@ -128,12 +127,11 @@ void print_table(const VerifyArgs& a, const baselines::VerifyReport& report) {
     std::cout << cell(r.name, 18) << cell(std::to_string(r.dual_columns.size()), 6)
               << cell(sci(r.summary.max_kkt.stationarity), 11) << cell(sci(r.summary.max_kkt.penetration), 10)
               << cell(sci(r.summary.max_kkt.negative_pressure), 11) << cell(sci(r.summary.max_kkt.complementarity), 10)
-              << cell(sci(r.summary.max_primal_h1), 11) << cell(sci(r.summary.max_dual_l2), 10) << cell(sci(r.max_reduced_penetration), 11)
+              << cell(sci(r.errors.max_primal_error), 11) << cell(sci(r.errors.max_dual_error), 10) << cell(sci(r.max_reduced_penetration), 11)
               << cell(sci(r.tau), 10) << r.nonconverged << "\n";
 }
 
-void run_verify(const VerifyArgs& a) {
-  if (!a.out.empty()) check_output_path(a.out);
+baselines::VerifyOptions verify_options(const VerifyArgs& a) {
   baselines::VerifyOptions options;
   options.methods = methods_of(a);
   if (a.reference != "ipopt" && a.reference != "fom")
@@ -142,63 +140,64 @@ void run_verify(const VerifyArgs& a) {
   options.threads = a.threads;
   options.bench = a.bench;
   options.repeats = a.repeats;
+  return options;
+}
 
-  const rom::SnapshotDatabase db = rom::read_database(a.db);
-  auto problem = rom::problem_from_database(db, a.db);
-  rom::ReducedModelOptions model_options;
-  model_options.delta = a.delta;
-  const rom::ReducedModel model(*problem, db, model_options);
-  warn_if_no_primal_modes(model);
-  const std::vector<fom::Param> params = baselines::subsample(rom::database_validation_set(db, *problem), a.limit);
-
-  // Progress bars on stderr, one per stage.
-  const bool show = a.progress || ::isatty(STDERR_FILENO);
+/// Progress bars on stderr, one per stage (label); finish() ends the last one.
+struct StageProgress {
+  bool show;
   std::unique_ptr<rom::ProgressBar> bar;
   std::string stage;
-  options.progress = [&](const std::string& label, int done, int total) {
+  void update(const std::string& label, int done, int total) {
     if (label != stage) {
-      if (bar) bar->finish();
+      finish();
       bar = std::make_unique<rom::ProgressBar>(std::cerr, "verify: " + label, show);
       stage = label;
     }
     bar->update(done, total);
-  };
-  const baselines::VerifyReport report = baselines::verify(model, params, options);
-  if (bar) bar->finish();
-  if (!a.out.empty()) baselines::write_verify_csv(a.out, *problem, report);
-
-  const int n = static_cast<int>(params.size());
-  const double fom_time = report.fom_median_time_s;
-  if (a.json) {
-    nlohmann::json j;
-    j["problem"] = problem->name();
-    j[db.training_kind] = db.training_size;
-    j["delta"] = model.delta();
-    j["validation_size"] = n;
-    j["reference"] = {{"solver", a.reference},
-                      {"failures", report.reference_failures},
-                      {"max_kkt", kkt_json(report.reference_summary.max_kkt)},
-                      {"wall_time_s", report.reference_wall_s}};
-    j["reduced_penetration_slack"] = report.reduced_penetration_slack;
-    j["methods"] = nlohmann::json::object();
-    for (const auto& r : report.methods) j["methods"][r.name] = method_json(r, model, a.bench, fom_time);
-    if (a.bench) j["fom_median_time_s"] = fom_time;
-    std::cout << j.dump() << std::endl;
-    return;
   }
+  void finish() {
+    if (bar) bar->finish();
+  }
+};
 
-  std::cout << "verify " << problem->name() << " (" << db.training_kind << " " << db.training_size << "): " << n
-            << " validation parameters, primal rank " << model.primal_rank() << " (delta " << model.delta()
-            << "), dictionary " << model.dictionary_size() << "\n"
+void print_json(const VerifyArgs& a, const rom::SnapshotDatabase& db, const rom::ReducedModel& model,
+                const baselines::VerifyReport& report) {
+  nlohmann::json j;
+  j["problem"] = model.problem().name();
+  j[db.training_kind] = db.training_size;
+  j["delta"] = model.delta();
+  j["validation_size"] = report.params.size();
+  j["reference"] = {{"solver", a.reference},
+                    {"failures", report.reference_failures},
+                    {"max_kkt", kkt_json(report.reference_summary.max_kkt)},
+                    {"wall_time_s", report.reference_wall_s}};
+  j["reduced_penetration_slack"] = report.reduced_penetration_slack;
+  j["methods"] = nlohmann::json::object();
+  for (const auto& r : report.methods) j["methods"][r.name] = method_json(r, model, a.bench, report.fom_median_time_s);
+  if (a.bench) j["fom_median_time_s"] = report.fom_median_time_s;
+  std::cout << j.dump() << std::endl;
+}
+
+void print_text(const VerifyArgs& a, const rom::SnapshotDatabase& db, const rom::ReducedModel& model,
+                const baselines::VerifyReport& report) {
+  const double fom_time = report.fom_median_time_s;
+  std::cout << "verify " << model.problem().name() << " (" << db.training_kind << " " << db.training_size
+            << "): " << report.params.size() << " validation parameters, primal rank " << model.primal_rank()
+            << " (delta " << model.delta() << "), dictionary " << model.dictionary_size() << "\n"
             << "reference " << a.reference << ": " << report.reference_failures << " failures, " << std::setprecision(3)
             << report.reference_wall_s << " s\n"
             << "maximum over the validation set (KKT residuals are full-order and relative, see fom/kkt.hpp):\n";
   print_table(a, report);
   for (const baselines::MethodVerification& r : report.methods) {
-    std::cout << r.name << ": mean primal error " << sci(r.summary.mean_primal_h1) << ", mean dual error "
-              << sci(r.summary.mean_dual_l2)
+    std::cout << r.name << ": mean primal error " << sci(r.errors.mean_primal_error) << ", mean dual error "
+              << sci(r.errors.mean_dual_error)
               << ", mean |I| " << std::setprecision(3) << r.mean_sparsity << ", mean iterations " << r.mean_iterations
               << ", mean time " << r.mean_time_s * 1e6 << " us";
+    if (r.errors.absolute_error_rows)
+      std::cout << "; " << r.errors.absolute_error_rows << " parameters with a near-zero reference displacement "
+                << "left out of the errors (absolute: max primal " << sci(r.errors.max_absolute_primal_error)
+                << ", max dual " << sci(r.errors.max_absolute_dual_error) << ")";
     if (r.reduced_constraint)
       std::cout << "; reduced penetration <= tau + " << report.reduced_penetration_slack << ": "
                 << (r.reduced_violations ? "VIOLATED at " + std::to_string(r.reduced_violations) + " parameters"
@@ -212,6 +211,27 @@ void run_verify(const VerifyArgs& a) {
   }
   if (a.bench) std::cout << "FOM (factorisation reused): median " << fom_time * 1e3 << " ms per query\n";
   if (!a.out.empty()) std::cout << "per-parameter results written to " << a.out << "\n";
+}
+
+void run_verify(const VerifyArgs& a) {
+  if (!a.out.empty()) check_output_path(a.out);
+  baselines::VerifyOptions options = verify_options(a);
+  const rom::SnapshotDatabase db = rom::read_database(a.db);
+  auto problem = rom::problem_from_database(db, a.db);
+  rom::ReducedModelOptions model_options;
+  model_options.delta = a.delta;
+  const rom::ReducedModel model(*problem, db, model_options);
+  warn_if_no_primal_modes(model);
+  const std::vector<fom::Param> params = baselines::subsample(rom::database_validation_set(db, *problem), a.limit);
+  StageProgress progress{a.progress || ::isatty(STDERR_FILENO), nullptr, ""};
+  options.progress = [&](const std::string& label, int done, int total) { progress.update(label, done, total); };
+  const baselines::VerifyReport report = baselines::verify(model, params, options);
+  progress.finish();
+  if (!a.out.empty()) baselines::write_verify_csv(a.out, *problem, report);
+  if (a.json)
+    print_json(a, db, model, report);
+  else
+    print_text(a, db, model, report);
 }
 
 CommandRegistrar reg("verify", [](CLI::App& app) {

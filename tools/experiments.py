@@ -116,10 +116,10 @@ def read_rows(path):
     for r in rows:
         sel = r.get("selected", "").split()
         out.append({
-            "params": [float(r[k]) for k in r if k not in {"primal_h1_error", "dual_l2_error", "sparsity", "iterations",
+            "params": [float(r[k]) for k in r if k not in {"primal_error", "dual_error", "sparsity", "iterations",
                                                            "time_s", "converged", "status", "selected", "errors"}],
-            "primal": float(r["primal_h1_error"]),
-            "dual": float(r["dual_l2_error"]),
+            "primal": float(r["primal_error"]),
+            "dual": float(r["dual_error"]),
             "sparsity": int(r["sparsity"]),
             "iterations": int(r["iterations"]),
             "time": float(r["time_s"]),

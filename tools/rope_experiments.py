@@ -78,8 +78,8 @@ def plot_chls(rows, path):
 def plot_errors(training, validation, path):
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
     floor = 1e-17  # training errors can be exactly 0; show them at the floor
-    for ax, key, title in ((axes[0], "primal_h1_error", "Displacement (H1)"),
-                           (axes[1], "dual_l2_error", "Contact pressure (L2)")):
+    for ax, key, title in ((axes[0], "primal_error", "Displacement (H1)"),
+                           (axes[1], "dual_error", "Contact pressure (L2)")):
         for rows, style, label in ((training, "o", "training"), (validation, "s", "validation")):
             ax.semilogy(column(rows, "gamma"), [max(v, floor) for v in column(rows, key)], style,
                         label=label + " error")
@@ -109,8 +109,8 @@ COMPLIANCE = [
     ("penetration (absolute, length)", "penetration_abs"),
     ("complementary slack (relative)", "complementarity"),
     ("complementary slack (absolute, |l'(Cu - g)|)", "complementarity_abs"),
-    ("primal H1 error", "primal_h1_error"),
-    ("dual L2 error", "dual_l2_error"),
+    ("primal H1 error", "primal_error"),
+    ("dual L2 error", "dual_error"),
 ]
 
 
@@ -204,7 +204,7 @@ def main():
         json.dump(summary, f, indent=2)
 
     print("rope convex hull (delta %g), results in %s" % (a.delta, a.results))
-    print("CHLS: max %.3e, mean %.3e" % (summary["chls"]["max_error"], summary["chls"]["mean_error"]))
+    print("CHLS: max %.3e, mean %.3e" % (summary["chls"]["max_chls_error"], summary["chls"]["mean_chls_error"]))
     for name in ("training", "validation"):
         s = summary["hull_" + name]
         print("%-10s max primal %.2e, max dual %.2e, mean sparsity %.2f, max |1'a-1| %.1e, "

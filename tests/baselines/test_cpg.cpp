@@ -17,7 +17,7 @@
 #include "core/nnls.hpp"
 #include "fom/problem.hpp"
 #include "rom/offline.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 
 using namespace contactrom;

@@ -19,7 +19,7 @@
 #include "fom/problem.hpp"
 #include "rom/greedy_active_set.hpp"
 #include "rom/offline.hpp"
-#include "rom/online_evaluation.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 
 using namespace contactrom;

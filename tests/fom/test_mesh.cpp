@@ -538,22 +538,47 @@ BOOST_AUTO_TEST_CASE(a_gmsh_crash_is_an_input_error_naming_the_file) {
   BOOST_TEST(load_mesh(kMeshDir + "ironing.geo").fingerprint() == ironing().fingerprint());
 }
 
-BOOST_AUTO_TEST_CASE(gmsh_running_past_the_time_limit_is_stopped) {
-  // A NaN radius makes gmsh 4.8.4 loop forever meshing the arc.
-  const TempFile geo("nan.geo",
-                     "r = Sqrt(-1);\n"
-                     "Point(1) = {0,0,0,0.1}; Point(2) = {r,0,0,0.1}; Point(3) = {0,r,0,0.1};\n"
-                     "Circle(1) = {2,1,3}; Line(2) = {1,2}; Line(3) = {3,1};\n"
-                     "Curve Loop(1) = {2,1,3}; Plane Surface(1) = {1}; Recombine Surface{1};\n"
-                     "Physical Surface(\"body\") = {1}; Physical Curve(\"base\") = {2};\n");
+/// The message of load_mesh's refusal of `geo` under a 2 s time limit, checked to
+/// be one line naming the file and to come well before 30 s.
+std::string refusal_within_time_limit(const TempFile& geo) {
   contactrom::fom::MeshOptions options;
   options.time_limit_s = 2.0;
   const auto start = std::chrono::steady_clock::now();
   const std::string msg = input_error_of([&] { load_mesh(geo.path.string(), options); });
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   BOOST_TEST(contains(msg, geo.path.string()), msg);
-  BOOST_TEST(contains(msg, "2 s"), msg);
+  BOOST_TEST(msg.find('\n') == std::string::npos, msg);
   BOOST_TEST(elapsed < 30.0);
+  return msg;
+}
+
+BOOST_AUTO_TEST_CASE(gmsh_running_past_the_time_limit_is_stopped) {
+  // A .geo is a program: this one loops (for days) before it builds anything.
+  const TempFile geo("loop.geo", "For i In {1:1e15}\n  x = i;\nEndFor\nPoint(1) = {0,0,0,0.1};\n");
+  const std::string msg = refusal_within_time_limit(geo);
+  BOOST_TEST(contains(msg, "time limit of 2 s"), msg);
+}
+
+BOOST_AUTO_TEST_CASE(a_nan_radius_is_refused_in_one_line) {
+  // A NaN radius makes gmsh 4.8.4 loop forever meshing the arc: stopped at the time
+  // limit. Under AddressSanitizer, gmsh's own bad free() on these coordinates
+  // (GFace::computeMeanPlane) ends the gmsh child first; contactrom then names the
+  // file and gmsh's failure instead. Either is a clean one-line refusal.
+  const TempFile geo("nan.geo",
+                     "r = Sqrt(-1);\n"
+                     "Point(1) = {0,0,0,0.1}; Point(2) = {r,0,0,0.1}; Point(3) = {0,r,0,0.1};\n"
+                     "Circle(1) = {2,1,3}; Line(2) = {1,2}; Line(3) = {3,1};\n"
+                     "Curve Loop(1) = {2,1,3}; Plane Surface(1) = {1}; Recombine Surface{1};\n"
+                     "Physical Surface(\"body\") = {1}; Physical Curve(\"base\") = {2};\n");
+  const std::string msg = refusal_within_time_limit(geo);
+  const bool time_limit = contains(msg, "time limit of 2 s");
+#if defined(__SANITIZE_ADDRESS__)
+  const bool gmsh_failed = contains(msg, "gmsh ended with exit code") || contains(msg, "gmsh crashed");
+  if (!time_limit) BOOST_TEST_MESSAGE("sanitizer build: gmsh failed on the NaN radius before the time limit: " << msg);
+  BOOST_TEST((time_limit || gmsh_failed), msg);
+#else
+  BOOST_TEST(time_limit, msg);
+#endif
 }
 
 BOOST_AUTO_TEST_CASE(a_mesh_above_the_node_limit_is_refused_with_its_count) {

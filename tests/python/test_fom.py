@@ -107,6 +107,19 @@ def test_ipopt_reference_agrees(problems, solvers):
     report = contactrom.verify(problems["hertz"], 0.2, sol.u, sol.lam, reference=ref)
     assert report["status"] == "success"
     assert report["kkt"]["max"] <= 1e-10
-    assert report["errors"]["primal_h1"] <= 1e-8
-    assert report["errors"]["dual_l2"] <= 1e-6
+    assert report["errors"]["primal_error"] <= 1e-8
+    assert report["errors"]["dual_error"] <= 1e-6
     assert report["errors"]["active_set_differences"] == 0
+    assert report["errors"]["errors"] == "relative"
+
+
+def test_verify_errors_are_absolute_against_a_near_zero_reference(problems, solvers):
+    # d = 1e-9: the reference displacement is near zero; errors relative to it would
+    # divide round-off by round-off, so they are absolute, as in `contactrom online`.
+    ref = solvers["hertz"].solve(1e-9)
+    other = solvers["hertz"].solve(2e-9)
+    report = contactrom.verify(problems["hertz"], 1e-9, other.u, other.lam, reference=ref)
+    assert report["errors"]["errors"] == "absolute"
+    # The solution at 2e-9 is about twice the one at 1e-9: a relative error would be
+    # about 1; the absolute one is of the size of the displacement, about 1e-9.
+    assert 0.0 < report["errors"]["primal_error"] < 1e-6

@@ -29,6 +29,21 @@ def test_validation_errors_equal_cli(hertz_db_path, rom):
                 "mean_iterations"):
         assert ours[key] == pytest.approx(cli[key], rel=1e-12, abs=1e-300), key
     assert ours["max_primal_error"] == ours["rows"]["primal_error"].max()
+    # One key list (rom::summary_values) for the CLI's JSON and the Python dict.
+    assert set(ours) - {"rows"} == set(cli)
+
+
+def test_near_zero_reference_gives_absolute_errors(rom):
+    # d = 1e-9: the FOM displacement is near zero, a relative error would divide
+    # round-off by round-off; the row's errors are absolute and left out of the means.
+    report = rom.evaluate(params=[1e-9, 0.1], threads=1)
+    rows = report["rows"]
+    assert list(rows["absolute_errors"]) == [True, False]
+    assert report["absolute_error_rows"] == 1
+    assert report["max_absolute_primal_error"] == rows["primal_error"][0]
+    assert report["max_absolute_dual_error"] == rows["dual_error"][0]
+    assert report["max_primal_error"] == report["mean_primal_error"] == rows["primal_error"][1]
+    assert report["max_dual_error"] == report["mean_dual_error"] == rows["dual_error"][1]
 
 
 @pytest.mark.parametrize("mu", [0.0137, 0.2])

@@ -207,9 +207,9 @@ BOOST_AUTO_TEST_CASE(cli_chls_rope) {
   r = contactrom::test::run_command(kExe + " chls --db " + db + " --out " + csv + " --json");
   BOOST_REQUIRE_EQUAL(r.exit_code, 0);
   const auto j = nlohmann::json::parse(r.out);
-  BOOST_TEST(j["errors"].size() == 9u);
-  BOOST_TEST(j["max_error"].get<double>() >= j["mean_error"].get<double>());
-  BOOST_TEST(j["max_error"].get<double>() < 0.1);  // the convex-subset hypothesis holds for rope
+  BOOST_TEST(j["chls_error"].size() == 9u);
+  BOOST_TEST(j["max_chls_error"].get<double>() >= j["mean_chls_error"].get<double>());
+  BOOST_TEST(j["max_chls_error"].get<double>() < 0.1);  // the convex-subset hypothesis holds for rope
   const std::string text = contactrom::test::slurp(csv);
   BOOST_TEST(text.rfind("gamma,chls_error,", 0) == 0u);
   BOOST_TEST(std::count(text.begin(), text.end(), '\n') == 10);

@@ -18,6 +18,8 @@
 #include "rom/greedy_active_set.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_evaluation.hpp"
+#include "rom/online_methods.hpp"
+#include "rom/online_timing.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/support_rows.hpp"
 

@@ -14,6 +14,7 @@
 
 #include "common/database_checks.hpp"
 #include "common/run_command.hpp"
+#include "fom/kkt.hpp"
 #include "fom/problem.hpp"
 #include "rom/offline.hpp"
 #include "rom/reduced_model_file.hpp"

@@ -1,0 +1,120 @@
+#pragma once
+/// \file online_solver.hpp
+/// \brief The common interface of the online ROM methods (greedy active set,
+/// convex hull, CPG, full dictionary, ...): one query's result, the solver
+/// interface, the settings the methods share (and the parsing of their
+/// method-specific ones), and the clock of the contact-operator construction.
+///
+/// Methods are built by name through the registry (rom/online_methods.hpp) and
+/// evaluated against the FOM by rom/online_evaluation.hpp.
+/// Exact command line (see docs/rom.md):
+/// \code
+///   contactrom online --db hertz30.h5 --method greedy --param 0.1275 --json
+/// \endcode
+#include <Eigen/Dense>
+#include <chrono>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "fom/problem.hpp"
+#include "rom/reduced_model.hpp"
+
+namespace contactrom::rom {
+
+/// \brief One online query of a ROM.
+struct OnlineResult {
+  fom::Param mu;                 ///< parameter of the query
+  Eigen::VectorXd u_hat;         ///< reduced primal coordinates û (size r)
+  Eigen::VectorXd u;             ///< full displacement Φû + u_lift(μ) (n_dofs)
+  Eigen::VectorXd lambda;        ///< full contact pressure D_d[:, I] λ̂_I (n_c)
+  std::vector<int> selected;     ///< selected dictionary columns I (indices into ReducedModel::dictionary())
+  Eigen::VectorXd coefficients;  ///< λ̂_I, in the order of `selected`
+  int iterations = 0;            ///< iterations of the method (one reduced solve each for greedy)
+  bool converged = false;        ///< stopping criterion met before the iteration cap
+  Status status = Status::Success;  ///< NoConvergence when !converged; NumericalIssue on a failed solve
+  /// Wall time of the online core (seconds): everything from μ to (û, λ̂_I) and the
+  /// full pressure, nonlinear contact operators included; the full-field
+  /// reconstruction Φû + u_lift (a mesh-size operation needed only for output) is
+  /// excluded and timed in `reconstruction_time_s`.
+  double time_s = 0.0;
+  double reconstruction_time_s = 0.0;  ///< wall time of u = Φû + u_lift (seconds)
+  /// Part of `time_s` spent building the contact operators at the iterates (surface
+  /// displacement Φ_s û, contact search, assembly of C_R and g_R, the rows Ĉ_I, ĝ_I
+  /// of the reduced operators): the "construction of the non-linear operators" that
+  /// the paper's timings leave out. Measured only when the solver was built with
+  /// OnlineSolverOptions::time_operators (it costs two clock reads per phase);
+  /// −1 otherwise, and for methods that do not measure it.
+  double operator_time_s = -1.0;
+  std::string message;                 ///< reason when status != Success
+};
+
+/// \brief An online ROM method. solve() is const and must be thread-safe.
+class OnlineSolver {
+ public:
+  virtual ~OnlineSolver() = default;
+  /// Registry name of the method ("greedy", ...).
+  virtual std::string name() const = 0;
+  /// The reduced model the solver works on.
+  virtual const ReducedModel& model() const = 0;
+  /// \brief Solves the reduced problem at μ (range-checked by the caller).
+  virtual OnlineResult solve(const fom::Param& mu) const = 0;
+  /// Number of dual columns the method draws from (the whole dictionary unless the
+  /// method builds its own dual basis, e.g. CPG).
+  virtual int dual_basis_size() const { return model().dictionary_size(); }
+};
+
+/// \brief Settings shared by the online methods (each documents which it reads).
+struct OnlineSolverOptions {
+  /// Penetration threshold τ of the greedy enrichment; < 0: τ = δ of the model (the
+  /// paper's choice). Default −1.
+  double tau = -1.0;
+  /// How τ is applied: "absolute" (paper: on D_dᵀ(Cu − g) directly) or "relative"
+  /// (τ times the scale U·max_p Σ_s w_s|D_d[s,p]|; see docs/rom.md). Default "absolute".
+  std::string tau_scaling = "absolute";
+  /// Iteration cap k_max. Default 50.
+  int max_iterations = 50;
+  /// Relative change of û under which the iteration may stop. Default 1e-5.
+  double step_tolerance = 1e-5;
+  /// Measure OnlineResult::operator_time_s (greedy, greedy-nested, cpg,
+  /// full-dictionary). Off by default: the clock reads add about 1 % to a query.
+  bool time_operators = false;
+  /// Method-specific settings by name (for methods added later), as text.
+  std::map<std::string, std::string> extra;
+};
+
+/// \brief Refuses method-specific settings (OnlineSolverOptions::extra) that `method`
+/// does not know. \throws InputError "online method 'm' has no option 'k'; it knows: ...".
+void check_extra_options(const OnlineSolverOptions& options, const std::string& method,
+                         const std::vector<std::string>& known);
+
+/// \brief Value of a method-specific setting (OnlineSolverOptions::extra) as a finite
+/// number. \throws InputError "<method> option <key> = '<text>' is not a number".
+double parse_option_number(const std::string& method, const std::string& key, const std::string& text);
+
+/// \brief Value of a method-specific setting as an integer (the whole text).
+/// \throws InputError "<method> option <key> = '<text>' is not an integer".
+long long parse_option_integer(const std::string& method, const std::string& key, const std::string& text);
+
+/// \brief Accumulates the wall time of the operator-construction phases of one
+/// query into OnlineResult::operator_time_s; does nothing unless enabled.
+class OperatorClock {
+ public:
+  explicit OperatorClock(bool enabled) : m_enabled(enabled) {}
+  void start() {
+    if (m_enabled) m_start = std::chrono::steady_clock::now();
+  }
+  void stop() {
+    if (m_enabled) m_total += std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
+  }
+  /// Seconds accumulated, or −1 when disabled.
+  double total() const { return m_enabled ? m_total : -1.0; }
+
+ private:
+  bool m_enabled;
+  double m_total = 0.0;
+  std::chrono::steady_clock::time_point m_start;
+};
+
+}  // namespace contactrom::rom
