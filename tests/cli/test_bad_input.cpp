@@ -142,10 +142,9 @@ BOOST_FIXTURE_TEST_CASE(corrupted_databases, Fixture) {
   const int patched = std::system(("/usr/bin/python3 -c \"import h5py, numpy; f = h5py.File('" + file("h2.h5") +
                                    "', 'a'); f.attrs['training_size'] = numpy.int32(7)\" 2>/dev/null")
                                       .c_str());
-  if (patched == 0)
-    check_case({"online --db " + file("h2.h5"), "claims training size 7 of hertz, but it holds 2 snapshots", "", ""});
-  else
-    BOOST_TEST_MESSAGE("relabelled-database case needs /usr/bin/python3 with h5py; not run");
+  // h5py and numpy are installed by tools/setup.sh: without them the case fails.
+  BOOST_REQUIRE_MESSAGE(patched == 0, "the relabelled-database case needs /usr/bin/python3 with h5py and numpy");
+  check_case({"online --db " + file("h2.h5"), "claims training size 7 of hertz, but it holds 2 snapshots", "", ""});
 }
 
 BOOST_FIXTURE_TEST_CASE(output_targets, Fixture) {
