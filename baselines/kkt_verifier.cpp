@@ -107,10 +107,10 @@ std::vector<std::pair<std::string, double>> VerificationSummary::fields() const 
           {"max_negative_pressure", max_kkt.negative_pressure},
           {"max_complementarity", max_kkt.complementarity},
           {"max_kkt", max_kkt.max()},
-          {"max_primal_h1", max_primal_h1},
-          {"mean_primal_h1", mean_primal_h1},
-          {"max_dual_l2", max_dual_l2},
-          {"mean_dual_l2", mean_dual_l2},
+          {"max_primal_error", max_primal_h1},
+          {"mean_primal_error", mean_primal_h1},
+          {"max_dual_error", max_dual_l2},
+          {"mean_dual_error", mean_dual_l2},
           {"max_active_set_differences", max_active_set_differences},
           {"total_active_set_differences", total_active_set_differences}};
 }

@@ -80,8 +80,8 @@ struct VerificationSummary {
   double max_kkt_residual() const { return max_kkt.max(); }
   /// (key, value) pairs in a fixed order for JSON/CSV writers: count, invalid,
   /// with_reference, max_stationarity, max_penetration, max_negative_pressure,
-  /// max_complementarity, max_kkt, max_primal_h1, mean_primal_h1, max_dual_l2,
-  /// mean_dual_l2, max_active_set_differences, total_active_set_differences.
+  /// max_complementarity, max_kkt, max_primal_error, mean_primal_error, max_dual_error,
+  /// mean_dual_error, max_active_set_differences, total_active_set_differences.
   std::vector<std::pair<std::string, double>> fields() const;
 
  private:

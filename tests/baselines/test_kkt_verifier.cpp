@@ -193,7 +193,7 @@ BOOST_AUTO_TEST_CASE(summary_takes_componentwise_maxima_and_means) {
   BOOST_TEST(fields.front().second == 3.0);
   bool found = false;
   for (const auto& [key, value] : fields) {
-    if (key != "max_primal_h1") continue;
+    if (key != "max_primal_error") continue;
     found = true;
     BOOST_TEST(value == 3e-2);
   }
