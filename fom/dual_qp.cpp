@@ -65,7 +65,7 @@ Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::Vecto
     const Eigen::VectorXd w = g * lambda - h;
     std::vector<char> next(n, 0);
     for (int i = 0; i < n; ++i) next[i] = eligible[i] && (active[i] ? lambda(i) > -tol : w(i) < -tol);
-    if (next == active && active_gaps_close(w, active, lambda, g, scale)) {
+    if (next == active && active_gaps_close(w, h, active, scale)) {
       // Converged: clean round-off negatives (|λ_i| <= tol) on the active set.
       lambda = lambda.cwiseMax(0.0);
       return lambda;
@@ -85,12 +85,12 @@ Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::Vecto
 
 // Complementarity on the active set: w_i = (Gλ − h)_i vanishes on every active row,
 // to a tolerance above the round-off of a Cholesky solve (relative_tolerance ×
-// kGapSlack, against max(|h|∞, |Gλ|∞)). Only a least-squares solve on a singular
-// subsystem misses it.
-bool DualQpSolver::active_gaps_close(const Eigen::VectorXd& w, const std::vector<char>& active,
-                                     const Eigen::VectorXd& lambda, const Eigen::MatrixXd& g, double scale) const {
+// kGapSlack, against max(|h|∞, |Gλ|∞), with Gλ = w + h). Only a least-squares solve
+// on a singular subsystem misses it.
+bool DualQpSolver::active_gaps_close(const Eigen::VectorXd& w, const Eigen::VectorXd& h,
+                                     const std::vector<char>& active, double scale) const {
   constexpr double kGapSlack = 1e3;
-  const double tol = kGapSlack * m_options.relative_tolerance * std::max(scale, (g * lambda).cwiseAbs().maxCoeff());
+  const double tol = kGapSlack * m_options.relative_tolerance * std::max(scale, (w + h).cwiseAbs().maxCoeff());
   for (int i = 0; i < static_cast<int>(w.size()); ++i)
     if (active[i] && std::abs(w(i)) > tol) return false;
   return true;

@@ -50,8 +50,8 @@ class DualQpSolver {
 
  private:
   bool solve_on(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<int>& set, Eigen::VectorXd& z) const;
-  bool active_gaps_close(const Eigen::VectorXd& w, const std::vector<char>& active, const Eigen::VectorXd& lambda,
-                         const Eigen::MatrixXd& g, double scale) const;
+  bool active_gaps_close(const Eigen::VectorXd& w, const Eigen::VectorXd& h, const std::vector<char>& active,
+                         double scale) const;
   Eigen::VectorXd lawson_hanson(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<char>& eligible);
 
   DualQpOptions m_options;
