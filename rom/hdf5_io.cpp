@@ -310,7 +310,8 @@ void write_file(const std::string& path, const std::function<void(hid_t file, hi
 namespace {
 
 /// Version of the HDF5 superblock of `path`: the byte after the signature, which
-/// sits at offset 0, 512, 1024, 2048, ... (after a user block); -1 if not found.
+/// sits at offset 0, 512, 1024, 2048, ... (after a user block); -1 if there is no
+/// signature (not an HDF5 file, or unreadable), as H5Fis_hdf5 would find.
 int superblock_version(const std::string& path) {
   static const char signature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
   std::ifstream in(path, std::ios::binary);
@@ -328,11 +329,11 @@ hid_t open_file(const std::string& path, const std::string& label, const std::st
   if (!fs::exists(path, ec)) throw InputError(label + " '" + path + "' not found");
   if (fs::is_directory(path, ec)) throw InputError(label + " '" + path + "' is a directory, expected an HDF5 file");
   silence();
-  if (H5Fis_hdf5(path.c_str()) <= 0)
+  const int version = superblock_version(path);
+  if (version < 0)
     throw InputError(label + " '" + path + "' is not an HDF5 file (expected one written by " + expected_writer + ")");
   // Without checksums (superblock versions 0 and 1) a damaged file reaches
   // libhdf5's parsers unchecked; contactrom writes version 2.
-  const int version = superblock_version(path);
   if (version < 2)
     throw InputError(label + " '" + path + "' has HDF5 superblock version " + std::to_string(version) +
                      " (no metadata checksums), expected 2 or later as written by " + expected_writer +
