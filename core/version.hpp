@@ -7,7 +7,7 @@
 
 namespace contactrom {
 
-/// \brief The version, "MAJOR.MINOR.PATCH" (e.g. "0.1.0").
+/// \brief The version, "MAJOR.MINOR.PATCH" (e.g. "0.2.0").
 std::string version();
 
 }  // namespace contactrom
