@@ -13,23 +13,15 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/input_error.hpp"
 #include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 
 namespace fs = std::filesystem;
-using contactrom::InputError;
+using contactrom::test::input_error_of;
 
 namespace {
 
-template <typename F>
-std::string message_of(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 /// A fresh, empty folder under the system's temporary folder, removed at the end.
 struct Folder {
@@ -86,14 +78,14 @@ BOOST_AUTO_TEST_CASE(a_failing_file_of_a_set_leaves_none_and_keeps_the_old_targe
 BOOST_AUTO_TEST_CASE(refused_targets_are_named_and_nothing_is_written) {
   const Folder dir;
   // check_output_path only inspects the target; nothing is written to /dev/null.
-  const std::string m = message_of([] { contactrom::check_output_path("/dev/null"); });
+  const std::string m = input_error_of([] { contactrom::check_output_path("/dev/null"); });
   BOOST_TEST(m.find("'/dev/null': it is a device, pipe or socket") != std::string::npos, m);
-  BOOST_TEST(message_of([] { contactrom::check_output_path(""); }) == "output file name is empty; expected a file name");
-  BOOST_TEST(message_of([&] { contactrom::check_output_path(dir.path.string()); }).find("is a folder") !=
+  BOOST_TEST(input_error_of([] { contactrom::check_output_path(""); }) == "output file name is empty; expected a file name");
+  BOOST_TEST(input_error_of([&] { contactrom::check_output_path(dir.path.string()); }).find("is a folder") !=
              std::string::npos);
   const std::string missing = (dir.path / "no_such_folder" / "out.csv").string();
   const std::string m_missing =
-      message_of([&] { contactrom::write_file_atomically(missing, [](std::ostream& out) { out << "x"; }); });
+      input_error_of([&] { contactrom::write_file_atomically(missing, [](std::ostream& out) { out << "x"; }); });
   BOOST_TEST(m_missing.find("no_such_folder") != std::string::npos, m_missing);
   BOOST_TEST(m_missing.find('\n') == std::string::npos);
   // A symbolic link is refused, and its target is left as it was.
@@ -101,7 +93,7 @@ BOOST_AUTO_TEST_CASE(refused_targets_are_named_and_nothing_is_written) {
   contactrom::write_file_atomically(real.string(), [](std::ostream& out) { out << "kept"; });
   fs::create_symlink(real, link);
   const std::string m_link =
-      message_of([&] { contactrom::write_file_atomically(link.string(), [](std::ostream& out) { out << "x"; }); });
+      input_error_of([&] { contactrom::write_file_atomically(link.string(), [](std::ostream& out) { out << "x"; }); });
   BOOST_TEST(!m_link.empty());
   BOOST_TEST(dir.read("real.txt") == "kept");
   BOOST_TEST(fs::is_symlink(link));
