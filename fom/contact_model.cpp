@@ -163,7 +163,8 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
   } scratch;
   // Deformed master nodes and, for the distances, per segment: tangent t, midpoint,
   // 1/|t|² and the radius of a circle about the midpoint holding the segment
-  // (½(|t_x|+|t_y|) ≥ ½|t|, no root); `prepare` fills segments j0 … j1−1.
+  // (½(|t_x|+|t_y|) ≥ ½|t|, no root); `prepare` fills segments j0 … j1−1 (the
+  // circles only for a full search).
   const int nseg = std::max(nm - 1, 0);
   Eigen::Matrix2Xd& xm = scratch.xm;
   Eigen::Matrix2Xd& seg_t = scratch.seg_t;
@@ -175,14 +176,15 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
   mid.resize(2, nseg);
   inv_len2.resize(nseg);
   half.resize(nseg);
-  auto prepare = [&](int j0, int j1) {
+  auto prepare = [&](int j0, int j1, bool circles) {
     for (int j = j0; j <= std::min(j1, nm - 1); ++j)
       xm.col(j) = pair.master_x.col(j) + u_surface.segment<2>(2 * pair.master_surface[static_cast<size_t>(j)]);
     for (int j = j0; j < j1; ++j) {
       const Eigen::Vector2d t = xm.col(j + 1) - xm.col(j);
       seg_t.col(j) = t;
-      mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
       inv_len2(j) = 1.0 / t.squaredNorm();
+      if (!circles) continue;  // the settled rows need no pruning
+      mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
       half(j) = 0.5 * (std::abs(t.x()) + std::abs(t.y()));
     }
   };
@@ -237,7 +239,7 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
       const int c = memory->centre[static_cast<size_t>(rows ? rows[r] : pair.row_begin + r)];
       if (c >= 0) c_min = std::min(c_min, c), c_max = std::max(c_max, c);
     }
-    if (c_max >= 0) prepare(std::max(c_min - 2, 0), std::min(c_max + 3, nseg));
+    if (c_max >= 0) prepare(std::max(c_min - 2, 0), std::min(c_max + 3, nseg), false);
     for (int r = 0; r < nrows && settled; ++r) {
       const int k = rows ? rows[r] : pair.row_begin + r, c = memory->centre[static_cast<size_t>(k)];
       if (c < 0) {
@@ -264,7 +266,7 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
   }
 
   if (!settled) {
-    prepare(0, nseg);
+    prepare(0, nseg, true);
     // Bounding circles of blocks of m_block consecutive segments (centre, radius):
     // a block is skipped when its circle is farther than the best distance found
     // (plus the margin when recording, so that skipped segments are known to be
