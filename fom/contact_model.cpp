@@ -163,7 +163,8 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
   } scratch;
   // Deformed master nodes and, for the distances, per segment: tangent t, midpoint,
   // 1/|t|² and the radius of a circle about the midpoint holding the segment
-  // (½(|t_x|+|t_y|) ≥ ½|t|, no root); `prepare` fills segments j0 … j1−1.
+  // (½(|t_x|+|t_y|) ≥ ½|t|, no root); `prepare` fills segments j0 … j1−1 (the
+  // circles only for a full search).
   const int nseg = std::max(nm - 1, 0);
   Eigen::Matrix2Xd& xm = scratch.xm;
   Eigen::Matrix2Xd& seg_t = scratch.seg_t;
@@ -175,21 +176,24 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
   mid.resize(2, nseg);
   inv_len2.resize(nseg);
   half.resize(nseg);
-  auto prepare = [&](int j0, int j1) {
+  auto prepare = [&](int j0, int j1, bool circles) {
     for (int j = j0; j <= std::min(j1, nm - 1); ++j)
       xm.col(j) = pair.master_x.col(j) + u_surface.segment<2>(2 * pair.master_surface[static_cast<size_t>(j)]);
     for (int j = j0; j < j1; ++j) {
       const Eigen::Vector2d t = xm.col(j + 1) - xm.col(j);
       seg_t.col(j) = t;
-      mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
       inv_len2(j) = 1.0 / t.squaredNorm();
+      if (!circles) continue;  // the settled rows need no pruning
+      mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
       half(j) = 0.5 * (std::abs(t.x()) + std::abs(t.y()));
     }
   };
 
   // Closest point of slave position (px, py) on segment j, kept when closer than
   // the best so far; ties (a slave node exactly at a master node) go to the lower
-  // segment index.
+  // segment index. The distance itself (a square root on the critical path) is
+  // taken only where it is used: by the pruning of a full search after each
+  // improvement, by the certificate of a settled row once.
   struct Best {
     double dist2 = std::numeric_limits<double>::max(), root = std::numeric_limits<double>::max();
     int seg = -1;
@@ -202,7 +206,7 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
     const double ex = dx - xi * tx, ey = dy - xi * ty;
     const double dist2 = ex * ex + ey * ey;
     if (dist2 < best.dist2 * (1.0 - 1e-14) || (best.seg >= 0 && dist2 <= best.dist2 * (1.0 + 1e-14) && j < best.seg))
-      best = {dist2, std::sqrt(dist2), j, xi, raw};
+      best = {dist2, best.root, j, xi, raw};
     return dist2;
   };
   auto slave_position = [&](int k) {
@@ -235,7 +239,7 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
       const int c = memory->centre[static_cast<size_t>(rows ? rows[r] : pair.row_begin + r)];
       if (c >= 0) c_min = std::min(c_min, c), c_max = std::max(c_max, c);
     }
-    if (c_max >= 0) prepare(std::max(c_min - 2, 0), std::min(c_max + 3, nseg));
+    if (c_max >= 0) prepare(std::max(c_min - 2, 0), std::min(c_max + 3, nseg), false);
     for (int r = 0; r < nrows && settled; ++r) {
       const int k = rows ? rows[r] : pair.row_begin + r, c = memory->centre[static_cast<size_t>(k)];
       if (c < 0) {
@@ -247,6 +251,7 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
       try_segment(x.x(), x.y(), c, best);
       if (c > 0) try_segment(x.x(), x.y(), c - 1, best);
       if (c + 1 < nseg) try_segment(x.x(), x.y(), c + 1, best);
+      best.root = std::sqrt(best.dist2);
       const double a = (u_surface.segment<2>(2 * k) - memory->slave_reference.col(k)).norm();
       settled = memory->clearance[static_cast<size_t>(k)] - a - b > best.root * (1.0 + 1e-12);
 
@@ -261,7 +266,7 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
   }
 
   if (!settled) {
-    prepare(0, nseg);
+    prepare(0, nseg, true);
     // Bounding circles of blocks of m_block consecutive segments (centre, radius):
     // a block is skipped when its circle is farther than the best distance found
     // (plus the margin when recording, so that skipped segments are known to be
@@ -300,6 +305,7 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
       int ntried = 0;
       auto visit = [&](int j) {
         double d2 = try_segment(px, py, j, best);
+        if (best.seg == j) best.root = std::sqrt(d2);  // closer than before: the pruning's radius
         if (!memory) return;
         for (int t = 0; t < std::min(ntried, kept); ++t)  // insertion into the sorted four
           if (d2 < tried_d2[t]) std::swap(d2, tried_d2[t]), std::swap(j, tried_seg[t]);
@@ -373,27 +379,6 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
   }
 }
 
-bool NodeToSegmentContact::row_entries(const Pairing& p, int k, int (&cols)[6], double (&vals)[6], double& g) const {
-  const int j = p.segment[static_cast<size_t>(k)];
-  g = 0.0;
-  if (j < 0) return false;
-  const Pair& pair = m_pairs[static_cast<size_t>(m_row_pair[static_cast<size_t>(k)])];
-  const double w = m_weights(k), xi = p.xi[static_cast<size_t>(k)];
-  const Eigen::Vector2d n = p.normal.col(k);
-  const Eigen::Vector2d xm = (1.0 - xi) * pair.master_x.col(j) + xi * pair.master_x.col(j + 1);
-  g = w * n.dot(m_slave_x.col(k) - xm);
-  const int a = pair.master_surface[static_cast<size_t>(j)], b = pair.master_surface[static_cast<size_t>(j + 1)];
-  const int c[6] = {2 * k, 2 * k + 1, 2 * a, 2 * a + 1, 2 * b, 2 * b + 1};
-  const double v[6] = {-w * n(0), -w * n(1), w * (1.0 - xi) * n(0), w * (1.0 - xi) * n(1), w * xi * n(0), w * xi * n(1)};
-  // Compressed rows keep their columns ascending: node k, a, b in increasing order.
-  int order[3] = {0, 1, 2};
-  const int node[3] = {k, a, b};
-  std::sort(order, order + 3, [&](int x, int y) { return node[x] < node[y]; });
-  for (int e = 0; e < 3; ++e)
-    for (int d = 0; d < 2; ++d) cols[2 * e + d] = c[2 * order[e] + d], vals[2 * e + d] = v[2 * order[e] + d];
-  return true;
-}
-
 void NodeToSegmentContact::assemble(const Pairing& p, ConstraintMatrix& c, Eigen::VectorXd& g) const {
   std::vector<int> all(m_slave.size());
   for (size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
@@ -403,6 +388,10 @@ void NodeToSegmentContact::assemble(const Pairing& p, ConstraintMatrix& c, Eigen
 void NodeToSegmentContact::assemble_rows(const Pairing& p, const std::vector<int>& rows, ConstraintMatrix& c,
                                          Eigen::VectorXd& g) const {
   // Written straight into the compressed arrays (reused storage, no allocation).
+  // Row k paired with segment j = (a, b) of its pair's master chain: entries −w n on
+  // slave node k, w(1−ξ) n on a and w ξ n on b, and g_k = w n·(X_k − X_m(ξ)) with
+  // the reference coordinates. The rows run through the pairs in order, so the
+  // pair's data is looked up once per run.
   const int nr = static_cast<int>(rows.size());
   g.resize(nr);
   c.resize(nr, static_cast<int>(m_surface_dofs.size()));
@@ -411,13 +400,31 @@ void NodeToSegmentContact::assemble_rows(const Pairing& p, const std::vector<int
   int* inner = c.innerIndexPtr();
   double* value = c.valuePtr();
   int nnz = 0;
+  const Pair* pair = nullptr;
   for (int i = 0; i < nr; ++i) {
     outer[i] = nnz;
-    int cols[6];
-    double vals[6];
-    if (!row_entries(p, rows[static_cast<size_t>(i)], cols, vals, g(i))) continue;
-    for (int e = 0; e < 6; ++e) inner[nnz + e] = cols[e], value[nnz + e] = vals[e];
-    nnz += 6;
+    const int k = rows[static_cast<size_t>(i)], j = p.segment[static_cast<size_t>(k)];
+    g(i) = 0.0;
+    if (j < 0) continue;
+    if (!pair || k < pair->row_begin || k >= pair->row_end) pair = &m_pairs[static_cast<size_t>(m_row_pair[static_cast<size_t>(k)])];
+    const double w = m_weights(k), xi = p.xi[static_cast<size_t>(k)], nx = p.normal(0, k), ny = p.normal(1, k);
+    const double* xa = pair->master_x.data() + 2 * j;  // X_a, then X_b
+    const double xm0 = (1.0 - xi) * xa[0] + xi * xa[2], xm1 = (1.0 - xi) * xa[1] + xi * xa[3];
+    g(i) = w * (nx * (m_slave_x(0, k) - xm0) + ny * (m_slave_x(1, k) - xm1));
+    // The three nodes' entries, sorted by node so that the row's columns ascend.
+    struct Entry {
+      int node;
+      double vx, vy;
+    } e[3] = {{k, -w * nx, -w * ny},
+              {pair->master_surface[static_cast<size_t>(j)], w * (1.0 - xi) * nx, w * (1.0 - xi) * ny},
+              {pair->master_surface[static_cast<size_t>(j + 1)], w * xi * nx, w * xi * ny}};
+    if (e[1].node < e[0].node) std::swap(e[0], e[1]);
+    if (e[2].node < e[1].node) std::swap(e[1], e[2]);
+    if (e[1].node < e[0].node) std::swap(e[0], e[1]);
+    for (const Entry& en : e) {
+      inner[nnz] = 2 * en.node, value[nnz++] = en.vx;
+      inner[nnz] = 2 * en.node + 1, value[nnz++] = en.vy;
+    }
   }
   outer[nr] = nnz;
   c.resizeNonZeros(nnz);

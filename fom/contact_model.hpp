@@ -169,8 +169,6 @@ class NodeToSegmentContact final : public ContactModel {
   /// Both search_rows: every pair's run of the listed rows.
   void search_all(const Eigen::VectorXd& u_surface, const std::vector<int>* rows, const Pairing* hint,
                   SearchMemory* memory, Pairing& p) const;
-  /// The six (column, value) entries of row k and g_k; returns false for an unpaired row.
-  bool row_entries(const Pairing& p, int k, int (&cols)[6], double (&vals)[6], double& g) const;
 
   std::vector<int> m_slave;
   Eigen::Matrix2Xd m_slave_x;  // reference coordinates

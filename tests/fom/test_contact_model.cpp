@@ -2,7 +2,8 @@
 // form on a flat master line and on a master arc (chords of the unit circle), the
 // linearised constraint C(u)u − g(u) under rigid motions and penetration, unpaired
 // rows, several pairs, the searches with a hint, a row subset or a memory (same
-// result as the full search), assemble_rows, the scalar obstacle of the rope, and
+// result as the full search), assemble_rows (a row selection of assemble, the
+// closed-form row in ascending columns whatever the node order), the scalar obstacle of the rope, and
 // the refusal of malformed pairs.
 #define BOOST_TEST_MODULE fom_contact_model
 #include <boost/test/unit_test.hpp>
@@ -251,6 +252,73 @@ BOOST_AUTO_TEST_CASE(assemble_rows_is_a_row_selection_of_assemble) {
   base.fom::ContactModel::assemble_rows(p, rows, generic, g_generic);
   BOOST_TEST((MatrixXd(generic) - MatrixXd(part)).norm() == 0.0);
   BOOST_TEST((g_generic - g_part).norm() == 0.0);
+}
+
+BOOST_AUTO_TEST_CASE(assembled_rows_are_the_formula_in_ascending_columns_whatever_the_node_order) {
+  // Two pairs whose surface node numbers put a row's slave node before, after and
+  // between its master segment's nodes. Pair 0: slaves 0 … 4 on y = 0 over the master
+  // nodes 8, 9, 10 on y = −0.3 (surface nodes 8 …). Pair 1: slaves 5, 6, 7 on y = 0.4
+  // over a master chain made of node 11 and pair 0's slave nodes 4 … 0, so its
+  // segment 11 → 4 has surface nodes 8+ > k > 4 and the others both below k. At 40
+  // random displacements and row subsets, every row of assemble_rows must be the
+  // linearised gap of its pairing: −w n on slave node k, w(1 − ξ) n on a, w ξ n on b,
+  // g = w n·(X_k − X_m(ξ)) in the reference coordinates, with ascending columns.
+  Eigen::Matrix2Xd nodes(2, 12);
+  for (int k = 0; k < 5; ++k) nodes.col(k) = Vector2d(k, 0.0);
+  nodes.col(5) = Vector2d(0.5, 0.4), nodes.col(6) = Vector2d(2.2, 0.4), nodes.col(7) = Vector2d(4.6, 0.4);
+  nodes.col(8) = Vector2d(4.5, -0.3), nodes.col(9) = Vector2d(2.0, -0.3), nodes.col(10) = Vector2d(-0.5, -0.3);
+  nodes.col(11) = Vector2d(5.0, 0.1);
+  const std::vector<fom::ContactPairChains> chains = {{{0, 1, 2, 3, 4}, {8, 9, 10}}, {{5, 6, 7}, {11, 4, 3, 2, 1, 0}}};
+  const fom::NodeToSegmentContact model(nodes, chains);
+  const Eigen::Index n = static_cast<Eigen::Index>(model.surface_dofs().size());
+  BOOST_REQUIRE(n == 2 * 12);
+  std::vector<int> surface_node(12);  // mesh node → surface node
+  for (Eigen::Index i = 0; i < n; i += 2) surface_node[static_cast<size_t>(model.surface_dofs()[static_cast<size_t>(i)] / 2)] = static_cast<int>(i / 2);
+  std::mt19937_64 gen(5);
+  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+  std::bernoulli_distribution keep(0.6);
+  int slave_first = 0, slave_between = 0, slave_last = 0;
+  for (int step = 0; step < 40; ++step) {
+    VectorXd u(n);
+    for (Eigen::Index i = 0; i < n; ++i) u(i) = jitter(gen);
+    const fom::Pairing p = model.search(u);
+    std::vector<int> rows;
+    for (int k = 0; k < 8; ++k)
+      if (step == 0 || keep(gen)) rows.push_back(k);
+    fom::ConstraintMatrix c;
+    VectorXd g;
+    model.assemble_rows(p, rows, c, g);
+    BOOST_REQUIRE(c.rows() == static_cast<Eigen::Index>(rows.size()));
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const int k = rows[i], j = p.segment[static_cast<size_t>(k)];
+      const auto row = static_cast<Eigen::Index>(i);
+      BOOST_TEST_CONTEXT("step " << step << " row " << k) {
+        BOOST_REQUIRE(j >= 0);  // every slave lies over its master chain
+        const std::vector<int>& master = chains[static_cast<size_t>(model.pair_of_row(k))].master;
+        const int a = master[static_cast<size_t>(j)], b = master[static_cast<size_t>(j + 1)];
+        const double w = model.weights()(k), xi = p.xi[static_cast<size_t>(k)];
+        const Vector2d normal = p.normal.col(k);
+        VectorXd expected = VectorXd::Zero(n);
+        expected.segment<2>(2 * surface_node[static_cast<size_t>(k)]) = -w * normal;
+        expected.segment<2>(2 * surface_node[static_cast<size_t>(a)]) = w * (1.0 - xi) * normal;
+        expected.segment<2>(2 * surface_node[static_cast<size_t>(b)]) = w * xi * normal;
+        int previous = -1, at = 0, slave_at = -1;
+        for (fom::ConstraintMatrix::InnerIterator it(c, row); it; ++it, ++at) {
+          BOOST_TEST(it.col() > previous);
+          previous = static_cast<int>(it.col());
+          BOOST_TEST(std::abs(it.value() - expected(it.col())) <= 1e-15);
+          if (it.col() == 2 * surface_node[static_cast<size_t>(k)]) slave_at = at / 2;
+        }
+        BOOST_TEST(at == 6);
+        (slave_at == 0 ? slave_first : slave_at == 1 ? slave_between : slave_last) += 1;
+        const Vector2d x_m = (1.0 - xi) * nodes.col(a) + xi * nodes.col(b);
+        BOOST_TEST(std::abs(g(row) - w * normal.dot(nodes.col(k) - x_m)) <= 1e-15);
+      }
+    }
+  }
+  BOOST_TEST(slave_first > 0);
+  BOOST_TEST(slave_between > 0);
+  BOOST_TEST(slave_last > 0);
 }
 
 BOOST_AUTO_TEST_CASE(restrict_to_surface_gathers_the_surface_dofs) {
