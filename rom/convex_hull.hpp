@@ -209,6 +209,10 @@ struct ConvexHullResult {
   int focuss_iterations = 0;         ///< nnFOCUSS iterations, summed over the pairing loop
   int nnls_iterations = 0;           ///< NNLS active-set changes, summed
   int pairing_iterations = 0;        ///< solves in the pairing fixed point (1 without pairing)
+  fom::Pairing pairing;              ///< the pairing of the last solve (empty without pairing)
+  /// fom::pairing_change() of the result, the pairing fixed point's stopping test
+  /// (0 without pairing; ∞ if the first solve failed).
+  double pairing_change = 0.0;
 };
 
 /// \brief The convex-hull online solver (registry name "convex-hull"); see the file comment.
