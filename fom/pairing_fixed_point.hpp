@@ -10,7 +10,7 @@
 ///
 /// Algorithm, on the surface displacement \f$ x \f$ (n_s):
 ///  1. pair at \f$ x \f$ (ContactModel::search_rows, seeded by the previous
-///     pairing) and assemble \f$ C, g \f$;
+///     pairing, with a SearchMemory of the loop's searches) and assemble \f$ C, g \f$;
 ///  2. solve at that pairing (the caller's exact QP solve) →
 ///     \f$ \lambda \f$ and the surface displacement \f$ F(x) \f$ of the solution;
 ///  3. re-pair at \f$ F(x) \f$ → \f$ C', g' \f$ and stop when the KKT system of the
@@ -113,10 +113,16 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
   AndersonMixer mixer(options.anderson_depth);
   ConstraintMatrix c_next;
   Eigen::VectorXd g_next;
+  Pairing next;
+  // The iterates move less and less: the memory settles most rows of the two
+  // searches per iteration without searching the whole master chain, with the
+  // full search's result.
+  SearchMemory memory;
+  bool assembled = false;  // out.c, out.g already hold the operator of `pairing`
   out.status = Status::NoConvergence;
   for (int it = 0; it < options.max_iterations; ++it) {
     ++out.iterations;
-    contact.assemble(pairing, out.c, out.g);
+    if (!assembled) contact.assemble(pairing, out.c, out.g);
     out.solution = solve_at(pairing, out.c, out.g, x);
     out.pairing = pairing;
     if (out.solution.status != Status::Success) {
@@ -129,7 +135,7 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
       return out;
     }
     const Eigen::VectorXd& f = out.solution.surface_displacement;
-    Pairing next = contact.search_rows(f, nullptr, &pairing);
+    contact.search_rows(f, nullptr, &pairing, memory, next);
     contact.assemble(next, c_next, g_next);
     out.residual = pairing_change(out.c, out.g, c_next, g_next, f, out.solution.lambda, contact.weights(), u_scale,
                                   options.tolerance, options.penetration);
@@ -139,7 +145,14 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
     }
     if (out.solution.map_changed) mixer.clear();
     x = mixer.next(x, f);
-    pairing = contact.search_rows(x, nullptr, &next);
+    assembled = x == f;
+    if (assembled) {  // a plain step (no history yet): the pairing and operator at f are built
+      std::swap(pairing, next);
+      std::swap(out.c, c_next);
+      std::swap(out.g, g_next);
+    } else {
+      contact.search_rows(x, nullptr, &next, memory, pairing);
+    }
   }
   return out;
 }
