@@ -164,6 +164,7 @@ class PairedHullSolve {
 
   VectorXd surface_displacement(const VectorXd& alpha) const { return m_lift_s + m_dict.surface_primal() * alpha; }
   const VectorXd& alpha() const { return m_alpha; }
+  Index num_columns() const { return m_dict.size(); }
   const MatrixXd& projected_operator() const { return m_a; }  ///< Bᵀ K_mono of the last solve
   const VectorXd& projected_rhs() const { return m_bf; }
   Status status() const { return m_status; }  ///< of the last solve
@@ -193,6 +194,49 @@ class PairedHullSolve {
   int m_full_solves = 0, m_focuss_iterations = 0, m_nnls_iterations = 0;
   Status m_status = Status::Success;
 };
+
+/// Outcome of run_pairing_fixed_point().
+struct HullFixedPoint {
+  fom::PairingFixedPointResult last;  ///< the last run of the shared fixed point
+  int iterations = 0;                 ///< solves in all its runs
+  bool settled = false;               ///< converged, and the re-selection kept the support
+  std::string message;                ///< why not, when the solves succeeded but it did not settle
+};
+
+/// The pairing fixed point shared with the FOM (fom/pairing_fixed_point.hpp) on the
+/// surface displacement x = u_s, from the centroid of the hull, each solve the exact
+/// projected solve at its pairing (`solve_at`). Once it settles on a frozen
+/// support, one full solve at the settled pairing re-selects; a different support
+/// continues the fixed point from there, within the same budget.
+HullFixedPoint run_pairing_fixed_point(const fom::ContactModel& contact, double u_scale,
+                                       const ConvexHullOptions& options, PairedHullSolve& solve_at) {
+  const fom::PairingFixedPointOptions fp_options = pairing_options(options);
+  const Index m = solve_at.num_columns();
+  HullFixedPoint out;
+  VectorXd x = solve_at.surface_displacement(VectorXd::Constant(m, 1.0 / static_cast<double>(m)));
+  fom::Pairing pairing = contact.search(x);
+  for (;;) {
+    fom::PairingFixedPointOptions remaining = fp_options;
+    remaining.max_iterations = fp_options.max_iterations - out.iterations;
+    out.last = fom::solve_pairing_fixed_point(contact, u_scale, x, pairing, remaining, solve_at);
+    out.iterations += out.last.iterations;
+    if (out.last.status == Status::NoConvergence) {
+      out.message = fom::pairing_no_convergence_message(out.last, fp_options);
+      return out;
+    }
+    if (out.last.status != Status::Success || !solve_at.may_reselect() || solve_at.reselect()) {
+      out.settled = out.last.status == Status::Success;
+      return out;
+    }
+    if (out.iterations >= fp_options.max_iterations) {
+      out.message = "convex-hull support changed when re-selected at the settled pairing, with none of the " +
+                    std::to_string(fp_options.max_iterations) + " pairing iterations left";
+      return out;
+    }
+    x = solve_at.surface_displacement(solve_at.alpha());
+    pairing = contact.search_rows(x, nullptr, &out.last.pairing);
+  }
+}
 
 }  // namespace
 
@@ -344,44 +388,22 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
   const ConvexHullOptions& opt = dict.options();
   const ReducedModel& model = dict.model();
   const fom::ContactModel& contact = model.problem().contact();
-  const Index m = dict.size();
 
   ConvexHullResult res;
   OnlineResult& on = res.online;
   on.mu = mu;
 
-  // The pairing fixed point shared with the FOM (fom/pairing_fixed_point.hpp) on
-  // the surface displacement x = u_s, from the centroid of the hull; each solve is
-  // the exact projected solve at its pairing (PairedHullSolve). Once it settles on a
-  // frozen support, one full solve at the settled pairing re-selects; a different
-  // support continues the fixed point from there, within the same budget.
+  // The pairing fixed point around the exact projected solve at each pairing.
   PairedHullSolve solve_at(dict, mu);
-  const fom::PairingFixedPointOptions fp_options = pairing_options(opt);
-  VectorXd x = solve_at.surface_displacement(VectorXd::Constant(m, 1.0 / static_cast<double>(m)));
-  fom::Pairing pairing = contact.search(x);
-  fom::PairingFixedPointResult fp;
-  bool budget_spent = false;
-  for (;;) {
-    fom::PairingFixedPointOptions remaining = fp_options;
-    remaining.max_iterations = fp_options.max_iterations - res.pairing_iterations;
-    fp = fom::solve_pairing_fixed_point(contact, model.problem().displacement_scale(), x, pairing, remaining,
-                                        solve_at);
-    res.pairing_iterations += fp.iterations;
-    if (fp.status != Status::Success || !solve_at.may_reselect() || solve_at.reselect()) break;
-    if (res.pairing_iterations >= fp_options.max_iterations) {
-      budget_spent = true;
-      break;
-    }
-    x = solve_at.surface_displacement(solve_at.alpha());
-    pairing = contact.search_rows(x, nullptr, &fp.pairing);
-  }
+  const HullFixedPoint fp = run_pairing_fixed_point(contact, model.problem().displacement_scale(), opt, solve_at);
   res.alpha = solve_at.alpha();
   res.focuss_iterations = solve_at.focuss_iterations();
   res.nnls_iterations = solve_at.nnls_iterations();
-  res.pairing = fp.pairing;
-  res.pairing_change = fp.residual;
+  res.pairing_iterations = fp.iterations;
+  res.pairing = fp.last.pairing;
+  res.pairing_change = fp.last.residual;
   const Status status = solve_at.status();
-  const bool settled = fp.status == Status::Success && !budget_spent;
+  const bool settled = fp.settled;
 
   const std::vector<Index> support = nonzeros(res.alpha);
   on.selected.assign(support.begin(), support.end());
@@ -417,9 +439,7 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
     on.message = text;
   } else if (status == Status::Success && !settled) {
     on.status = Status::NoConvergence;
-    on.message = budget_spent ? "convex-hull support changed when re-selected at the settled pairing, with no pairing "
-                                "iteration left of " + std::to_string(opt.max_pairing_iterations)
-                              : fom::pairing_no_convergence_message(fp, fp_options);
+    on.message = fp.message;
   } else if (status == Status::NoConvergence) {
     on.message = "nnFOCUSS reached its cap of " + std::to_string(opt.focuss.max_iterations) + " iterations";
   } else if (status != Status::Success) {
