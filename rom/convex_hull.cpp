@@ -120,7 +120,7 @@ class PairedHullSolve {
  public:
   PairedHullSolve(const MonolithicDictionary& dict, const fom::Param& mu)
       : m_dict(dict), m_bk(dict.projected_stiffness(mu)), m_bf(dict.projected_rhs(mu)),
-        m_lift_s(dict.surface_lifting(mu)) {}
+        m_lift_s(dict.constant_contact() ? VectorXd() : dict.surface_lifting(mu)) {}
 
   fom::PairedSolution operator()(const fom::Pairing&, const fom::ConstraintMatrix& c, const VectorXd&,
                                  const VectorXd&) {
@@ -144,6 +144,7 @@ class PairedHullSolve {
     // An nnFOCUSS cap still leaves an exact polished α on the simplex: the pairing
     // goes on, and status() reports the cap at the end.
     out.status = m_status == Status::NoConvergence ? Status::Success : m_status;
+    if (constant) return out;  // no pairing: the fixed point reads neither
     out.surface_displacement = surface_displacement(m_alpha);
     out.lambda = m_dict.dual() * m_alpha;
     return out;
@@ -186,7 +187,7 @@ class PairedHullSolve {
   const MonolithicDictionary& m_dict;
   const MatrixXd m_bk;      // Bᵀ K(μ) D_p
   const VectorXd m_bf;      // Bᵀ f(μ)
-  const VectorXd m_lift_s;  // u_lift(μ) on the surface
+  const VectorXd m_lift_s;  // u_lift(μ) on the surface (with pairing only)
   MatrixXd m_a;             // Bᵀ K_mono of the last solve
   VectorXd m_alpha;
   std::vector<Index> m_support;  // of the last full solve, frozen once m_frozen
@@ -210,9 +211,17 @@ struct HullFixedPoint {
 /// continues the fixed point from there, within the same budget.
 HullFixedPoint run_pairing_fixed_point(const fom::ContactModel& contact, double u_scale,
                                        const ConvexHullOptions& options, PairedHullSolve& solve_at) {
+  HullFixedPoint out;
+  if (!contact.has_pairing()) {  // constant contact block: one solve, no operator to build
+    const fom::PairedSolution solution = solve_at(fom::Pairing{}, fom::ConstraintMatrix{}, VectorXd{}, VectorXd{});
+    out.last.status = solution.status;
+    out.last.residual = 0.0;
+    out.iterations = 1;
+    out.settled = true;
+    return out;
+  }
   const fom::PairingFixedPointOptions fp_options = pairing_options(options);
   const Index m = solve_at.num_columns();
-  HullFixedPoint out;
   VectorXd x = solve_at.surface_displacement(VectorXd::Constant(m, 1.0 / static_cast<double>(m)));
   fom::Pairing pairing = contact.search(x);
   for (;;) {
