@@ -6,33 +6,57 @@ namespace contactrom {
 
 AndersonMixer::AndersonMixer(int depth) : m_depth(std::max(depth, 0)) {}
 
-Eigen::VectorXd AndersonMixer::next(const Eigen::VectorXd& x, const Eigen::VectorXd& f) {
-  const Eigen::VectorXd r = f - x;
-  if (m_started) {
-    if (r.norm() > m_r_prev.norm()) m_df.clear(), m_dr.clear();  // restart on growth
-    m_df.push_back(f - m_f_prev);
-    m_dr.push_back(r - m_r_prev);
-    if (static_cast<int>(m_df.size()) > m_depth) m_df.erase(m_df.begin()), m_dr.erase(m_dr.begin());
+void AndersonMixer::reset(int depth) {
+  clear();
+  depth = std::max(depth, 0);
+  if (depth != m_depth) m_depth = depth, m_df.resize(0, 0), m_dr.resize(0, 0);  // sized again by the next call
+}
+
+void AndersonMixer::size_for(Eigen::Index n) {
+  if (m_df.rows() == n && m_df.cols() == m_depth) return;
+  m_df.setZero(n, m_depth), m_dr.setZero(n, m_depth);
+  m_gram.setIdentity(m_depth, m_depth);
+  m_rhs.setZero(m_depth), m_gamma.setZero(m_depth);
+  m_ldlt = Eigen::LDLT<Eigen::MatrixXd>(m_depth);
+  m_r.resize(n);
+  clear();  // the history, if any, was of vectors of another length
+}
+
+void AndersonMixer::next(const Eigen::VectorXd& x, const Eigen::VectorXd& f, Eigen::VectorXd& out) {
+  size_for(x.size());
+  m_r = f - x;  // before `out` is written: it may be x
+  if (m_started && m_depth > 0) {
+    if (m_r.norm() > m_r_prev.norm()) restart();  // restart on growth
+    int slot;
+    if (m_count < m_depth) {
+      slot = (m_oldest + m_count) % m_depth, ++m_count;
+    } else {  // full: the newest difference replaces the oldest
+      slot = m_oldest, m_oldest = (m_oldest + 1) % m_depth;
+    }
+    m_df.col(slot) = f - m_f_prev;
+    m_dr.col(slot) = m_r - m_r_prev;
   }
   m_started = true;
   m_f_prev = f;
-  m_r_prev = r;
-  Eigen::VectorXd out = f;
-  if (m_dr.empty()) return out;
-  // Least-squares γ = argmin |r − ΔR γ| by the normal equations (at most `depth`
-  // columns; a pivoted LDLᵀ drops dependent differences).
-  const int m = static_cast<int>(m_dr.size());
-  Eigen::MatrixXd gram(m, m);
-  Eigen::VectorXd rhs(m);
-  for (int a = 0; a < m; ++a) {
-    rhs(a) = m_dr[a].dot(r);
-    for (int b = 0; b <= a; ++b) gram(a, b) = gram(b, a) = m_dr[a].dot(m_dr[b]);
+  m_r_prev = m_r;
+  if (m_count == 0) {
+    if (&out != &f) out = f;
+    return;
   }
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(gram);
-  const Eigen::VectorXd gamma = ldlt.solve(rhs);
-  if (ldlt.info() != Eigen::Success || !gamma.allFinite()) return out;
-  for (int a = 0; a < m; ++a) out.noalias() -= gamma(a) * m_df[a];
-  return out;
+  // Least-squares γ = argmin |r − ΔR γ| by the normal equations, oldest difference
+  // first; the columns beyond m_count are the identity with a zero right-hand side.
+  const auto column = [&](int a) { return (m_oldest + a) % m_depth; };
+  m_gram.setIdentity();
+  m_rhs.setZero();
+  for (int a = 0; a < m_count; ++a) {
+    m_rhs(a) = m_dr.col(column(a)).dot(m_r);
+    for (int b = 0; b <= a; ++b) m_gram(a, b) = m_gram(b, a) = m_dr.col(column(a)).dot(m_dr.col(column(b)));
+  }
+  m_ldlt.compute(m_gram);
+  m_gamma = m_ldlt.solve(m_rhs);
+  if (&out != &f) out = f;
+  if (m_ldlt.info() != Eigen::Success || !m_gamma.allFinite()) return;
+  for (int a = 0; a < m_count; ++a) out.noalias() -= m_gamma(a) * m_df.col(column(a));
 }
 
 }  // namespace contactrom

@@ -10,7 +10,7 @@
 #include <fstream>
 
 #include "core/errors.hpp"
-#include "fom/input_values.hpp"
+#include "core/format.hpp"
 
 namespace contactrom {
 namespace {

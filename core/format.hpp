@@ -1,7 +1,8 @@
 #pragma once
 /// \file format.hpp
 /// \brief Text helpers shared by the libraries and the CLI: numbers written so that
-/// they read back exactly, and comma-separated lists.
+/// they read back exactly, comma-separated lists, and quoted input for messages.
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,11 @@ std::string format_number(double value);
 
 /// \brief `items` separated by `separator` (default ", "): {"a", "b"} → "a, b".
 std::string join(const std::vector<std::string>& items, const std::string& separator = ", ");
+
+/// \brief `text` between single quotes, fit for a one-line message: control
+/// bytes are written as `\xNN`, and text beyond `max_length` bytes is cut
+/// and marked with "... (N bytes)".
+std::string quoted(const std::string& text, std::size_t max_length = 80);
 
 namespace fom {
 using contactrom::format_number;  // the name it had when it lived in fom/parameter_space.hpp

@@ -53,24 +53,6 @@ std::string Interval::text() const {
   return "a finite number";
 }
 
-std::string quoted(const std::string& text, std::size_t max_length) {
-  std::string out = "'";
-  const size_t shown = std::min(text.size(), max_length);
-  for (size_t i = 0; i < shown; ++i) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    if (c < 0x20 || c == 0x7f) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  out += "'";
-  if (shown < text.size()) out += "... (" + std::to_string(text.size()) + " bytes)";
-  return out;
-}
-
 double parse_number(const std::string& text, const std::string& what) {
   const std::string t = trim_blanks(text);
   if (t.empty()) throw InputError(what + " " + quoted(text) + " is empty; expected a number");

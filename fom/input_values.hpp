@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/format.hpp"  // quoted()
 #include "fom/problem.hpp"
 
 namespace contactrom {
@@ -37,11 +38,6 @@ struct Interval {
   static Interval at_least(double a) { return {a, std::numeric_limits<double>::infinity(), false, false}; }
   static Interval greater_than(double a) { return {a, std::numeric_limits<double>::infinity(), true, false}; }
 };
-
-/// \brief `text` between single quotes, fit for a one-line message: control
-/// bytes are written as `\xNN`, and text beyond `max_length` bytes is cut
-/// and marked with "... (N bytes)".
-std::string quoted(const std::string& text, std::size_t max_length = 80);
 
 /// \brief Parses `text` as one finite number.
 /// \param what how the value is named in messages, e.g. "--tau" or "parameter d".

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "core/version.hpp"
 #include "fom/input_values.hpp"
 #include "python/bindings.hpp"
 
@@ -98,6 +99,7 @@ PYBIND11_MODULE(_contactrom, m) {
   namespace py = pybind11;
   using namespace contactrom;
   m.doc() = "contactrom: reduced-order models of contact problems (C++ core)";
+  m.attr("__version__") = version();
 
   // Bad input → ValueError with the CLI's one-line message; anything else the C++
   // side throws (std::bad_alloc aside) is a RuntimeError, as pybind11 does by default.

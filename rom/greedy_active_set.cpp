@@ -38,7 +38,7 @@ T greedy_choice(const std::string& key, const std::string& value,
 }
 
 /// Alg. 1's elimination: position of the most negative multiplier, −1 if none is.
-int most_negative(const Eigen::VectorXd& lambda) {
+int most_negative(const Eigen::Ref<const Eigen::VectorXd>& lambda) {
   int at = -1;
   double lowest = 0.0;
   for (int i = 0; i < lambda.size(); ++i)
@@ -179,6 +179,12 @@ struct GreedyActiveSet::Query {
   Query(const GreedyActiveSet& solver, const fom::Param& mu)
       : solver(solver), k_inv(solver.m_model, mu), operators(solver.m_options.time_operators), ops(thread_operators()) {
     ops.reset(solver.m_options.rebuild == OperatorRebuild::Partial);
+    if (solver.m_options.best_iterate_on_failure) {  // sized here, so that offer() does not allocate
+      const int m = solver.m_model.dictionary_size();
+      best.u_hat.resize(solver.m_model.primal_rank());
+      best.lambda_i.reserve(static_cast<size_t>(m));
+      best.selected.reserve(static_cast<size_t>(m));
+    }
   }
   /// The operators' storage of the calling thread, reused by its queries (the
   /// pairing, the search memory and C_R hold a few dozen arrays).
@@ -226,32 +232,38 @@ struct GreedyActiveSet::Query {
     return (u_hat - x).norm() <= solver.m_options.step_tolerance * u_hat.norm();
   }
 
-  /// Best iterate with λ̂ ≥ 0 so far (smallest largest violation), for the iteration cap.
+  /// Best iterate with λ̂ ≥ 0 so far (smallest largest violation), for the iteration
+  /// cap; in storage sized by the constructor.
   struct {
     bool valid = false;
     double violation = 0.0;
-    Eigen::VectorXd u_hat, lambda_i;
+    Eigen::VectorXd u_hat;
+    std::vector<double> lambda_i;
     std::vector<int> selected;
   } best;
-  void offer(double max_violation, const Eigen::VectorXd& u, const Eigen::VectorXd& l, const std::vector<int>& s) {
+  void offer(double max_violation, const Eigen::VectorXd& u, const Eigen::Ref<const Eigen::VectorXd>& l,
+             const std::vector<int>& s) {
     if (!solver.m_options.best_iterate_on_failure || (best.valid && max_violation >= best.violation)) return;
     best.valid = true;
     best.violation = max_violation;
     best.u_hat = u;
-    best.lambda_i = l;
+    best.lambda_i.assign(l.data(), l.data() + l.size());
     best.selected = s;
   }
-  /// Stores the outcome: the last iterate, or the best one when `use_best` and one exists.
-  void finish(bool use_best, Eigen::VectorXd& u, Eigen::VectorXd& l, std::vector<int>& s) {
+  /// Stores the outcome (copies: the schedule keeps its storage for the thread's next
+  /// query): the last iterate, or the best one when `use_best` and one exists.
+  void finish(bool use_best, const Eigen::VectorXd& u, const Eigen::Ref<const Eigen::VectorXd>& l,
+              const std::vector<int>& s) {
     if (use_best && best.valid) {
-      u.swap(best.u_hat);
-      l.swap(best.lambda_i);
-      s.swap(best.selected);
       best_iterate_returned = true;
+      u_hat = best.u_hat;
+      lambda_i = Eigen::Map<const Eigen::VectorXd>(best.lambda_i.data(), static_cast<Eigen::Index>(best.lambda_i.size()));
+      selected = best.selected;
+      return;
     }
-    u_hat = std::move(u);
-    lambda_i = std::move(l);
-    selected = std::move(s);
+    u_hat = u;
+    lambda_i = l;
+    selected = s;
   }
 };
 
@@ -314,19 +326,26 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   return res;
 }
 
-Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur,
-                                  const Eigen::Ref<const Eigen::VectorXd>& rhs, double singular_tolerance) {
+void schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur, const Eigen::Ref<const Eigen::VectorXd>& rhs,
+                       double singular_tolerance, Eigen::Ref<Eigen::VectorXd> lambda) {
   using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 16, 16>;
   thread_local Eigen::LDLT<Small> small;
   thread_local Eigen::LDLT<Eigen::MatrixXd> large;
   if (schur.rows() <= 16) {
     small.compute(schur);
-    if (small.info() == Eigen::Success && small.rcond() > singular_tolerance) return small.solve(rhs);
+    if (small.info() == Eigen::Success && small.rcond() > singular_tolerance) return void(lambda = small.solve(rhs));
   } else {
     large.compute(schur);
-    if (large.info() == Eigen::Success && large.rcond() > singular_tolerance) return large.solve(rhs);
+    if (large.info() == Eigen::Success && large.rcond() > singular_tolerance) return void(lambda = large.solve(rhs));
   }
-  return schur.completeOrthogonalDecomposition().solve(rhs);
+  lambda = schur.completeOrthogonalDecomposition().solve(rhs);
+}
+
+Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur,
+                                  const Eigen::Ref<const Eigen::VectorXd>& rhs, double singular_tolerance) {
+  Eigen::VectorXd lambda(rhs.size());
+  schur_multipliers(schur, rhs, singular_tolerance, lambda);
+  return lambda;
 }
 
 /// The interleaved schedule's state between its steps (paper Alg. 1 with the
@@ -339,9 +358,9 @@ struct GreedyActiveSet::Interleaved {
     u_hat = q->u_start, x = q->u_start, active = q->start_columns;
     in_active.assign(static_cast<size_t>(g->m_model.dictionary_size()), 0);
     for (int p : active) in_active[static_cast<size_t>(p)] = 1;
-    mixer = fom::AndersonMixer(g->m_options.anderson_depth);
+    mixer.reset(g->m_options.anderson_depth);
     seen.clear();
-    solved.clear(), lambda_i.resize(0);
+    solved.clear(), n_lambda = 0;
     pending = false, removed = added = -1, max_violation = 0.0;
     const int r = g->m_model.primal_rank();
     if (c_hat_i.cols() != r) c_hat_i.resize(0, r), w.resize(r, 0);  // another model: grown again by solve()
@@ -349,13 +368,17 @@ struct GreedyActiveSet::Interleaved {
   }
   const GreedyActiveSet* g = nullptr;
   Query* q = nullptr;
-  Eigen::VectorXd u_hat, lambda_i;
+  Eigen::VectorXd u_hat;
   Eigen::VectorXd x;    // where the operators are built (û^{k−1} in Alg. 1)
   Eigen::VectorXd u_s;  // Φ_s x + u_off,s
   Eigen::VectorXd gap, violation, rhs;
-  // Ĉ_I, K̂⁻¹Ĉ_Iᵀ and S in storage that only grows: the leading |I| rows/columns are used.
+  // Ĉ_I, K̂⁻¹Ĉ_Iᵀ, S and λ̂_I in storage that only grows: the leading |I| rows/columns are used.
   RowMajorMatrix c_hat_i;
   Eigen::MatrixXd w, schur;
+  Eigen::VectorXd lambda_storage;
+  int n_lambda = 0;  // |I| of the last solve
+  /// λ̂_I of the last solve.
+  Eigen::VectorBlock<Eigen::VectorXd> lambda_i() { return lambda_storage.head(n_lambda); }
   SupportRows::RowsScratch rows;  // rows of C_R Φ_s shared by the selected columns
   std::vector<int> active, solved;  // the selection, and the one of the last solve
   std::vector<char> in_active;
@@ -381,16 +404,16 @@ struct GreedyActiveSet::Interleaved {
     const int na = static_cast<int>(active.size()), r = g->m_model.primal_rank();
     if (c_hat_i.rows() < na) {
       const int cap = std::max(2 * static_cast<int>(c_hat_i.rows()), std::max(na, 4));
-      c_hat_i.resize(cap, r), w.resize(r, cap), schur.resize(cap, cap), rhs.resize(cap);
+      c_hat_i.resize(cap, r), w.resize(r, cap), schur.resize(cap, cap), rhs.resize(cap), lambda_storage.resize(cap);
     }
     // Rows of Ĉ_I = D_Iᵀ C_R Φ_s and entries of ĝ_I = D_Iᵀ (g_R − C_R u_off,s), from
     // the rows where each selected column is non-zero.
     q->operators.start();
     g->m_support.reduced_rows(active, q->ops.c, q->ops.g, g->m_model.surface_basis_rows(), q->lift_s, c_hat_i, rhs, rows);
     q->operators.stop();
+    n_lambda = na;
     if (na == 0) {
       u_hat = q->u_free;
-      lambda_i.resize(0);
     } else {
       const auto c_hat = c_hat_i.topRows(na);
       auto w_i = w.leftCols(na);
@@ -398,11 +421,12 @@ struct GreedyActiveSet::Interleaved {
       schur.topLeftCorner(na, na).noalias() = c_hat * w_i;
       for (int i = 0; i < na; ++i) rhs(i) = c_hat.row(i).dot(q->u_free) - rhs(i);  // Ĉ_I K̂⁻¹ f̂ − ĝ_I
       // |I| > r: min-norm
-      lambda_i = schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), g->m_options.singular_tolerance);
-      u_hat.noalias() = q->u_free - w_i * lambda_i;
+      schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), g->m_options.singular_tolerance, lambda_i());
+      u_hat = q->u_free;
+      u_hat.noalias() -= w_i * lambda_i();
     }
     solved = active;
-    return u_hat.allFinite() && lambda_i.allFinite();
+    return u_hat.allFinite() && lambda_i().allFinite();
   }
 
   /// Step 3: one change — remove the most negative multiplier, else add the column
@@ -412,7 +436,7 @@ struct GreedyActiveSet::Interleaved {
     q->surface_displacement(u_hat, u_s);
     added = -1;
     max_violation = 0.0;
-    removed = most_negative(lambda_i);
+    removed = most_negative(lambda_i());
     if (removed >= 0) {
       in_active[static_cast<size_t>(active[removed])] = 0;
       active.erase(active.begin() + removed);
@@ -420,7 +444,7 @@ struct GreedyActiveSet::Interleaved {
     }
     g->m_support.violation(q->ops.c, q->ops.g, u_s, gap, violation);
     if (violation.size() > 0) max_violation = violation.maxCoeff();
-    q->offer(max_violation, u_hat, lambda_i, solved);
+    q->offer(max_violation, u_hat, lambda_i(), solved);
     added = most_violated(violation, in_active, g->m_threshold);
     if (added < 0) return false;
     in_active[static_cast<size_t>(added)] = 1;
@@ -436,20 +460,20 @@ struct GreedyActiveSet::Interleaved {
   void next_rebuild_point(bool changed) {
     pending = !changed && q->small_step(u_hat, x);
     if (changed || pending) {
-      mixer = fom::AndersonMixer(g->m_options.anderson_depth);
+      mixer.reset(g->m_options.anderson_depth);
       x = u_hat;
     } else {
-      x = mixer.next(x, u_hat);
+      mixer.next(x, u_hat, x);
       if (x != u_hat) q->surface_displacement(x, u_s);  // else u_s is û's already
     }
   }
 
   /// One line per iteration for GreedyOptions::trace.
-  void trace(int k, bool changed) const {
+  void trace(int k, bool changed) {
     std::ostream* out = g->m_options.trace;
     if (!out) return;
     const int na = static_cast<int>(solved.size());
-    *out << "greedy k=" << k + 1 << " |I|=" << na << " min(lambda)=" << (na ? lambda_i.minCoeff() : 0.0)
+    *out << "greedy k=" << k + 1 << " |I|=" << na << " min(lambda)=" << (na ? lambda_i().minCoeff() : 0.0)
          << " max(violation)=" << max_violation << " step=" << (u_hat - x).norm() / std::max(u_hat.norm(), 1e-300)
          << " -> ";
     if (removed >= 0)
@@ -503,19 +527,25 @@ void GreedyActiveSet::solve_interleaved(Query& q, OnlineResult& res) const {
     if (changed && m_options.nested_on_cycle && k + 1 < k_max && revisits(s.seen, s.solved, s.active))
       return s.hand_over_to_nested(res, k);
   }
-  q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i, s.solved);
+  q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i(), s.solved);
 }
 
 /// The nested schedule's state between its steps.
 struct GreedyActiveSet::Nested {
-  Nested(const GreedyActiveSet& solver, Query& q)
-      : g(solver), q(q), dr(solver.m_support.basis), x(q.u_start), u_hat(q.u_start),
-        in_active(static_cast<size_t>(solver.m_model.dictionary_size()), 0), mixer(solver.m_options.anderson_depth) {
-    for (int p : q.start_columns) {  // filled by make_column once the operators exist
+  /// Starts a query: the start's selection and û, x = û. The state of a thread is
+  /// reused by its queries (storage only: every field is set here or before use).
+  void start(const GreedyActiveSet& solver, Query& query) {
+    g = &solver, q = &query, dr = &solver.m_support.basis;
+    x = q->u_start, u_hat = q->u_start;
+    in_active.assign(static_cast<size_t>(g->m_model.dictionary_size()), 0);
+    while (!cols.empty()) spare.push_back(std::move(cols.back())), cols.pop_back();
+    for (int p : q->start_columns) {  // filled by make_column once the operators exist
       in_active[static_cast<size_t>(p)] = 1;
-      cols.emplace_back();
-      cols.back().p = p;
+      take_spare().p = p;
     }
+    mixer.reset(g->m_options.anderson_depth);
+    seen.clear(), solved.clear();
+    n_lambda = 0, pending = false, finite = true, solves = 0;
   }
   /// A selected column p with the operators frozen: its row Ĉ_p = d_pᵀ A of Ĉ_I,
   /// w_p = K̂⁻¹ Ĉ_pᵀ and z_p = D_dᵀ C_s Φ_s w_p, the change of every column's
@@ -526,45 +556,58 @@ struct GreedyActiveSet::Nested {
     Eigen::MatrixXd w;  // r × 1
     Eigen::VectorXd z;
   };
-  const GreedyActiveSet& g;
-  Query& q;
-  const Eigen::MatrixXd& dr;  // D_d on the support rows R, |R| × m
-  std::vector<Column> cols, spare;  // selected columns; removed ones, kept for their storage
+  const GreedyActiveSet* g = nullptr;
+  Query* q = nullptr;
+  const Eigen::MatrixXd* dr = nullptr;  // D_d on the support rows R, |R| × m
+  std::vector<Column> cols, spare;  // selected columns; unused ones, kept for their storage
   RowMajorMatrix a;        // A = C_R Φ_s (|R| × r)
   Eigen::VectorXd b;       // C_R u_off,s − g_R: A û + b is the gap on R
   Eigen::VectorXd v_free;  // every column's violation at u_free, D_Rᵀ (A u_free + b)
-  Eigen::VectorXd gap, aw, violation, lambda_i, rhs, x, u_hat, u_s;
+  Eigen::VectorXd gap, aw, violation, rhs, x, u_hat, u_s;
+  // S and λ̂_I in storage that only grows: the leading |I| rows/columns are used.
   Eigen::MatrixXd schur;
+  Eigen::VectorXd lambda_storage;
+  int n_lambda = 0;  // |I| of the last solve
   std::vector<char> in_active;
   std::vector<int> solved;
   SelectionHistory seen;  // selections met on the current operators
-  fom::AndersonMixer mixer;
+  fom::AndersonMixer mixer{0};
   bool pending = false;  // settled: to be confirmed at the fresh pairing of û
   bool finite = true;    // every solve so far gave finite values
   int solves = 0;
+
+  /// λ̂_I of the last solve.
+  Eigen::VectorBlock<Eigen::VectorXd> lambda_i() { return lambda_storage.head(n_lambda); }
+  /// Appends a column to the selection, in the storage of an unused one if any.
+  Column& take_spare() {
+    if (spare.empty()) spare.emplace_back();
+    cols.push_back(std::move(spare.back()));
+    spare.pop_back();
+    return cols.back();
+  }
 
   /// Fills `col` for dictionary column p on the current operators (its vectors keep
   /// their storage from one rebuild to the next).
   void make_column(Column& col, int p) {
     col.p = p;
-    q.operators.start();  // Ĉ_p is the operator; w_p and z_p belong to the solve
-    col.c_hat.setZero(g.m_model.primal_rank());
-    for (int i : g.m_support.column_support[static_cast<size_t>(p)]) col.c_hat.noalias() += dr(i, p) * a.row(i);
-    q.operators.stop();
-    q.k_inv.apply(col.c_hat.transpose(), col.w);
+    q->operators.start();  // Ĉ_p is the operator; w_p and z_p belong to the solve
+    col.c_hat.setZero(g->m_model.primal_rank());
+    for (int i : g->m_support.column_support[static_cast<size_t>(p)]) col.c_hat.noalias() += (*dr)(i, p) * a.row(i);
+    q->operators.stop();
+    q->k_inv.apply(col.c_hat.transpose(), col.w);
     aw.noalias() = a * col.w.col(0);
-    col.z.noalias() = dr.transpose() * aw;
+    col.z.noalias() = dr->transpose() * aw;
   }
 
   /// After a rebuild: A = C_R Φ_s, b = C_R u_off,s − g_R, every column's violation at
   /// u_free, and the selected columns' vectors.
   void freeze_operators() {
-    q.operators.start();
-    g.m_support.gap_operator(q.ops.c, q.ops.g, g.m_model.surface_basis_rows(), q.lift_s, a, b);
-    q.operators.stop();
-    gap.noalias() = a * q.u_free;
+    q->operators.start();
+    g->m_support.gap_operator(q->ops.c, q->ops.g, g->m_model.surface_basis_rows(), q->lift_s, a, b);
+    q->operators.stop();
+    gap.noalias() = a * q->u_free;
     gap += b;
-    v_free.noalias() = dr.transpose() * gap;
+    v_free.noalias() = dr->transpose() * gap;
     for (auto& col : cols) make_column(col, col.p);
   }
 
@@ -572,28 +615,29 @@ struct GreedyActiveSet::Nested {
   /// columns' vectors. False on a non-finite value.
   bool solve() {
     const int na = static_cast<int>(cols.size());
-    u_hat = q.u_free;
+    u_hat = q->u_free;
     violation = v_free;
-    lambda_i.resize(na);
+    if (schur.rows() < na) {
+      const int cap = std::max(2 * static_cast<int>(schur.rows()), std::max(na, 4));
+      schur.resize(cap, cap), rhs.resize(cap), lambda_storage.resize(cap);
+    }
+    n_lambda = na;
     if (na > 0) {
-      if (schur.rows() < na) {  // storage that only grows; the leading |I| entries are used
-        const int cap = std::max(2 * static_cast<int>(schur.rows()), std::max(na, 4));
-        schur.resize(cap, cap), rhs.resize(cap);
-      }
+      auto lambda = lambda_i();
       for (int i = 0; i < na; ++i) {
         rhs(i) = v_free(cols[i].p);  // Ĉ_i u_free − ĝ_i
         for (int j = 0; j <= i; ++j) schur(i, j) = schur(j, i) = cols[i].c_hat.dot(cols[j].w.col(0));
       }
-      lambda_i = schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), g.m_options.singular_tolerance);
+      schur_multipliers(schur.topLeftCorner(na, na), rhs.head(na), g->m_options.singular_tolerance, lambda);
       for (int i = 0; i < na; ++i) {
-        u_hat.noalias() -= lambda_i(i) * cols[i].w.col(0);
-        violation.noalias() -= lambda_i(i) * cols[i].z;
+        u_hat.noalias() -= lambda(i) * cols[i].w.col(0);
+        violation.noalias() -= lambda(i) * cols[i].z;
       }
     }
     ++solves;
     solved.resize(static_cast<size_t>(na));
     for (int i = 0; i < na; ++i) solved[static_cast<size_t>(i)] = cols[i].p;
-    return u_hat.allFinite() && lambda_i.allFinite();
+    return u_hat.allFinite() && lambda_i().allFinite();
   }
 
   /// Steps 2–3 repeated on the frozen operators until nothing changes, a selection
@@ -602,14 +646,14 @@ struct GreedyActiveSet::Nested {
   bool settle(int rebuild) {
     bool changed = false;
     seen.clear();
-    while (solves < g.m_options.max_solves) {
+    while (solves < g->m_options.max_solves) {
       if (!(finite = solve())) break;
-      const int remove = most_negative(lambda_i);
+      const int remove = most_negative(lambda_i());
       const double max_violation = violation.size() > 0 ? violation.maxCoeff() : 0.0;
       int add = -1;
       if (remove < 0) {
-        q.offer(max_violation, u_hat, lambda_i, solved);
-        add = most_violated(violation, in_active, g.m_threshold);
+        q->offer(max_violation, u_hat, lambda_i(), solved);
+        add = most_violated(violation, in_active, g->m_threshold);
       }
       trace_step(rebuild, remove, add, max_violation);
       if (remove >= 0) {
@@ -618,10 +662,7 @@ struct GreedyActiveSet::Nested {
         cols.erase(cols.begin() + remove);
       } else if (add >= 0) {
         in_active[static_cast<size_t>(add)] = 1;
-        if (spare.empty()) spare.emplace_back();
-        cols.push_back(std::move(spare.back()));
-        spare.pop_back();
-        make_column(cols.back(), add);
+        make_column(take_spare(), add);
       } else {
         break;
       }
@@ -636,25 +677,25 @@ struct GreedyActiveSet::Nested {
   /// while the selection is unchanged (a smooth fixed point in x).
   void next_rebuild_point(bool changed, int rebuild) {
     const double step = (u_hat - x).norm(), size = u_hat.norm();
-    if (g.m_options.trace)
-      *g.m_options.trace << "greedy rebuild=" << rebuild << " step=" << step / std::max(size, 1e-300) << "\n";
-    if (!changed && step <= g.m_options.step_tolerance * size) {
+    if (g->m_options.trace)
+      *g->m_options.trace << "greedy rebuild=" << rebuild << " step=" << step / std::max(size, 1e-300) << "\n";
+    if (!changed && step <= g->m_options.step_tolerance * size) {
       pending = true;
       x = u_hat;
     } else if (!changed) {
-      x = mixer.next(x, u_hat);
+      mixer.next(x, u_hat, x);
     } else {
-      mixer = fom::AndersonMixer(g.m_options.anderson_depth);
+      mixer.reset(g->m_options.anderson_depth);
       x = u_hat;
     }
   }
 
-  void trace_step(int rebuild, int remove, int add, double max_violation) const {
-    std::ostream* out = g.m_options.trace;
+  void trace_step(int rebuild, int remove, int add, double max_violation) {
+    std::ostream* out = g->m_options.trace;
     if (!out) return;
     const int na = static_cast<int>(cols.size());
     *out << "greedy rebuild=" << rebuild << " solve=" << solves << " |I|=" << na
-         << " min(lambda)=" << (na ? lambda_i.minCoeff() : 0.0) << " max(violation)=" << max_violation << " -> ";
+         << " min(lambda)=" << (na ? lambda_i().minCoeff() : 0.0) << " max(violation)=" << max_violation << " -> ";
     if (remove >= 0)
       *out << "remove " << cols[remove].p;
     else if (add >= 0)
@@ -666,7 +707,8 @@ struct GreedyActiveSet::Nested {
 };
 
 void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds) const {
-  Nested s(*this, q);
+  thread_local Nested s;  // its storage serves the thread's next queries
+  s.start(*this, q);
   for (int rebuild = 0;; ++rebuild) {
     // 1. Operators at x (surface rows only); a settled û is confirmed at its own pairing.
     q.surface_displacement(s.x, s.u_s);
@@ -690,7 +732,7 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds
     s.next_rebuild_point(changed, rebuild);
   }
   res.iterations = s.solves;
-  q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i, s.solved);
+  q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i(), s.solved);
 }
 
 }  // namespace contactrom::rom

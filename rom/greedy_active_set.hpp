@@ -208,7 +208,12 @@ double greedy_threshold(const ReducedModel& model, const GreedyOptions& options)
 /// S (|I| × |I|): S⁻¹ rhs by LDLᵀ, or — when S is numerically singular (LDLᵀ failure
 /// or reciprocal condition ≤ `singular_tolerance`, e.g. dependent rows) — the
 /// least-squares, minimum-norm solution. The factorisation lives in per-thread
-/// storage of fixed size while |I| ≤ 16, so the online steps do not allocate it.
+/// storage of fixed size while |I| ≤ 16, so the online steps do not allocate it
+/// (the minimum-norm fallback does).
+/// \param lambda the multipliers (size |I|)
+void schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur, const Eigen::Ref<const Eigen::VectorXd>& rhs,
+                       double singular_tolerance, Eigen::Ref<Eigen::VectorXd> lambda);
+/// \returns the multipliers, as schur_multipliers(schur, rhs, singular_tolerance, lambda).
 Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur,
                                   const Eigen::Ref<const Eigen::VectorXd>& rhs, double singular_tolerance);
 

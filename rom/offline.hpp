@@ -22,6 +22,7 @@
 
 #include "core/parallel_for.hpp"
 #include "core/progress_bar.hpp"
+#include "core/version.hpp"
 #include "fom/active_set_solver.hpp"
 #include "fom/problem.hpp"
 #include "rom/snapshot_database.hpp"
@@ -31,8 +32,8 @@ namespace contactrom::rom {
 /// \brief Options of generate_snapshots (documented defaults).
 struct OfflineOptions {
   int threads = 0;  ///< worker threads; ≤ 0: std::thread::hardware_concurrency(). Default 0.
-  /// Label written as the `created_by` attribute. Default "contactrom 0.1.0".
-  std::string created_by = "contactrom 0.1.0";
+  /// Label written as the `created_by` attribute. Default "contactrom " + version().
+  std::string created_by = "contactrom " + version();
   ProgressCallback progress;  ///< called after every snapshot (optional)
 };
 

@@ -10,6 +10,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/errors.hpp"
+#include "core/version.hpp"
 #include "fom/kkt.hpp"
 #include "rom/dense_csv.hpp"
 #include "rom/hdf5_io.hpp"
@@ -59,7 +60,7 @@ void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
   const int version = kReducedModelFormatVersion;
   hdf5::write_string_attribute(f, "kind", kKind);
   hdf5::write_scalar_attribute(f, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &version);
-  hdf5::write_string_attribute(f, "created_by", std::string("contactrom ") + CONTACTROM_VERSION);
+  hdf5::write_string_attribute(f, "created_by", "contactrom " + contactrom::version());
   hdf5::write_string_attribute(f, "method", rom.method());
   hdf5::write_scalar_attribute(f, "delta", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &d.options.delta);
   hdf5::write_string_attribute(f, "lifting", lifting_name(d.options.lifting));

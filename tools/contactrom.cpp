@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "core/errors.hpp"
+#include "core/version.hpp"
 #include "fom/input_values.hpp"
 #include "tools/cli.hpp"
 #ifdef CONTACTROM_HAVE_MPI
@@ -31,7 +32,7 @@ int main(int argc, char** argv) {
   using namespace contactrom;
   CLI::App app{"contactrom: sparse dictionary reduced-order models for frictionless contact"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "contactrom 0.1.0");
+  app.set_version_flag("--version", "contactrom " + version());
   auto& table = cli::command_table();
   std::sort(table.begin(), table.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   for (auto& entry : table) entry.setup(app);

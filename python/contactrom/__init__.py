@@ -5,6 +5,7 @@ see docs/python.md. Bad input raises ValueError with the one-line message the
 command-line tool prints; a solver that returns no solution at all raises
 RuntimeError; numerical non-convergence is a ``status`` of the result.
 """
+from ._contactrom import __version__  # the C++ library's version
 from ._contactrom import (
     FomSolution,
     FullOrderSolver,

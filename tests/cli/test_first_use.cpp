@@ -1,7 +1,8 @@
 // What a new user meets first: every command is documented in the README, every
 // help text lists its choices instead of pointing into the sources, the bench
-// table keeps each name apart from its value, and a training size a problem
-// cannot honour is refused rather than silently replaced.
+// table keeps each name apart from its value, a training size a problem cannot
+// honour is refused rather than silently replaced, and one version is reported
+// everywhere.
 #define BOOST_TEST_MODULE cli_first_use
 #include <boost/test/unit_test.hpp>
 #include <algorithm>
@@ -13,6 +14,8 @@
 #include <vector>
 
 #include "common/run_command.hpp"
+#include "core/version.hpp"
+#include "rom/snapshot_database.hpp"
 
 using contactrom::test::run_command;
 using contactrom::test::slurp;
@@ -97,4 +100,19 @@ BOOST_AUTO_TEST_CASE(a_training_size_the_problem_cannot_honour_is_refused) {
   BOOST_TEST(r.out.empty());
   BOOST_TEST(r.err.find("--train") != std::string::npos, r.err);
   BOOST_TEST(!std::ifstream(out).good(), "a database was written");
+}
+
+BOOST_AUTO_TEST_CASE(one_version_everywhere) {
+  // The build's project version, as the library, `--version` and the files the CLI
+  // writes report it (Python's contactrom.__version__: tests/python/test_quiet.py).
+  const std::string expected = CONTACTROM_PROJECT_VERSION;
+  BOOST_TEST(contactrom::version() == expected);
+  const auto r = run_command(kExe + " --version");
+  BOOST_TEST(r.exit_code == 0);
+  BOOST_TEST(r.out == "contactrom " + expected + "\n");
+  const std::string db = "/tmp/contactrom_first_use_version.h5";
+  const auto offline = run_command(kExe + " offline --problem hertz --train 3 --threads 1 --out " + db);
+  BOOST_REQUIRE_MESSAGE(offline.exit_code == 0, offline.err);
+  BOOST_TEST(contactrom::rom::read_database(db).created_by == "contactrom " + expected);
+  std::remove(db.c_str());
 }

@@ -1,12 +1,13 @@
 // core/format.hpp: format_number writes the shortest text that reads back as the same
 // double (checked by reading it back, and on decimals that need few digits); join puts
-// the separator between items only.
+// the separator between items only; quoted escapes control bytes and cuts long text.
 #define BOOST_TEST_MODULE core_format
 #include <boost/test/unit_test.hpp>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <random>
+#include <string>
 
 #include "core/format.hpp"
 
@@ -38,4 +39,11 @@ BOOST_AUTO_TEST_CASE(join_separates_items_only) {
   BOOST_TEST(join({"a"}) == "a");
   BOOST_TEST(join({"a", "b", "c"}) == "a, b, c");
   BOOST_TEST(join({"d", "", "e"}, ",") == "d,,e");
+}
+
+BOOST_AUTO_TEST_CASE(quoted_cuts_and_escapes) {
+  BOOST_TEST(contactrom::quoted("a\x01\x1b" "b") == "'a\\x01\\x1bb'");
+  const std::string q = contactrom::quoted(std::string(5000000, 'x'));
+  BOOST_TEST(q.size() < 120u);
+  BOOST_TEST(q.find("(5000000 bytes)") != std::string::npos);
 }

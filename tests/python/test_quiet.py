@@ -1,7 +1,11 @@
-"""The module writes nothing on stdout (a Python program owns its stdout)."""
+"""The module writes nothing on stdout (a Python program owns its stdout), and
+reports the version of the C++ library it wraps."""
 import os
 import subprocess
 import sys
+
+import contactrom
+from conftest import run_cli
 
 SCRIPT = """
 import contactrom
@@ -27,3 +31,8 @@ def test_nothing_on_stdout(tmp_path):
                           env=dict(os.environ), timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == ""
+
+
+def test_version_is_the_command_line_tool_s():
+    assert run_cli("--version").stdout == f"contactrom {contactrom.__version__}\n"
+    assert contactrom.__version__.count(".") == 2

@@ -14,6 +14,7 @@
 #include <string>
 #include <unistd.h>
 
+#include "common/input_error.hpp"
 #include "core/errors.hpp"
 #include "fom/problem.hpp"
 #include "rom/snapshot_database.hpp"
@@ -22,6 +23,7 @@ namespace fs = std::filesystem;
 using contactrom::InputError;
 using contactrom::Status;
 using contactrom::rom::SnapshotDatabase;
+using contactrom::test::input_error_of;
 
 namespace {
 
@@ -79,17 +81,6 @@ SnapshotDatabase synthetic(int n_snap, int n_dofs, int n_c) {
 bool bitwise_equal(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return a.rows() == b.rows() && a.cols() == b.cols() &&
          std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0;
-}
-
-/// The message of the InputError thrown by f (empty if none).
-template <typename F>
-std::string input_error_of(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 /// The h5py cases need /usr/bin/python3 with h5py and numpy (tools/setup.sh

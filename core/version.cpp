@@ -1,0 +1,7 @@
+#include "core/version.hpp"
+
+namespace contactrom {
+
+std::string version() { return CONTACTROM_VERSION; }
+
+}  // namespace contactrom
