@@ -112,10 +112,12 @@ fom::PairingFixedPointOptions pairing_options(const ConvexHullOptions& options) 
 /// constant block without pairing), returning u_s = u_lift,s + D_p,s α and
 /// λ = D_d α. Two phases. Selection: full solves (nnFOCUSS over all columns) until
 /// the support repeats or `selection_iterations` full solves are spent. Then the
-/// support is frozen and only α is re-solved on it, a smooth map in which the
-/// pairing settles: re-selecting at every step lets near-tied supports alternate
-/// for ever. Anderson mixing acts on u_s only, to choose the pairing; α is always
-/// an exact solve, hence on the simplex, and is never extrapolated.
+/// support is frozen and only α is re-solved on it (a column a solve drops stays
+/// out), a smooth map in which the pairing settles: re-selecting at every step lets
+/// near-tied supports alternate for ever. Every change of the support is reported
+/// as PairedSolution::map_changed, so that the Anderson history of the old map is
+/// dropped. Anderson mixing acts on u_s only, to choose the pairing; α is always an
+/// exact solve, hence on the simplex, and is never extrapolated.
 class PairedHullSolve {
  public:
   PairedHullSolve(const MonolithicDictionary& dict, const fom::Param& mu)
@@ -190,7 +192,7 @@ class PairedHullSolve {
   const VectorXd m_lift_s;  // u_lift(μ) on the surface (with pairing only)
   MatrixXd m_a;             // Bᵀ K_mono of the last solve
   VectorXd m_alpha;
-  std::vector<Index> m_support;  // of the last full solve, frozen once m_frozen
+  std::vector<Index> m_support;  // of the last solve; once m_frozen, the columns solved on
   bool m_frozen = false, m_last_full = true;
   int m_full_solves = 0, m_focuss_iterations = 0, m_nnls_iterations = 0;
   Status m_status = Status::Success;
