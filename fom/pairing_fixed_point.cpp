@@ -9,14 +9,14 @@ namespace contactrom::fom {
 
 double pairing_change(const ConstraintMatrix& c, const Eigen::VectorXd& g, const ConstraintMatrix& c_next,
                       const Eigen::VectorXd& g_next, const Eigen::VectorXd& u_s, const Eigen::VectorXd& lambda,
-                      const Eigen::VectorXd& weights, double u_scale, double tolerance) {
+                      const Eigen::VectorXd& weights, double u_scale, double tolerance, bool penetration) {
   const Eigen::VectorXd force = c.transpose() * lambda;
   const double force_scale = std::max(force.norm(), 1e-300);
   double change = (c_next.transpose() * lambda - force).norm() / force_scale;
   const Eigen::VectorXd v = (c * u_s - g).cwiseQuotient(weights);
   const Eigen::VectorXd v_next = (c_next * u_s - g_next).cwiseQuotient(weights);
   for (Eigen::Index s = 0; s < v.size(); ++s) {
-    change = std::max(change, v_next(s) / u_scale);  // penetration under the new pairing
+    if (penetration) change = std::max(change, v_next(s) / u_scale);  // penetration under the new pairing
     if (lambda(s) > 0.0 || v(s) > -tolerance * u_scale) change = std::max(change, std::abs(v_next(s) - v(s)) / u_scale);
   }
   return change;

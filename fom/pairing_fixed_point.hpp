@@ -1,7 +1,8 @@
 #pragma once
 /// \file pairing_fixed_point.hpp
 /// \brief The contact pairing fixed point shared by the FOM solvers
-/// (fom::ActiveSetSolver, baselines::IpoptQpSolver): the constraint operator
+/// (fom::ActiveSetSolver, baselines::IpoptQpSolver) and the convex-hull ROM
+/// (rom::ConvexHullSolver): the constraint operator
 /// \f$ C(u), g(u) \f$ of node-to-segment contact depends on the deformed
 /// configuration, so the QP "minimise the energy subject to \f$ C u_s \le g \f$" is
 /// solved at a fixed pairing and the pairing is recomputed from its solution until
@@ -9,17 +10,20 @@
 ///
 /// Algorithm, on the surface displacement \f$ x \f$ (n_s):
 ///  1. pair at \f$ x \f$ (ContactModel::search_rows, seeded by the previous
-///     pairing) and assemble \f$ C, g \f$;
+///     pairing, with a SearchMemory of the loop's searches) and assemble \f$ C, g \f$;
 ///  2. solve at that pairing (the caller's exact QP solve) →
 ///     \f$ \lambda \f$ and the surface displacement \f$ F(x) \f$ of the solution;
 ///  3. re-pair at \f$ F(x) \f$ → \f$ C', g' \f$ and stop when the KKT system of the
 ///     solution is unchanged (pairing_change() ≤ `tolerance`);
 ///  4. otherwise \f$ x \leftarrow \f$ Anderson mixing of \f$ x, F(x) \f$
-///     (AndersonMixer, Walker & Ni 2011, type II, depth `anderson_depth`) and go to 1.
+///     (AndersonMixer, Walker & Ni 2011, type II, depth `anderson_depth`) and go to 1;
+///     a solve that reports PairedSolution::map_changed (a reduced solver changed
+///     the columns it solves on, so F itself changed) drops the history first.
 ///
 /// The QP is always solved exactly: the extrapolated \f$ x \f$ only chooses the
 /// pairing, so a converged result is a KKT point of its own pairing whatever the
-/// acceleration did. Models without pairing (obstacles) take one solve.
+/// acceleration did (for the convex-hull ROM: an exact projected solve, α on the
+/// simplex). Models without pairing (obstacles) take one solve.
 ///
 /// Stopping test (pairing_change()): with \f$ v = (C u_s - g)/w \f$ and
 /// \f$ v' = (C' u_s - g')/w \f$ the gaps per tributary length w under the old and new
@@ -29,6 +33,14 @@
 /// A the rows that carry pressure (\f$ \lambda_s > 0 \f$) or are within
 /// tolerance·U of contact: the contact forces, the gaps that matter and the
 /// penetration must each be unchanged to `tolerance` (relative).
+///
+/// The penetration term asks more than an unchanged pairing: that the solution be
+/// feasible under the new pairing, which an exact QP solution is (to rounding) once
+/// its pairing has settled. A reduced solution is not: a convex combination of
+/// snapshots computed with other pairings penetrates slightly (hertz: up to 4e-5 U)
+/// whatever its pairing, so with the term the test could never pass. Such callers
+/// set PairingFixedPointOptions::penetration = false: the test then measures only
+/// what re-pairing changes — forces and gaps — with the same meaning of `tolerance`.
 #include <Eigen/Dense>
 #include <limits>
 #include <string>
@@ -45,6 +57,10 @@ struct PairingFixedPointOptions {
   int max_iterations = 300;   ///< cap on the solves (pairing iterations). Default 300.
   double tolerance = 1e-12;   ///< stop when pairing_change() ≤ this (relative). Default 1e-12.
   int anderson_depth = 10;    ///< Anderson depth (0: plain fixed-point iteration). Default 10.
+  /// Whether the penetration under the new pairing is part of pairing_change() (see
+  /// the file comment): true for exact solves, false for reduced solutions, which
+  /// penetrate slightly whatever their pairing. Default true.
+  bool penetration = true;
 };
 
 /// \brief What the solve at a fixed pairing returns to the fixed point.
@@ -52,6 +68,10 @@ struct PairedSolution {
   Status status = Status::Success;         ///< anything but Success stops the fixed point
   Eigen::VectorXd surface_displacement;    ///< \f$ F(x) \f$: u on the surface dofs at the solution (n_s)
   Eigen::VectorXd lambda;                  ///< pressure per constraint row (n_c); > 0 marks the rows that carry force
+  /// The solve's map x ↦ F(x) changed since the previous solve (a reduced solver
+  /// changed the columns it solves on): the Anderson history is dropped, and the
+  /// next iterate is F(x) itself. Exact solvers leave it false.
+  bool map_changed = false;
 };
 
 /// \brief Outcome of solve_pairing_fixed_point().
@@ -75,9 +95,10 @@ struct PairingFixedPointResult {
 /// \param weights tributary length per row (ContactModel::weights())
 /// \param u_scale displacement scale U of the problem
 /// \param tolerance rows within tolerance·U of contact count as touching
+/// \param penetration include the term \f$ \max_s \max(v'_s, 0)/U \f$ (PairingFixedPointOptions::penetration)
 double pairing_change(const ConstraintMatrix& c, const Eigen::VectorXd& g, const ConstraintMatrix& c_next,
                       const Eigen::VectorXd& g_next, const Eigen::VectorXd& u_s, const Eigen::VectorXd& lambda,
-                      const Eigen::VectorXd& weights, double u_scale, double tolerance);
+                      const Eigen::VectorXd& weights, double u_scale, double tolerance, bool penetration = true);
 
 /// \brief Runs the pairing fixed point (see the file comment) from the surface
 /// displacement `x` and its pairing `pairing`.
@@ -92,10 +113,16 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
   AndersonMixer mixer(options.anderson_depth);
   ConstraintMatrix c_next;
   Eigen::VectorXd g_next;
+  Pairing next;
+  // The iterates move less and less: the memory settles most rows of the two
+  // searches per iteration without searching the whole master chain, with the
+  // full search's result.
+  SearchMemory memory;
+  bool assembled = false;  // out.c, out.g already hold the operator of `pairing`
   out.status = Status::NoConvergence;
   for (int it = 0; it < options.max_iterations; ++it) {
     ++out.iterations;
-    contact.assemble(pairing, out.c, out.g);
+    if (!assembled) contact.assemble(pairing, out.c, out.g);
     out.solution = solve_at(pairing, out.c, out.g, x);
     out.pairing = pairing;
     if (out.solution.status != Status::Success) {
@@ -108,16 +135,24 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
       return out;
     }
     const Eigen::VectorXd& f = out.solution.surface_displacement;
-    Pairing next = contact.search_rows(f, nullptr, &pairing);
+    contact.search_rows(f, nullptr, &pairing, memory, next);
     contact.assemble(next, c_next, g_next);
     out.residual = pairing_change(out.c, out.g, c_next, g_next, f, out.solution.lambda, contact.weights(), u_scale,
-                                  options.tolerance);
+                                  options.tolerance, options.penetration);
     if (out.residual <= options.tolerance) {
       out.status = Status::Success;
       return out;
     }
+    if (out.solution.map_changed) mixer.clear();
     x = mixer.next(x, f);
-    pairing = contact.search_rows(x, nullptr, &next);
+    assembled = x == f;
+    if (assembled) {  // a plain step (no history yet): the pairing and operator at f are built
+      std::swap(pairing, next);
+      std::swap(out.c, c_next);
+      std::swap(out.g, g_next);
+    } else {
+      contact.search_rows(x, nullptr, &next, memory, pairing);
+    }
   }
   return out;
 }

@@ -4,12 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <random>
-#include <set>
 
-#include "core/anderson.hpp"
 #include "fom/input_values.hpp"
+#include "fom/pairing_fixed_point.hpp"
 #include "rom/online_methods.hpp"
 #include "rom/pod.hpp"
 
@@ -95,6 +93,160 @@ ProjectedSolve solve_projected(const MatrixXd& a, const VectorXd& b, const Conve
     }
   }
   return out;
+}
+
+/// The shared pairing fixed point's settings from the convex-hull options. The
+/// penetration term is left out of its stopping test: a convex combination of
+/// snapshots penetrates slightly whatever its pairing (fom/pairing_fixed_point.hpp).
+fom::PairingFixedPointOptions pairing_options(const ConvexHullOptions& options) {
+  fom::PairingFixedPointOptions o;
+  o.max_iterations = options.max_pairing_iterations;
+  o.tolerance = options.pairing_tolerance;
+  o.anderson_depth = options.anderson_depth;
+  o.penetration = false;
+  return o;
+}
+
+/// The exact solve at one pairing, the `solve_at` of fom::solve_pairing_fixed_point():
+/// the projected problem with that pairing's contact block (B_s^T C^T D_d, or the
+/// constant block without pairing), returning u_s = u_lift,s + D_p,s α and
+/// λ = D_d α. Two phases. Selection: full solves (nnFOCUSS over all columns) until
+/// the support repeats or `selection_iterations` full solves are spent. Then the
+/// support is frozen and only α is re-solved on it (a column a solve drops stays
+/// out), a smooth map in which the pairing settles: re-selecting at every step lets
+/// near-tied supports alternate for ever. Every change of the support is reported
+/// as PairedSolution::map_changed, so that the Anderson history of the old map is
+/// dropped. Anderson mixing acts on u_s only, to choose the pairing; α is always an
+/// exact solve, hence on the simplex, and is never extrapolated.
+class PairedHullSolve {
+ public:
+  PairedHullSolve(const MonolithicDictionary& dict, const fom::Param& mu)
+      : m_dict(dict), m_bk(dict.projected_stiffness(mu)), m_bf(dict.projected_rhs(mu)),
+        m_lift_s(dict.constant_contact() ? VectorXd() : dict.surface_lifting(mu)) {}
+
+  fom::PairedSolution operator()(const fom::Pairing&, const fom::ConstraintMatrix& c, const VectorXd&,
+                                 const VectorXd&) {
+    const MatrixXd* constant = m_dict.constant_contact();
+    m_a = m_bk + (constant ? *constant : m_dict.projected_contact(c));
+    m_last_full = !m_frozen;
+    if (m_frozen) {
+      const ProjectedSolve step = count(solve_projected(select_columns(m_a, m_support), m_bf, m_dict.options()));
+      m_alpha.setZero(m_dict.size());
+      for (std::size_t i = 0; i < m_support.size(); ++i) m_alpha(m_support[i]) = step.alpha(static_cast<Index>(i));
+    } else {
+      m_alpha = full_solve();
+    }
+    std::vector<Index> support = nonzeros(m_alpha);  // frozen: a column dropped stays out
+    const bool same_support = support == m_support;
+    if (!m_frozen)
+      m_frozen = (m_full_solves > 1 && same_support) || m_full_solves >= m_dict.options().selection_iterations;
+    m_support = std::move(support);
+    fom::PairedSolution out;
+    out.map_changed = !same_support;
+    // An nnFOCUSS cap still leaves an exact polished α on the simplex: the pairing
+    // goes on, and status() reports the cap at the end.
+    out.status = m_status == Status::NoConvergence ? Status::Success : m_status;
+    if (constant) return out;  // no pairing: the fixed point reads neither
+    out.surface_displacement = surface_displacement(m_alpha);
+    out.lambda = m_dict.dual() * m_alpha;
+    return out;
+  }
+
+  /// Whether the last solve was on a frozen support that a full solve may re-select.
+  bool may_reselect() const { return !m_last_full && m_full_solves < m_dict.options().selection_iterations; }
+  /// One full solve at the last solve's pairing. True when it selects the frozen
+  /// support again (α is kept); otherwise α and the frozen support become its.
+  bool reselect() {
+    VectorXd alpha = full_solve();
+    std::vector<Index> support = nonzeros(alpha);
+    if (m_status == Status::NumericalIssue || support == m_support) return true;
+    m_alpha = std::move(alpha);
+    m_support = std::move(support);
+    return false;
+  }
+
+  VectorXd surface_displacement(const VectorXd& alpha) const { return m_lift_s + m_dict.surface_primal() * alpha; }
+  const VectorXd& alpha() const { return m_alpha; }
+  Index num_columns() const { return m_dict.size(); }
+  const MatrixXd& projected_operator() const { return m_a; }  ///< Bᵀ K_mono of the last solve
+  const VectorXd& projected_rhs() const { return m_bf; }
+  Status status() const { return m_status; }  ///< of the last solve
+  int focuss_iterations() const { return m_focuss_iterations; }
+  int nnls_iterations() const { return m_nnls_iterations; }
+
+ private:
+  ProjectedSolve count(ProjectedSolve step) {
+    m_focuss_iterations += step.focuss_iterations;
+    m_nnls_iterations += step.nnls_iterations;
+    m_status = step.status;
+    return step;
+  }
+  VectorXd full_solve() {
+    ++m_full_solves;
+    return count(solve_projected(m_a, m_bf, m_dict.options())).alpha;
+  }
+
+  const MonolithicDictionary& m_dict;
+  const MatrixXd m_bk;      // Bᵀ K(μ) D_p
+  const VectorXd m_bf;      // Bᵀ f(μ)
+  const VectorXd m_lift_s;  // u_lift(μ) on the surface (with pairing only)
+  MatrixXd m_a;             // Bᵀ K_mono of the last solve
+  VectorXd m_alpha;
+  std::vector<Index> m_support;  // of the last solve; once m_frozen, the columns solved on
+  bool m_frozen = false, m_last_full = true;
+  int m_full_solves = 0, m_focuss_iterations = 0, m_nnls_iterations = 0;
+  Status m_status = Status::Success;
+};
+
+/// Outcome of run_pairing_fixed_point().
+struct HullFixedPoint {
+  fom::PairingFixedPointResult last;  ///< the last run of the shared fixed point
+  int iterations = 0;                 ///< solves in all its runs
+  bool settled = false;               ///< converged, and the re-selection kept the support
+  std::string message;                ///< why not, when the solves succeeded but it did not settle
+};
+
+/// The pairing fixed point shared with the FOM (fom/pairing_fixed_point.hpp) on the
+/// surface displacement x = u_s, from the centroid of the hull, each solve the exact
+/// projected solve at its pairing (`solve_at`). Once it settles on a frozen
+/// support, one full solve at the settled pairing re-selects; a different support
+/// continues the fixed point from there, within the same budget.
+HullFixedPoint run_pairing_fixed_point(const fom::ContactModel& contact, double u_scale,
+                                       const ConvexHullOptions& options, PairedHullSolve& solve_at) {
+  HullFixedPoint out;
+  if (!contact.has_pairing()) {  // constant contact block: one solve, no operator to build
+    const fom::PairedSolution solution = solve_at(fom::Pairing{}, fom::ConstraintMatrix{}, VectorXd{}, VectorXd{});
+    out.last.status = solution.status;
+    out.last.residual = 0.0;
+    out.iterations = 1;
+    out.settled = true;
+    return out;
+  }
+  const fom::PairingFixedPointOptions fp_options = pairing_options(options);
+  const Index m = solve_at.num_columns();
+  VectorXd x = solve_at.surface_displacement(VectorXd::Constant(m, 1.0 / static_cast<double>(m)));
+  fom::Pairing pairing = contact.search(x);
+  for (;;) {
+    fom::PairingFixedPointOptions remaining = fp_options;
+    remaining.max_iterations = fp_options.max_iterations - out.iterations;
+    out.last = fom::solve_pairing_fixed_point(contact, u_scale, x, pairing, remaining, solve_at);
+    out.iterations += out.last.iterations;
+    if (out.last.status == Status::NoConvergence) {
+      out.message = fom::pairing_no_convergence_message(out.last, fp_options);
+      return out;
+    }
+    if (out.last.status != Status::Success || !solve_at.may_reselect() || solve_at.reselect()) {
+      out.settled = out.last.status == Status::Success;
+      return out;
+    }
+    if (out.iterations >= fp_options.max_iterations) {
+      out.message = "convex-hull support changed when re-selected at the settled pairing, with none of the " +
+                    std::to_string(fp_options.max_iterations) + " pairing iterations left";
+      return out;
+    }
+    x = solve_at.surface_displacement(solve_at.alpha());
+    pairing = contact.search_rows(x, nullptr, &out.last.pairing);
+  }
 }
 
 }  // namespace
@@ -247,114 +399,22 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
   const ConvexHullOptions& opt = dict.options();
   const ReducedModel& model = dict.model();
   const fom::ContactModel& contact = model.problem().contact();
-  const Index m = dict.size();
 
   ConvexHullResult res;
   OnlineResult& on = res.online;
   on.mu = mu;
 
-  const MatrixXd bk = dict.projected_stiffness(mu);
-  const VectorXd bf = dict.projected_rhs(mu);
-  const bool pairing = dict.constant_contact() == nullptr;
-  VectorXd lift_s, u_s;
-  if (pairing) lift_s = dict.surface_lifting(mu);
-
-  // Pairing fixed point α ↦ g(α): pairing from u_s = u_lift,s + D_p,s α, contact
-  // block, projected solve. Two phases. Selection: full solves (nnFOCUSS over all
-  // columns) until the support repeats or `selection_iterations` solves are spent.
-  // Then the support is frozen and only α iterates (the solve restricted to those
-  // columns), a smooth map in which the pairing settles; re-selecting at every step
-  // lets near-tied supports alternate forever. The frozen phase converges linearly
-  // (rate 0.3–0.6 on hertz) and is accelerated by Anderson mixing, which keeps
-  // 1ᵀα = 1 (a combination of iterates with weights summing to one) and is
-  // abandoned for a plain step whenever it would make a coefficient negative. Once
-  // it settles, one more full solve (budget permitting) checks the selection under
-  // the converged pairing.
-  const int cap = pairing ? opt.max_pairing_iterations : 1;
-  fom::ConstraintMatrix c;
-  VectorXd g, x;  // x: the α that defines the pairing (empty: centroid of the hull)
-  MatrixXd a;
-  Status status = Status::Success;
-  bool settled = !pairing, frozen = false;
-  std::vector<Index> support_prev;
-  AndersonMixer mixer(opt.anderson_depth);  // on α, frozen phase only
-  double last_change = std::numeric_limits<double>::infinity();
-  int full_solves = 0;
-  for (int it = 0; it < cap; ++it) {
-    if (pairing) {
-      if (x.size() == 0)
-        u_s = lift_s + dict.surface_primal() * VectorXd::Constant(m, 1.0 / static_cast<double>(m));
-      else
-        u_s = lift_s + dict.surface_primal() * x;
-      contact.assemble(contact.search(u_s), c, g);
-      a = bk + dict.projected_contact(c);
-    } else {
-      a = bk + *dict.constant_contact();
-    }
-    auto full_solve = [&] {
-      ProjectedSolve step = solve_projected(a, bf, opt);
-      res.focuss_iterations += step.focuss_iterations;
-      res.nnls_iterations += step.nnls_iterations;
-      ++full_solves;
-      status = step.status;
-      return std::move(step.alpha);
-    };
-    if (!frozen) {
-      res.alpha = full_solve();
-    } else {
-      ProjectedSolve step = solve_projected(select_columns(a, support_prev), bf, opt);
-      res.focuss_iterations += step.focuss_iterations;
-      res.nnls_iterations += step.nnls_iterations;
-      res.alpha.setZero(m);
-      for (std::size_t i = 0; i < support_prev.size(); ++i) res.alpha(support_prev[i]) = step.alpha(static_cast<Index>(i));
-      status = step.status;
-    }
-    res.pairing_iterations = it + 1;
-    if (!pairing || status == Status::NumericalIssue) break;
-    std::vector<Index> support = nonzeros(res.alpha);
-    // Fixed-point residual measured where the pairing reads it: the relative change
-    // of the surface displacement (α itself can move along near-dependent columns
-    // without any effect on u).
-    const VectorXd u_next = lift_s + dict.surface_primal() * res.alpha;
-    const double change = (u_next - u_s).norm() / std::max(u_next.norm(), std::numeric_limits<double>::min());
-    bool same_support = it > 0 && support == support_prev;
-    if (same_support && change <= opt.pairing_tolerance) {
-      if (!frozen || full_solves >= opt.selection_iterations) {
-        settled = true;
-        break;
-      }
-      // Settled on a frozen support that was selected under an earlier pairing:
-      // re-select once under the converged pairing. Same support: done; otherwise
-      // continue the fixed point from the new selection.
-      VectorXd reselected = full_solve();
-      if (status == Status::NumericalIssue) break;
-      std::vector<Index> support_new = nonzeros(reselected);
-      if (support_new == support) {
-        settled = true;
-        break;
-      }
-      res.alpha = std::move(reselected);
-      support = std::move(support_new);
-      same_support = false;
-    }
-    if (!frozen && (same_support || full_solves >= opt.selection_iterations)) frozen = true;
-    // Anderson safeguard: restart the history when the support changed or the
-    // residual grew (the map is only piecewise smooth: pairing segments switch).
-    if (!frozen || !same_support || change > last_change) mixer.clear();
-    last_change = change;
-    support_prev = std::move(support);
-
-    // Next x: Anderson mixing of the last iterates in the frozen phase, else g(x).
-    VectorXd next = res.alpha;
-    if (frozen && x.size()) {
-      const VectorXd mixed = mixer.next(x, res.alpha);
-      if (mixed.allFinite() && (mixed.array() >= 0.0).all())
-        next = mixed;
-      else  // restart the history from the plain step
-        mixer.restart();
-    }
-    x = std::move(next);
-  }
+  // The pairing fixed point around the exact projected solve at each pairing.
+  PairedHullSolve solve_at(dict, mu);
+  const HullFixedPoint fp = run_pairing_fixed_point(contact, model.problem().displacement_scale(), opt, solve_at);
+  res.alpha = solve_at.alpha();
+  res.focuss_iterations = solve_at.focuss_iterations();
+  res.nnls_iterations = solve_at.nnls_iterations();
+  res.pairing_iterations = fp.iterations;
+  res.pairing = fp.last.pairing;
+  res.pairing_change = fp.last.residual;
+  const Status status = solve_at.status();
+  const bool settled = fp.settled;
 
   const std::vector<Index> support = nonzeros(res.alpha);
   on.selected.assign(support.begin(), support.end());
@@ -368,10 +428,11 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
     on.u_hat.noalias() += res.alpha(j) * dict.reduced_coordinates().col(j);
   }
   res.sum_violation = std::abs(res.alpha.sum() - 1.0);
+  const VectorXd& bf = solve_at.projected_rhs();
   // stableNorm: at a vanishing load (d = 1e-300) the squares of bf underflow, and a
   // zero norm made the residual absolute, i.e. tiny, and the query a success.
   const double bf_norm = bf.stableNorm();
-  const double residual = (a * res.alpha - bf).stableNorm();
+  const double residual = (solve_at.projected_operator() * res.alpha - bf).stableNorm();
   res.projected_residual = bf_norm > 0.0 ? residual / bf_norm : residual;
   on.iterations = res.focuss_iterations;
   on.converged = status == Status::Success && settled;
@@ -389,8 +450,7 @@ ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
     on.message = text;
   } else if (status == Status::Success && !settled) {
     on.status = Status::NoConvergence;
-    on.message = "convex-hull pairing fixed point did not settle in " + std::to_string(opt.max_pairing_iterations) +
-                 " iterations";
+    on.message = fp.message;
   } else if (status == Status::NoConvergence) {
     on.message = "nnFOCUSS reached its cap of " + std::to_string(opt.focuss.max_iterations) + " iterations";
   } else if (status != Status::Success) {

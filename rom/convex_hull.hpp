@@ -34,15 +34,19 @@
 /// is solved exactly (SimplexLeastSquares, rom/chls.hpp) on the support nnFOCUSS
 /// selected, so that \f$ |\mathbf 1^T\alpha - 1| \sim 10^{-16} \f$ (see
 /// docs/convex_hull.md for why and for the effect of ω₀).
-/// For contact with pairing (hertz) C depends on u: the pairing is iterated as a
-/// fixed point — pairing from \f$ u_s = u_{lift,s} + D_{p,s}\alpha \f$ (first at
-/// the centroid of the hull), rebuild \f$ B_s^T C^T D_d \f$, re-solve — until the
-/// support is unchanged and the surface displacement moves by at most
-/// `pairing_tolerance` (relative), capped at
-/// `max_pairing_iterations`. The support is re-selected in the first
-/// `selection_iterations` solves only (until it repeats) and then frozen, so that
-/// near-tied supports cannot alternate forever; the frozen phase is
-/// Anderson-accelerated (`anderson_depth`).
+/// For contact with pairing (hertz) C depends on u: the pairing is iterated with
+/// the fixed point the FOM uses (fom::solve_pairing_fixed_point) on the surface
+/// displacement \f$ x = u_s \f$ — pairing from x (first the centroid of the hull),
+/// rebuild \f$ B_s^T C^T D_d \f$, exact projected solve →
+/// \f$ F(x) = u_{lift,s} + D_{p,s}\alpha \f$, \f$ \lambda = D_d\alpha \f$ — until
+/// re-pairing at F(x) changes the contact forces and gaps by at most
+/// `pairing_tolerance` (fom::pairing_change() without its penetration term),
+/// capped at `max_pairing_iterations`, Anderson-accelerated on x
+/// (`anderson_depth`; α is never extrapolated). The support is selected by full
+/// solves in the first `selection_iterations` solves only (until it repeats), then
+/// frozen (a column dropped stays out), so that near-tied supports cannot alternate
+/// for ever; once the pairing settles on a frozen support, one full solve at that
+/// pairing re-selects, and a different support continues the fixed point.
 ///
 /// Applicability: the hull of non-penetrating snapshots is non-penetrating only
 /// when the feasible set is convex and parameter-independent
@@ -102,17 +106,19 @@ struct ConvexHullOptions {
   int max_pairing_iterations = 20;
   /// Pairing loop, selection phase: at most this many full solves (nnFOCUSS over
   /// all columns); the support is frozen as soon as it repeats or this cap is
-  /// reached, and the remaining iterations only update α on it. Default 3.
+  /// reached, and the remaining iterations only update α on it. The re-selection at
+  /// the settled pairing is one more full solve within this cap. Default 3.
   int selection_iterations = 3;
-  /// Depth of the Anderson acceleration of the frozen-support phase of the pairing
-  /// fixed point (0: plain iteration). Default 3.
+  /// Depth of the Anderson acceleration of the pairing fixed point, on the surface
+  /// displacement (0: plain iteration); the history is dropped whenever the support
+  /// changes. Default 3.
   int anderson_depth = 3;
-  /// The pairing fixed point stops when the support is unchanged and the surface
-  /// displacement moves by at most this, relative:
-  /// \f$ \|D_{p,s}(g(\alpha^k) - \alpha^k)\| \le \mathrm{tol}\,\|u_{lift,s} + D_{p,s}\,g(\alpha^k)\| \f$,
-  /// g being one solve with the pairing of \f$ \alpha^k \f$. The pairing only reads
-  /// \f$ u_s \f$, whereas α can drift along nearly dependent columns without
-  /// changing u. Default 1e-8.
+  /// Tolerance of the pairing fixed point's stopping test, the FOM's
+  /// (fom::pairing_change()) without its penetration term, which a convex
+  /// combination cannot meet: stop when re-pairing at the solution's
+  /// \f$ u_s \f$ changes the contact force \f$ C^T\lambda \f$ by at most this
+  /// relative to its norm and the gaps of the rows in contact by at most this times
+  /// the displacement scale U (dimensionless). Default 1e-8.
   double pairing_tolerance = 1e-8;
   /// Largest relative projected residual \f$ \|B^T r(\alpha)\| / \|B^T f(\mu)\| \f$ of
   /// a solve reported as success. A query outside the convex hull of the training
@@ -209,6 +215,10 @@ struct ConvexHullResult {
   int focuss_iterations = 0;         ///< nnFOCUSS iterations, summed over the pairing loop
   int nnls_iterations = 0;           ///< NNLS active-set changes, summed
   int pairing_iterations = 0;        ///< solves in the pairing fixed point (1 without pairing)
+  fom::Pairing pairing;              ///< the pairing of the last solve (empty without pairing)
+  /// fom::pairing_change() of the result, the pairing fixed point's stopping test
+  /// (0 without pairing; ∞ if the first solve failed).
+  double pairing_change = 0.0;
 };
 
 /// \brief The convex-hull online solver (registry name "convex-hull"); see the file comment.

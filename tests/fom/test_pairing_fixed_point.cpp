@@ -1,10 +1,13 @@
-// fom/pairing_fixed_point.hpp through fom::ActiveSetSolver on hertz: a converged
+// fom/pairing_fixed_point.hpp: pairing_change() on hand-made two-row operators
+// (closed forms, with and without its penetration term); through
+// fom::ActiveSetSolver on hertz: a converged
 // solution passes the stopping test it reports (re-pairing at it changes nothing
 // beyond the tolerance), the cap gives no_convergence with the last change in the
 // message, and Anderson acceleration reaches the same solution as the plain
 // iteration in fewer pairing iterations.
 #define BOOST_TEST_MODULE fom_pairing_fixed_point
 #include <boost/test/unit_test.hpp>
+#include <cmath>
 #include <memory>
 
 #include "fom/active_set_solver.hpp"
@@ -35,7 +38,41 @@ double change_at(const FomSolution& sol, double tolerance) {
                         tolerance);
 }
 
+/// A row-major constraint operator from dense rows.
+ConstraintMatrix operator_of(const Eigen::MatrixXd& dense) { return dense.sparseView(); }
+
 }  // namespace
+
+BOOST_AUTO_TEST_CASE(pairing_change_on_a_hand_made_case) {
+  // Two rows on two surface dofs, w = 1, U = 2. Row 0 carries pressure and
+  // penetrates by 1e-3 (v = 1e-3/U relative); row 1 is open by 0.5 and unloaded.
+  const Eigen::VectorXd weights = Eigen::VectorXd::Ones(2), lambda = Eigen::Vector2d(1.0, 0.0);
+  const Eigen::VectorXd u_s = Eigen::Vector2d(1e-3, -0.5), g = Eigen::VectorXd::Zero(2);
+  const double u_scale = 2.0, tol = 1e-8;
+  const ConstraintMatrix c = operator_of(Eigen::Matrix2d::Identity());
+  // Unchanged pairing: nothing changes but the penetration, which only the full test sees.
+  BOOST_TEST(pairing_change(c, g, c, g, u_s, lambda, weights, u_scale, tol, true) == 1e-3 / u_scale);
+  BOOST_TEST(pairing_change(c, g, c, g, u_s, lambda, weights, u_scale, tol, false) == 0.0);
+  BOOST_TEST(pairing_change(c, g, c, g, u_s, lambda, weights, u_scale, tol) == 1e-3 / u_scale);  // default: on
+  // A gap offset moved by 0.1 on the open row only: not a row that matters.
+  const Eigen::VectorXd g_open = Eigen::Vector2d(0.0, 0.1);
+  BOOST_TEST(pairing_change(c, g, c, g_open, u_s, lambda, weights, u_scale, tol, false) == 0.0);
+  // The loaded row's gap offset moves by 4e-3: its gap changes by 4e-3 and it no
+  // longer penetrates, so both tests give the gap change.
+  const Eigen::VectorXd g_contact = Eigen::Vector2d(4e-3, 0.0);
+  for (const bool penetration : {true, false})
+    BOOST_TEST(std::abs(pairing_change(c, g, c, g_contact, u_s, lambda, weights, u_scale, tol, penetration) -
+                        4e-3 / u_scale) <= 1e-17);
+  // The loaded row's normal turns to (0.8, 0.6): the contact force C^T λ = (1, 0)
+  // becomes (0.8, 0.6), a relative change of |(-0.2, 0.6)| = sqrt(0.4), which
+  // dominates both tests.
+  Eigen::Matrix2d turned = Eigen::Matrix2d::Identity();
+  turned.row(0) << 0.8, 0.6;
+  const ConstraintMatrix c_turned = operator_of(turned);
+  for (const bool penetration : {true, false})
+    BOOST_TEST(std::abs(pairing_change(c, g, c_turned, g, u_s, lambda, weights, u_scale, tol, penetration) -
+                        std::sqrt(0.4)) <= 1e-15);
+}
 
 BOOST_AUTO_TEST_CASE(a_converged_solution_passes_its_stopping_test) {
   const ActiveSetOptions options;

@@ -3,7 +3,8 @@
 // assembly; rope with δ = 1e-7 reproduces its training set to rounding with
 // 1ᵀα = 1, and selects the two training neighbours of every validation γ; the
 // randomised projection basis is reproducible for a fixed seed and matches the SVD
-// basis when L equals the dictionary rank; hertz runs its pairing fixed point;
+// basis when L equals the dictionary rank; hertz runs its pairing fixed point, whose
+// results pass the FOM's stopping test (fom::pairing_change) from the result alone;
 // ironing is refused with the documented message; registry and option parsing.
 #define BOOST_TEST_MODULE rom_convex_hull
 #include <boost/test/unit_test.hpp>
@@ -18,6 +19,7 @@
 #include "common/run_command.hpp"
 #include "fom/active_set_solver.hpp"
 #include "fom/kkt.hpp"
+#include "fom/pairing_fixed_point.hpp"
 #include "rom/convex_hull.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_methods.hpp"
@@ -245,6 +247,48 @@ BOOST_AUTO_TEST_CASE(hertz_runs_the_pairing_fixed_point) {
     BOOST_TEST(r.sum_violation <= 1e-14);
     BOOST_TEST(primal <= 5e-2);
   }
+}
+
+BOOST_AUTO_TEST_CASE(hertz_queries_are_fixed_points_of_their_pairing) {
+  // The stopping test of the shared pairing fixed point (fom::pairing_change(),
+  // without its penetration term), evaluated here from the result alone: its own
+  // pairing against the one found at its u_s.
+  const Setup& s = setup("hertz", 12);
+  const rom::ReducedModel model = model_of(s, 1e-8);
+  const rom::ConvexHullSolver solver(model);
+  const double tol = solver.options().pairing_tolerance;
+  const fom::ContactModel& contact = s.problem->contact();
+  auto change_at = [&](const rom::ConvexHullResult& r, bool penetration) {
+    const VectorXd u_s = contact.restrict_to_surface(r.online.u);
+    fom::ConstraintMatrix c, c_next;
+    VectorXd g, g_next;
+    contact.assemble(r.pairing, c, g);
+    contact.assemble(contact.search(u_s), c_next, g_next);
+    return fom::pairing_change(c, g, c_next, g_next, u_s, r.online.lambda, contact.weights(),
+                               s.problem->displacement_scale(), tol, penetration);
+  };
+  const int j = 6;  // a training parameter: its snapshot is reproduced
+  const fom::FomSolution ref = s.fom_solver->solve(s.db.parameter(j));
+  for (const fom::Param& mu : {s.db.parameter(j), fom::Param(VectorXd::Constant(1, 0.1387))}) {
+    const rom::ConvexHullResult r = solver.solve_detailed(mu);
+    BOOST_TEST_REQUIRE(r.online.converged, r.online.message);
+    BOOST_TEST(r.pairing_change <= tol);
+    // u is recomputed from α over the full mesh: the test holds up to that rounding.
+    BOOST_TEST(change_at(r, false) <= 10.0 * tol, "d = " << mu(0));
+    BOOST_TEST_MESSAGE("hertz d " << mu(0) << ": pairing change " << change_at(r, false) << " (with penetration "
+                                  << change_at(r, true) << "), pairing iterations " << r.pairing_iterations);
+    if (mu(0) == s.db.parameter(j)(0)) BOOST_TEST(fom::relative_h1_error(*s.problem, r.online.u, ref.u) <= 1e-8);
+  }
+  // One pairing iteration is not a fixed point: the cap reports it, with the change.
+  rom::ConvexHullOptions capped;
+  capped.max_pairing_iterations = 1;
+  const rom::ConvexHullResult r = rom::ConvexHullSolver(model, capped).solve_detailed(VectorXd::Constant(1, 0.1387));
+  BOOST_TEST(!r.online.converged);
+  BOOST_TEST(r.online.status == Status::NoConvergence);
+  BOOST_TEST(r.pairing_iterations == 1);
+  BOOST_TEST(r.online.message.find("did not settle in 1 fixed-point iterations (last change") != std::string::npos,
+             r.online.message);
+  BOOST_TEST(change_at(r, false) > tol);
 }
 
 BOOST_AUTO_TEST_CASE(applicability) {
