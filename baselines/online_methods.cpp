@@ -18,6 +18,8 @@ std::vector<rom::OptionSpec> reduced_active_set_specs() {
   o.push_back(choice("init", "empty", "starting point: empty, primal or cell", {"empty", "primal", "cell"}));
   o.push_back(choice("inner_solve", "nonnegative", "saddle-point solve: nonnegative or equality (textbook PDAS)",
                      {"nonnegative", "equality"}));
+  o.push_back(choice("rebuild", "partial", "contact operators rebuilt on the changed rows only (partial) or all (full)",
+                     {"partial", "full"}));
   return o;
 }
 

@@ -33,6 +33,7 @@ ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOption
   o.max_iterations = g.max_iterations;
   o.step_tolerance = g.step_tolerance;
   o.time_operators = g.time_operators;
+  o.rebuild = g.rebuild;
   if (const auto it = options.extra.find("inner_solve"); it != options.extra.end()) {
     if (it->second == "nonnegative")
       o.inner_solve = InnerSolve::NonNegative;
@@ -121,23 +122,29 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
   // those training parameters: their interpolated û and the union of their active sets.
   Eigen::VectorXd u_hat, u_prev, lambda_i, u_s, v, violation, rhs;
   std::vector<int> start;  // positions in W
+  int nearest = -1;        // training snapshot nearest to the start (−1: cold)
   if (init == rom::WarmStart::Cell && !m_starts.empty()) {
     u_hat.setZero(r);
+    double heaviest = -1.0;
     for (const auto& s : m_model.interpolation_stencil(mu)) {
       const Start& t = m_starts[static_cast<size_t>(s.column)];
       u_hat.noalias() += s.weight * t.u_hat;
       start.insert(start.end(), t.active.begin(), t.active.end());
+      if (s.weight > heaviest) heaviest = s.weight, nearest = s.column;
     }
     std::sort(start.begin(), start.end());
     start.erase(std::unique(start.begin(), start.end()), start.end());
   } else {
     std::vector<int> unused;
     rom::warm_start_point(m_model, init == rom::WarmStart::Primal ? init : rom::WarmStart::Empty, mu, u_free,
-                          unused, u_hat);
+                          unused, u_hat, &nearest);
   }
   rom::RowMajorMatrix c_hat_i;
   Eigen::MatrixXd z, schur;
-  rom::SupportOperators ops;  // pairing, C_R and g_R at the current û
+  rom::SupportOperators ops(m_options.rebuild == rom::OperatorRebuild::Partial);  // pairing, C_R, g_R at û
+  // Warm-started, the first search starts from the one made offline at the nearest
+  // training snapshot, as the greedy's does (same pairing as a full search).
+  if (nearest >= 0) ops.seed(m_model.snapshot_search_memory(nearest));
   std::vector<int> active, next, solved;  // positions in W
   std::vector<char> in_active(mw, 0);
   rom::NnlsQp nnls(m_options.nnls);

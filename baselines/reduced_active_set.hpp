@@ -98,11 +98,17 @@ struct ReducedActiveSetOptions {
   /// around μ, computed once in the constructor: their interpolated û and the union of
   /// their active sets). Nearest is refused.
   rom::WarmStart init = rom::WarmStart::Empty;
+  /// How each rebuild searches the contact pairs, as for the greedy: Partial (default)
+  /// keeps a memory of the previous searches (seeded, when warm-started, by the one
+  /// made offline at the nearest training snapshot), Full searches every row in full.
+  /// The operators are the same either way.
+  rom::OperatorRebuild rebuild = rom::OperatorRebuild::Partial;
 };
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
-/// step_tolerance, time_operators; validated as for the greedy), `extra["inner_solve"]`
-/// ("nonnegative" or "equality") and `extra["init"]` ("empty", "primal" or "cell").
+/// step_tolerance, time_operators, `extra["rebuild"]`; validated as for the greedy),
+/// `extra["inner_solve"]` ("nonnegative" or "equality") and `extra["init"]` ("empty",
+/// "primal" or "cell").
 /// \throws InputError on bad values.
 ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options);
 
