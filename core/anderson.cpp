@@ -17,7 +17,7 @@ void AndersonMixer::size_for(Eigen::Index n) {
   m_df.setZero(n, m_depth), m_dr.setZero(n, m_depth);
   m_gram.setIdentity(m_depth, m_depth);
   m_rhs.setZero(m_depth), m_gamma.setZero(m_depth);
-  m_ldlt = Eigen::LDLT<Eigen::MatrixXd>(m_depth);
+  m_ldlt.compute(m_gram);  // sizes its storage (the size-only constructor leaves its status unset)
   m_r.resize(n);
   clear();  // the history, if any, was of vectors of another length
 }
