@@ -125,13 +125,13 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
   int nearest = -1;        // training snapshot nearest to the start (−1: cold)
   if (init == rom::WarmStart::Cell && !m_starts.empty()) {
     u_hat.setZero(r);
-    double heaviest = -1.0;
-    for (const auto& s : m_model.interpolation_stencil(mu)) {
+    const std::vector<rom::ReducedModel::StencilPoint> stencil = m_model.interpolation_stencil(mu);
+    for (const auto& s : stencil) {
       const Start& t = m_starts[static_cast<size_t>(s.column)];
       u_hat.noalias() += s.weight * t.u_hat;
       start.insert(start.end(), t.active.begin(), t.active.end());
-      if (s.weight > heaviest) heaviest = s.weight, nearest = s.column;
     }
+    nearest = rom::ReducedModel::nearest_column(stencil);
     std::sort(start.begin(), start.end());
     start.erase(std::unique(start.begin(), start.end()), start.end());
   } else {

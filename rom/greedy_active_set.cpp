@@ -108,11 +108,9 @@ void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Para
     return;
   }
   std::vector<ReducedModel::StencilPoint> stencil = model.interpolation_stencil(mu);
-  const auto heaviest = std::max_element(stencil.begin(), stencil.end(), [](const auto& a, const auto& b) {
-    return a.weight < b.weight;
-  });
-  if (nearest) *nearest = heaviest->column;
-  if (init == WarmStart::Nearest) stencil = {{heaviest->column, 1.0}};
+  const int heaviest = ReducedModel::nearest_column(stencil);
+  if (nearest) *nearest = heaviest;
+  if (init == WarmStart::Nearest) stencil = {{heaviest, 1.0}};
   // (A quadratic stencil for û, tried on hertz 30, needed more pairing updates on
   // average: the solutions are not smooth in μ where nodes enter contact.)
   if (init != WarmStart::Primal)

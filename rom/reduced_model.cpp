@@ -213,6 +213,12 @@ void ReducedModel::build_parameter_grid() {
   }
 }
 
+int ReducedModel::nearest_column(const std::vector<StencilPoint>& stencil) {
+  const auto heaviest = std::max_element(stencil.begin(), stencil.end(),
+                                         [](const StencilPoint& a, const StencilPoint& b) { return a.weight < b.weight; });
+  return heaviest == stencil.end() ? -1 : heaviest->column;
+}
+
 std::vector<ReducedModel::StencilPoint> ReducedModel::interpolation_stencil(const fom::Param& mu) const {
   const int m = dictionary_size(), d = static_cast<int>(m_grid_values.size());
   std::vector<StencilPoint> out;

@@ -142,6 +142,9 @@ class ReducedModel {
   /// around μ, the nearest one (distance scaled by the parameter range) with weight 1.
   /// O(d · log m + 2^d); allocates only the returned vector.
   std::vector<StencilPoint> interpolation_stencil(const fom::Param& mu) const;
+  /// \brief The column of the heaviest point of `stencil` (the first of equal
+  /// weights): the training snapshot nearest to μ. −1 for an empty stencil.
+  static int nearest_column(const std::vector<StencilPoint>& stencil);
 
   /// Reduced stiffness terms \f$ \Phi^T K_q \Phi \f$ (r × r each).
   const std::vector<Eigen::MatrixXd>& reduced_stiffness_terms() const { return m_k_hat; }
