@@ -121,7 +121,8 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
             << std::setw(22) << "iterations" << std::setw(12) << s.mean_iterations << "\n"
             << std::setw(22) << "time per query (us)" << std::setw(12) << s.mean_time_s * 1e6 << "(median "
             << s.median_time_s * 1e6 << ")\n"
-            << "not converged: " << s.nonconverged << " of " << s.rows.size();
+            << "not converged: " << s.nonconverged << " of " << s.rows.size()
+            << "; inaccurate (contact residuals above tolerance): " << s.inaccurate;
   if (s.absolute_error_rows)
     std::cout << "; " << s.absolute_error_rows << " rows with a near-zero FOM displacement left out of the errors "
               << "(absolute errors: max primal " << s.max_absolute_primal_error << ", max dual "
