@@ -153,6 +153,10 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
     } else if (key == "rebuild") {
       g.rebuild = greedy_choice<OperatorRebuild>(
           key, value, {{"partial", OperatorRebuild::Partial}, {"full", OperatorRebuild::Full}});
+    } else if (key == "surface_step") {
+      g.surface_step = parse_option_number("greedy", key, value);
+      if (!(g.surface_step > 0.0))
+        throw InputError("greedy option surface_step = '" + value + "' invalid; expected a number > 0");
     } else if (key == "on_cycle") {
       g.nested_on_cycle = greedy_choice<bool>(key, value, {{"nested", true}, {"continue", false}});
     }
@@ -549,7 +553,7 @@ struct GreedyActiveSet::Nested {
     }
     mixer.reset(g->m_options.anderson_depth);
     seen.clear(), solved.clear();
-    n_lambda = 0, pending = false, finite = true, solves = 0;
+    n_lambda = 0, pending = false, failed_test = false, finite = true, solves = 0;
   }
   /// A selected column p with the operators frozen: its row Ĉ_p = d_pᵀ A of Ĉ_I,
   /// w_p = K̂⁻¹ Ĉ_pᵀ and z_p = D_dᵀ C_s Φ_s w_p, the change of every column's
@@ -579,6 +583,7 @@ struct GreedyActiveSet::Nested {
   std::vector<int> blocked;      // settle_exact: columns not offered again on these operators
   fom::AndersonMixer mixer{0};
   bool pending = false;  // settled: to be confirmed at the fresh pairing of û
+  bool failed_test = false;  // fixed-point schedule: the last settled û failed the physical test
   bool finite = true;    // every solve so far gave finite values
   int solves = 0;
 
@@ -835,18 +840,32 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds
   q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i(), s.solved);
 }
 
+double GreedyActiveSet::surface_step(const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x) const {
+  thread_local Eigen::VectorXd change;
+  change.noalias() = m_model.surface_basis() * (u_hat - x);
+  return (change.size() > 0 ? change.cwiseAbs().maxCoeff() : 0.0) / m_model.problem().displacement_scale();
+}
+
 void GreedyActiveSet::solve_fixed_point(Query& q, OnlineResult& res) const {
   thread_local Nested s;  // its storage serves the thread's next queries
   s.start(*this, q);
   const fom::ContactTolerances tolerances = contact_tolerances();
-  const double step_tolerance = std::max(m_options.step_tolerance, std::sqrt(m_model.delta()));
   for (int rebuild = 0;; ++rebuild) {
     // 1. Operators at x (surface rows only); where x = û, the physical test at û's own pairing.
     q.surface_displacement(s.x, s.u_s);
     q.rebuild(s.u_s);
-    if (s.pending && s.physically_converged(tolerances)) {
-      res.converged = true;
-      break;
+    if (s.pending) {
+      // A settled û that fails the physical test at its own pairing twice in a row
+      // is a fixed point of the reduced problem: iterating cannot improve it. It is
+      // returned as converged; the full-order check then reports it inaccurate.
+      const bool physical = s.physically_converged(tolerances);
+      if (physical || s.failed_test) {
+        res.converged = true;
+        break;
+      }
+      s.failed_test = true;
+    } else {
+      s.failed_test = false;
     }
     s.pending = false;
     if (rebuild >= m_options.max_iterations || s.solves >= m_options.max_solves) break;
@@ -860,9 +879,9 @@ void GreedyActiveSet::solve_fixed_point(Query& q, OnlineResult& res) const {
     // 3. The next point: û itself once the step is within the basis' resolution
     //    (then tested at its own pairing), else the Anderson extrapolation of the
     //    map x ↦ û(x), with one history over the whole query.
-    const double step = (s.u_hat - s.x).norm(), size = s.u_hat.norm();
-    if (m_options.trace) *m_options.trace << "greedy rebuild=" << rebuild << " step=" << step / std::max(size, 1e-300) << "\n";
-    if (step <= step_tolerance * size) {
+    const double step = surface_step(s.u_hat, s.x);
+    if (m_options.trace) *m_options.trace << "greedy rebuild=" << rebuild << " surface step=" << step << " U\n";
+    if (step <= m_options.surface_step) {
       s.pending = true;
       s.x = s.u_hat;
     } else {

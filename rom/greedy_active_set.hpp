@@ -163,6 +163,12 @@ struct GreedyOptions {
   /// selection, with the rebuilds left). false: the paper's Alg. 1, which may cycle
   /// to the cap. Default true.
   bool nested_on_cycle = true;
+  /// Fixed-point schedule: û is tested at its own pairing once the contact surface
+  /// moved by at most this, in units of the displacement scale U, between the point
+  /// where the operators were built and û (max over the surface dofs of
+  /// \f$ |\Phi_s(\hat u - x)| \f$). Default 1e-3 (a fiftieth of the default
+  /// penetration tolerance). The other schedules use step_tolerance.
+  double surface_step = 1e-3;
   /// Nested schedule: cap on the one-change solves of a query, over all rebuilds.
   /// Default 1000.
   int max_solves = 1000;
@@ -206,6 +212,8 @@ class GreedyActiveSet final : public OnlineSolver {
   /// interleaved schedule left of it when it hands over on a cycle)
   void solve_nested(Query& q, OnlineResult& res, int max_rebuilds) const;
   void solve_fixed_point(Query& q, OnlineResult& res) const;
+  /// \f$ \|\Phi_s(\hat u - x)\|_\infty / U \f$: how far the contact surface moved from x.
+  double surface_step(const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x) const;
 };
 
 /// \brief The threshold τ that GreedyActiveSet applies with `options` (defaulted to δ
