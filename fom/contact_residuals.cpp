@@ -30,12 +30,17 @@ std::string ContactResiduals::describe(const ContactTolerances& tol) const {
 
 ContactResiduals contact_residuals(const Problem& problem, const Eigen::VectorXd& u_surface,
                                    const Eigen::VectorXd& lambda) {
+  return contact_residuals(problem, problem.contact().search(u_surface), u_surface, lambda);
+}
+
+ContactResiduals contact_residuals(const Problem& problem, const Pairing& pairing, const Eigen::VectorXd& u_surface,
+                                   const Eigen::VectorXd& lambda) {
   const ContactModel& contact = problem.contact();
-  const Pairing pairing = contact.search(u_surface);
-  ConstraintMatrix c;
-  Eigen::VectorXd g;
+  thread_local ConstraintMatrix c;  // storage reused by the thread's next checks
+  thread_local Eigen::VectorXd g, gap;
   contact.assemble(pairing, c, g);
-  const Eigen::VectorXd gap = c * u_surface - g;  // (Cu − g)_s = w_s d_s
+  gap.noalias() = c * u_surface;
+  gap -= g;  // (Cu − g)_s = w_s d_s
   const Eigen::VectorXd& w = contact.weights();
   const double u_scale = problem.displacement_scale();
 

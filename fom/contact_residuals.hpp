@@ -20,6 +20,7 @@
 #include <Eigen/Dense>
 #include <string>
 
+#include "fom/contact_model.hpp"
 #include "fom/problem.hpp"
 
 namespace contactrom::fom {
@@ -54,6 +55,11 @@ struct ContactResiduals {
 /// \param u_surface displacement of the contact-surface dofs (ContactModel::surface_dofs order)
 /// \param lambda pressure per constraint row (size ContactModel::num_constraints())
 ContactResiduals contact_residuals(const Problem& problem, const Eigen::VectorXd& u_surface,
+                                   const Eigen::VectorXd& lambda);
+
+/// \brief Same, with `pairing` already searched at u_surface (e.g. by a search with a
+/// memory, ContactModel::search_rows, which gives the same pairing faster).
+ContactResiduals contact_residuals(const Problem& problem, const Pairing& pairing, const Eigen::VectorXd& u_surface,
                                    const Eigen::VectorXd& lambda);
 
 /// \brief The problem's tolerances: its file's `[rom]` `penetration_tolerance`,

@@ -44,10 +44,11 @@ struct OnlineResult {
   /// Wall time of the online core (seconds): everything from μ to (û, λ̂_I) and the
   /// full pressure, nonlinear contact operators included; the full-field
   /// reconstruction Φû + u_lift (a mesh-size operation needed only for output) is
-  /// excluded and timed in `reconstruction_time_s`.
+  /// excluded and timed in `reconstruction_time_s`. The full-order contact check
+  /// (`check_time_s`) is included: a status is part of the answer.
   double time_s = 0.0;
   /// Wall time of the full-order contact check that sets `contact` (one contact
-  /// search and assembly on the surface; not included in `time_s`).
+  /// search and assembly on the surface), included in `time_s`.
   double check_time_s = 0.0;
   double reconstruction_time_s = 0.0;  ///< wall time of u = Φû + u_lift (seconds)
   /// Part of `time_s` spent building the contact operators at the iterates (surface
