@@ -62,6 +62,8 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
   j["primal_rank"] = model.primal_rank();
   j["status"] = to_string(res.status);
   j["converged"] = res.converged;
+  j["penetration"] = res.contact.penetration;
+  j["separation"] = res.contact.complementarity;
   if (!res.message.empty()) j["message"] = res.message;
   j["iterations"] = res.iterations;
   j["sparsity"] = res.selected.size();
