@@ -114,7 +114,8 @@ void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Para
   // (A quadratic stencil for û, tried on hertz 30, needed more pairing updates on
   // average: the solutions are not smooth in μ where nodes enter contact.)
   if (init != WarmStart::Primal)
-    for (const auto& s : stencil) columns.push_back(s.column);
+    for (const auto& s : stencil)
+      for (int c : model.sibling_columns(s.column)) columns.push_back(c);
   const Eigen::MatrixXd& coords = model.snapshot_coordinates();
   u_hat.setZero(model.primal_rank());
   for (const auto& s : stencil) u_hat.noalias() += s.weight * coords.col(s.column);
