@@ -70,7 +70,8 @@ std::vector<OptionSpec> greedy_specs(bool with_schedule) {
                        "per rebuild, Alg. 1 with safeguards), paper (Alg. 1 exactly) or nested",
                        {"fixed-point", "interleaved", "paper", "nested"}));
   o.push_back(integer("anderson_depth", "5", "nested schedule: Anderson depth of the rebuild point (0: plain)", 0, 1e6));
-  o.push_back(number("surface_step", "1e-3",
+  if (with_schedule)
+    o.push_back(number("surface_step", "1e-3",
                      "fixed-point schedule: largest move of the contact surface (units of U) between the operators' "
                      "point and the answer",
                      Interval::greater_than(0)));
