@@ -130,6 +130,33 @@ BOOST_AUTO_TEST_CASE(sampling_plans) {
   BOOST_CHECK_THROW(nested.points_for(box, 25), InputError);
 }
 
+BOOST_AUTO_TEST_CASE(grid_end_points_are_exactly_the_bounds) {
+  // 0.1 * 6 / 6 = 0.10000000000000002: a grid computed as lo + (hi - lo) k / n
+  // leaves the range (0, 0.1] at n = 3, 6, 7, 12.
+  fom::ParameterSpace small;
+  small.add("d", 0.0, 0.1, true);
+  fom::ParameterSpace closed;
+  closed.add("x", -0.3, 0.1);
+  for (int n : {3, 6, 7, 12, 30}) {
+    for (const fom::ParameterSpace* space : {&small, &closed}) {
+      fom::SamplingPlan uniform;
+      const auto points = uniform.points_for(*space, n);
+      BOOST_TEST(points.back()(0) == 0.1, "n = " << n);
+      for (const auto& p : points) BOOST_TEST(space->contains(p), "n = " << n << ": " << p(0) << " is outside");
+      fom::SamplingPlan mid;
+      mid.kind = fom::SamplingPlan::Kind::Midpoints;
+      for (const auto& p : mid.points_for(*space, n)) BOOST_TEST(space->contains(p));
+    }
+  }
+  fom::SamplingPlan nested;
+  nested.kind = fom::SamplingPlan::Kind::Nested;
+  for (int level = 1; level <= 6; ++level) {
+    const auto points = nested.points_for(small, level);
+    BOOST_TEST(points.back()(0) == 0.1);
+    for (const auto& p : points) BOOST_TEST(small.contains(p));
+  }
+}
+
 BOOST_AUTO_TEST_CASE(shipped_hertz_file_gives_the_hertz_problem) {
   const auto p = fom::make_problem("hertz");
   BOOST_TEST(p->num_dofs() == 2 * 1034);
@@ -254,6 +281,7 @@ BOOST_AUTO_TEST_CASE(malformed_files_give_one_line_naming_file_line_and_key) {
       {"unknown parameter", "[0.0, \"-d\"]", "[0.0, \"-dd\"]", "dirichlet[1].displacement[1]"},
       {"non-affine expression", "[0.0, \"-d\"]", "[0.0, \"-d*d\"]", "dirichlet[1].displacement[1]"},
       {"lo >= hi", "range = [0.0, 0.3]", "range = [0.3, 0.3]", "parameters[0].range"},
+      {"width overflows", "range = [0.0, 0.3]", "range = [-1.7e308, 1.7e308]", "parameters[0].range"},
       {"surface without body", "[[bodies]]\ngroup = \"top\"\nyoung = 1.0\npoisson = 0.3\n", "", "bodies"},
       {"unknown key", "poisson = 0.3", "poison = 0.3", "bodies[0].poison"},
       {"negative modulus", "young = 1.0", "young = -1.0", "bodies[0].young"},
