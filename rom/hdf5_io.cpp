@@ -391,7 +391,12 @@ hid_t open_file(const std::string& path, const std::string& label, const std::st
     throw InputError(label + " " + quoted(path, 200) + " has HDF5 superblock version " + std::to_string(version) +
                      " (no metadata checksums), expected 2 or later as written by " + expected_writer +
                      "; write it again with " + expected_writer);
-  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  // Without HDF5's own file lock (flock): files are published whole by rename, so a
+  // reader never sees one being written, and `offline --append` holds its own lock
+  // on the database (core/atomic_file.hpp FileLock), which HDF5's would conflict with.
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "file access properties");
+  check(H5Pset_file_locking(fapl.id(), false, true), "file access properties");
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.id());
   if (file < 0) throw InputError(label + " " + quoted(path, 200) + " is truncated or corrupt (HDF5 cannot open it)");
   return file;
 }
