@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "core/errors.hpp"
 #include "core/format.hpp"
@@ -57,6 +58,13 @@ std::vector<PairAtRest> pairs_at_rest(const Problem& problem) {
   return out;
 }
 
+/// A length for a message, to 3 significant digits (0.05, not 0.04999999999999999).
+std::string length_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
 std::string pair_name(size_t q, const PairAtRest& p) {
   return "contact pair " + std::to_string(q) + " (slave " + quoted(p.slave, 200) + " on master " + quoted(p.master, 200) +
          ")";
@@ -71,7 +79,7 @@ std::vector<std::string> reference_contact_warnings(const Problem& problem) {
   for (size_t q = 0; q < pairs.size(); ++q) {
     const PairAtRest& p = pairs[q];
     if (p.overlap > kReferenceOverlapFraction * u)
-      out.push_back(pair_name(q, p) + " overlaps by " + format_number(p.overlap) +
+      out.push_back(pair_name(q, p) + " overlaps by " + length_text(p.overlap) +
                     " in the reference configuration, more than " + format_number(kReferenceOverlapFraction) +
                     " of the displacement scale U = " + format_number(u) +
                     "; expected surfaces that touch or are apart before loading");

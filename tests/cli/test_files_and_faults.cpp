@@ -124,7 +124,11 @@ BOOST_FIXTURE_TEST_CASE(merge_takes_parts_in_any_order, Fixture) {
   BOOST_REQUIRE(run_command(kExe + " merge " + file("p1.h5") + " " + file("p2.h5") + " " + file("p3.h5") + " --out " +
                             file("ordered.h5"))
                     .exit_code == 0);
-  BOOST_TEST(slurp(file("m.h5")) == slurp(file("ordered.h5")));
+  // (The summed timings differ in their last bits: the arrays are compared.)
+  const auto same = run_command("/usr/bin/python3 -c \"import h5py, numpy; a = h5py.File('" + file("m.h5") +
+                                "'); b = h5py.File('" + file("ordered.h5") + "'); print(int(all(numpy.array_equal("
+                                "a[k][()], b[k][()]) for k in ('parameters', 'primal', 'dual', 'status'))))\"");
+  BOOST_TEST(same.out == "1\n", same.out << same.err);
 }
 
 BOOST_FIXTURE_TEST_CASE(a_failed_set_of_outputs_leaves_none_of_them, Fixture) {
@@ -252,7 +256,8 @@ BOOST_FIXTURE_TEST_CASE(gmsh_ends_with_its_parent, Fixture) {
   // by PID (SIGKILL: no handler runs), the parent leaves no gmsh behind.
   std::ofstream(file("loop.geo")) << "For i In {1:1e15}\n  x = i;\nEndFor\nPoint(1) = {0,0,0,0.1};\n";
   std::ofstream(file("loop.toml")) << "[problem]\nname = \"loop\"\nmesh = \"loop.geo\"\n[[parameters]]\nname = \"d\"\n"
-                                      "range = [0.0, 1.0]\n[[bodies]]\ngroup = \"a\"\n";
+                                      "range = [0.0, 1.0]\n[[bodies]]\ngroup = \"a\"\n[[dirichlet]]\ngroup = \"b\"\n"
+                                      "displacement = [0.0, 0.0]\n[[contact]]\nslave = \"c\"\nmaster = \"e\"\n";
   const pid_t parent = start({"fom", "--problem", file("loop.toml"), "--param", "0.5"});
   // Wait for the child to appear.
   pid_t child = -1;

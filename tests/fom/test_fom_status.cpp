@@ -231,10 +231,10 @@ BOOST_AUTO_TEST_CASE(overlaps_and_unpaired_slave_nodes_are_warned_about_and_a_pa
   BOOST_TEST(fom::reference_contact_warnings(*fom::make_problem(build(1.0, 0.0, 0.5))).empty());
   // Overlapping by 0.05, half the displacement scale U = 0.1 (> 10 %).
   const auto overlap = fom::reference_contact_warnings(*fom::make_problem(build(1.0, 0.0, 0.45)));
-  BOOST_TEST(any_contains(overlap, "overlaps by 0.05"), overlap.size());
+  BOOST_TEST(any_contains(overlap, "overlaps by 0.05"), (overlap.empty() ? "" : overlap[0]));
   // The slave curve 0.15 longer than the master: its last node is never paired.
   const auto beyond = fom::reference_contact_warnings(*fom::make_problem(build(0.85, 0.0, 0.5)));
-  BOOST_TEST(any_contains(beyond, "1 of its 5 slave nodes lie just beyond the ends"), beyond.size());
+  BOOST_TEST(any_contains(beyond, "1 of its 5 slave nodes lie just beyond the ends"), (beyond.empty() ? "" : beyond[0]));
   // The CLI prints them on stderr and in the JSON.
   const auto r = contactrom::test::run_command(std::string(CONTACTROM_EXE) + " fom --problem " + build(1.0, 0.0, 0.45) +
                                                " --param 0.05 --json");
