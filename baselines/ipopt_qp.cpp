@@ -18,6 +18,7 @@
 
 #include "core/stopwatch.hpp"
 #include "fom/kkt.hpp"
+#include "fom/rigid_bodies.hpp"
 #include "fom/pairing_fixed_point.hpp"
 
 namespace contactrom::baselines {
@@ -308,7 +309,7 @@ struct IpoptQpSolver::Impl {
 };
 
 IpoptQpSolver::IpoptQpSolver(const fom::Problem& problem, IpoptOptions options)
-    : m_impl(std::make_unique<Impl>(problem, options)) {}
+    : m_impl((fom::check_rigid_motions_held(problem), std::make_unique<Impl>(problem, options))) {}
 
 IpoptQpSolver::~IpoptQpSolver() = default;
 

@@ -184,6 +184,7 @@ bool condense(const Problem& problem, const Param& mu, Condensation& out, const 
 }
 
 Eigen::MatrixXd unconstrained_load_responses(const Problem& problem, const Param& mu) {
+  check_rigid_motions_held(problem);
   Condensation cond;
   if (!condense(problem, mu, cond)) throw InputError(singular_stiffness_message(problem));
   return std::move(cond.z_load);
@@ -201,6 +202,9 @@ Eigen::VectorXd Condensation::surface_response(const Eigen::VectorXd& surface_fo
 
 ActiveSetSolver::ActiveSetSolver(const Problem& problem, ActiveSetOptions options)
     : m_problem(problem), m_options(options) {
+  // Before any factorisation: a rigid motion left free has no unique answer, and
+  // in floating point the factorisation may well succeed on it.
+  check_rigid_motions_held(problem);
   const auto t0 = std::chrono::steady_clock::now();
   if (!problem.stiffness_is_constant()) {
     // K(μ) changes with μ, its sparsity pattern does not: order the dofs once, here,

@@ -9,7 +9,6 @@
 #include "core/errors.hpp"
 #include "core/format.hpp"
 #include "fom/contact_checks.hpp"
-#include "fom/rigid_bodies.hpp"
 
 namespace contactrom::fom {
 namespace {
@@ -296,7 +295,6 @@ std::unique_ptr<Problem> build_problem(ProblemDefinition definition, Mesh mesh) 
   }
   p->m_u_scale = scale;
   p->m_fingerprint = hash_text(def.text + "|" + m.fingerprint());
-  check_rigid_motions_held(*p);  // before any solve: a free rigid motion has no unique answer
   check_contact_pairs_face(*p);
   return p;
 }

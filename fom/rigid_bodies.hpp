@@ -32,7 +32,8 @@ struct FreeRigidMotion {
 /// reported once, as "held by no Dirichlet condition". Empty for the 1D rope.
 std::vector<FreeRigidMotion> free_rigid_motions(const Problem& problem, double relative_tolerance = 1e-10);
 
-/// \brief Refuses a problem with a free rigid motion (InputError naming the body
+/// \brief Refuses a problem with a free rigid motion (the FOM solvers call it before
+/// factorising; the reduced model before its lifting) (InputError naming the body
 /// and the motion, e.g. "body 'top' is not held in every direction: free to
 /// translate in x"); bodies held by nothing are named as in singular_stiffness_message().
 void check_rigid_motions_held(const Problem& problem);

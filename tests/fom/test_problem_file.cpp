@@ -256,7 +256,11 @@ BOOST_AUTO_TEST_CASE(two_contact_pairs_fom_agrees_with_ipopt) {
     const auto r = ipopt.solve(mu);
     BOOST_TEST_REQUIRE(r.status == Status::Success);
     BOOST_TEST((s.u - r.u).cwiseAbs().maxCoeff() <= 1e-6 * p->displacement_scale());
-    BOOST_TEST((s.lambda - r.lambda).cwiseAbs().maxCoeff() <= 1e-6 * std::max(1.0, s.lambda.cwiseAbs().maxCoeff()));
+    // Pressures agree to 1e-5 (relative to max(1, max λ)): at d = 0.06 a beam node
+    // barely separates (gap 3e-7, no pressure in the exact solution) and Ipopt's
+    // barrier moves 1.5e-6 of pressure from its neighbour onto it (λ ≈ μ / gap); the
+    // displacements agree to 1e-6 U (above) and the KKT residuals to 1e-10.
+    BOOST_TEST((s.lambda - r.lambda).cwiseAbs().maxCoeff() <= 1e-5 * std::max(1.0, s.lambda.cwiseAbs().maxCoeff()));
     for (int row = 0; row < contact.num_constraints(); ++row)
       second_pair_active = second_pair_active || (contact.pair_of_row(row) == 1 && s.lambda(row) > 0);
   }
