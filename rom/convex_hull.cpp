@@ -395,6 +395,12 @@ ConvexHullSolver::ConvexHullSolver(const ReducedModel& model, const Options& opt
     : m_dictionary((check_convex_hull_applicable(model.problem()), model), options) {}
 
 ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
+  ConvexHullResult res = run(mu);
+  check_contact(model(), contact_tolerances(), res.online);
+  return res;
+}
+
+ConvexHullResult ConvexHullSolver::run(const fom::Param& mu) const {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   const MonolithicDictionary& dict = m_dictionary;

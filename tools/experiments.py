@@ -117,7 +117,8 @@ def read_rows(path):
         sel = r.get("selected", "").split()
         out.append({
             "params": [float(r[k]) for k in r if k not in {"primal_error", "dual_error", "sparsity", "iterations",
-                                                           "time_s", "converged", "status", "selected", "errors"}],
+                                                           "time_s", "converged", "status", "selected", "errors",
+                                                           "penetration", "separation"}],
             "primal": float(r["primal_error"]),
             "dual": float(r["dual_error"]),
             "sparsity": int(r["sparsity"]),
