@@ -282,3 +282,22 @@ BOOST_FIXTURE_TEST_CASE(gmsh_ends_with_its_parent, Fixture) {
   BOOST_TEST(gone, "gmsh child " << child << " outlived its parent");
   if (!gone) ::kill(child, SIGKILL);
 }
+
+BOOST_FIXTURE_TEST_CASE(user_strings_are_quoted_on_one_line, Fixture) {
+  // A file name with a newline and an escape sequence: every message stays one line
+  // and no control byte reaches the terminal.
+  const std::string odd = "'" + file("a\nb\x1b[31m.h5") + "'";
+  const std::string rom = std::string(CONTACTROM_SOURCE_DIR) + "/fuzz/corpus/reduced_model/rope_greedy.h5";
+  for (const std::string& args :
+       {"online --db " + odd, "chls --db " + odd, "reduce --db " + odd + " --method greedy --out " + file("r.h5"),
+        "query --rom " + odd + " --param 20", "query --rom " + rom + " --params " + odd, "merge " + odd + " --out " + file("m.h5"),
+        "offline --problem rope --append " + odd, "sparse --method nnls --dictionary " + odd + " --signal " + odd,
+        "fom --problem " + odd + " --param 1", "offline --problem rope --part " + odd + " --out " + file("p.h5")}) {
+    BOOST_TEST_CONTEXT("contactrom " + args) {
+      const auto r = run_command(kExe + " " + args);
+      BOOST_TEST(r.exit_code == 2);
+      BOOST_TEST(std::count(r.err.begin(), r.err.end(), '\n') == 1, r.err);
+      BOOST_TEST(r.err.find('\x1b') == std::string::npos, r.err);
+    }
+  }
+}
