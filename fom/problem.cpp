@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "core/format.hpp"
+#include "fom/contact_checks.hpp"
 
 namespace contactrom::fom {
 namespace {
@@ -58,7 +59,7 @@ class Builder {
       for (const BodySpec& b : m_def.bodies) listed = listed || b.group == surface;
       if (!listed)
         throw InputError(m_def.where({0, "bodies"}) + ": the mesh's physical surface '" + surface +
-                         "' has no [[bodies]] entry; expected every surface of '" + m_def.mesh + "' listed");
+                         "' has no [[bodies]] entry; expected every surface of " + quoted(m_def.mesh, 200) + " listed");
     }
   }
 
@@ -114,7 +115,7 @@ class Builder {
     for (const TractionSpec& t : m_def.traction) {
       group_nodes(t.group, t.where, "physical curve");
       if (m_mesh.group_segments(t.group).empty())
-        throw InputError(m_def.where(t.where) + ": '" + t.group + "' is a physical point; expected a physical curve");
+        throw InputError(m_def.where(t.where) + ": " + quoted(t.group, 200) + " is a physical point; expected a physical curve");
       for (const auto& seg : m_mesh.group_segments(t.group)) {
         const double half = 0.5 * (m_mesh.nodes.col(seg[1]) - m_mesh.nodes.col(seg[0])).norm();
         for (int node : seg)
@@ -168,7 +169,7 @@ class Builder {
   const std::vector<int>& group_nodes(const std::string& group, const SourceLocation& where, const char* kind) const {
     auto it = m_mesh.curve_nodes.find(group);
     if (it == m_mesh.curve_nodes.end())
-      throw InputError(m_def.where(where) + ": the mesh has no " + kind + " '" + group + "'; expected one of: " +
+      throw InputError(m_def.where(where) + ": the mesh has no " + kind + " " + quoted(group, 200) + "; expected one of: " +
                        joined_keys(m_mesh.curve_nodes));
     return it->second;
   }
@@ -294,6 +295,7 @@ std::unique_ptr<Problem> build_problem(ProblemDefinition definition, Mesh mesh) 
   }
   p->m_u_scale = scale;
   p->m_fingerprint = hash_text(def.text + "|" + m.fingerprint());
+  check_contact_pairs_face(*p);
   return p;
 }
 

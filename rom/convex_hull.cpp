@@ -1,5 +1,7 @@
 #include "rom/convex_hull.hpp"
 
+#include "core/format.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -308,7 +310,7 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
   Pod svd(PodOptions{delta, 0});
   svd.compute(dp);
   if (svd.info() != Status::Success)
-    throw InputError("SVD of the primal dictionary of '" + problem.name() + "' failed (" + to_string(svd.info()) + ")");
+    throw InputError("SVD of the primal dictionary of " + quoted(problem.name(), 200) + " failed (" + to_string(svd.info()) + ")");
   if (options.basis == ProjectionBasis::Svd) {
     m_b = svd.basis();
   } else {
@@ -325,7 +327,7 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
     m_b = orth.basis();
   }
   if (m_b.cols() == 0)
-    throw InputError("the primal dictionary of '" + problem.name() + "' is zero: no projection basis");
+    throw InputError("the primal dictionary of " + quoted(problem.name(), 200) + " is zero: no projection basis");
   const std::vector<char>& dirichlet = problem.is_dirichlet();
   for (Index i = 0; i < m_b.rows(); ++i)
     if (dirichlet[static_cast<std::size_t>(i)]) m_b.row(i).setZero();
@@ -488,7 +490,7 @@ ConvexHullOptions convex_hull_options(const OnlineSolverOptions& options) {
       else if (value == "random")
         o.basis = ProjectionBasis::Random;
       else
-        throw InputError("convex-hull basis '" + value + "' unknown; expected svd or random");
+        throw InputError("convex-hull basis " + quoted(value, 200) + " unknown; expected svd or random");
     } else if (key == "basis_delta") {
       o.basis_delta = parse_double(key, value);
     } else if (key == "rank_l") {
@@ -507,7 +509,7 @@ ConvexHullOptions convex_hull_options(const OnlineSolverOptions& options) {
       else if (value == "0" || value == "false")
         o.polish = false;
       else
-        throw InputError("convex-hull polish = '" + value + "' invalid; expected 0, 1, true or false");
+        throw InputError("convex-hull polish = " + quoted(value, 200) + " invalid; expected 0, 1, true or false");
     } else if (key == "max_pairing_iterations") {
       o.max_pairing_iterations = static_cast<int>(std::clamp(parse_integer(key, value), -1LL, 1000000LL));
     } else if (key == "selection_iterations") {

@@ -11,7 +11,7 @@ namespace {
 void check_compatible(const SnapshotDatabase& a, const std::string& name_a, const SnapshotDatabase& b,
                       const std::string& name_b) {
   auto differ = [&](const std::string& what, const std::string& va, const std::string& vb) {
-    throw InputError("cannot merge '" + name_b + "' into '" + name_a + "': " + what + " " + vb + " differs from " +
+    throw InputError("cannot merge " + quoted(name_b, 200) + " into " + quoted(name_a, 200) + ": " + what + " " + vb + " differs from " +
                      va + "; expected databases of the same problem and training set");
   };
   if (a.problem != b.problem) differ("problem", a.problem, b.problem);
@@ -103,13 +103,13 @@ void check_appendable(const SnapshotDatabase& db, const std::string& path, const
                       const std::string& training_kind, int training_size) {
   check_database_problem(db, problem, path);
   if (db.training_kind != training_kind || db.training_size != training_size)
-    throw InputError("cannot append to '" + path + "': its training set " + db.training_kind + " " +
+    throw InputError("cannot append to " + quoted(path, 200) + ": its training set " + db.training_kind + " " +
                      std::to_string(db.training_size) + " differs from " + training_kind + " " +
                      std::to_string(training_size) + "; expected the same --train or --level");
   const std::vector<fom::Param> training = fom::training_set(problem, training_size);
   for (int j = 0; j < db.num_snapshots(); ++j)
     if (index_of(training, db.parameter(j)) < 0)
-      throw InputError("cannot append to '" + path + "': its snapshot " + std::to_string(j) +
+      throw InputError("cannot append to " + quoted(path, 200) + ": its snapshot " + std::to_string(j) +
                        " is not at a parameter of its training set; expected a database written by contactrom offline");
 }
 
@@ -123,21 +123,31 @@ std::vector<fom::Param> parameters_not_in(const SnapshotDatabase& db, const std:
   return missing;
 }
 
-SnapshotDatabase append_snapshots(const SnapshotDatabase& db, const std::string& name, const SnapshotDatabase& added,
-                                  const std::vector<fom::Param>& training) {
-  const SnapshotDatabase merged = merge_databases({db, added}, {name, "the new snapshots"});
-  // Columns sorted by their position in the training set.
-  std::vector<std::pair<int, int>> position(merged.num_snapshots());
-  for (int j = 0; j < merged.num_snapshots(); ++j) {
-    position[j] = {index_of(training, merged.parameter(j)), j};
+SnapshotDatabase sorted_by_training(const SnapshotDatabase& db, const std::string& name,
+                                    const std::vector<fom::Param>& training) {
+  std::vector<std::pair<int, int>> position(db.num_snapshots());
+  for (int j = 0; j < db.num_snapshots(); ++j) {
+    position[j] = {index_of(training, db.parameter(j)), j};
     if (position[j].first < 0)
-      throw InputError("cannot append to '" + name + "': snapshot " + std::to_string(j) +
+      throw InputError("cannot sort the snapshots of " + quoted(name, 200) + ": snapshot " + std::to_string(j) +
                        " is not at a parameter of the training set");
   }
   std::sort(position.begin(), position.end());
   std::vector<int> order;
   for (const auto& p : position) order.push_back(p.second);
-  return reordered(merged, order);
+  return reordered(db, order);
+}
+
+SnapshotDatabase merge_in_training_order(const std::vector<SnapshotDatabase>& databases,
+                                         const std::vector<std::string>& names) {
+  const SnapshotDatabase merged = merge_databases(databases, names);
+  const auto problem = rebuild_database_problem(databases[0], names[0]);
+  return sorted_by_training(merged, names[0], fom::training_set(*problem, merged.training_size));
+}
+
+SnapshotDatabase append_snapshots(const SnapshotDatabase& db, const std::string& name, const SnapshotDatabase& added,
+                                  const std::vector<fom::Param>& training) {
+  return sorted_by_training(merge_databases({db, added}, {name, "the new snapshots"}), name, training);
 }
 
 }  // namespace contactrom::rom

@@ -174,7 +174,7 @@ std::string known_keys(const OnlineMethod& m) {
 
 void check_key(const OnlineMethod& m, const std::string& key) {
   if (!find_spec(m, key))
-    throw InputError("online method '" + m.name + "' has no option " + quoted(key) + "; it knows: " + known_keys(m));
+    throw InputError("online method " + quoted(m.name, 200) + " has no option " + quoted(key) + "; it knows: " + known_keys(m));
 }
 
 }  // namespace
@@ -274,7 +274,7 @@ std::string describe_option_type(const OptionSpec& spec) {
 }
 
 void validate_option_value(const std::string& method, const OptionSpec& spec, const std::string& value) {
-  const std::string what = "online method '" + method + "' option " + spec.key;
+  const std::string what = "online method " + quoted(method, 200) + " option " + spec.key;
   switch (spec.type) {
     case OptionType::Number:
       (void)parse_number(value, what, spec.range);
@@ -300,7 +300,7 @@ void validate_online_options(const std::string& method, const OnlineSolverOption
   if (m.open_options) return;  // the factory checks its own settings
   for (const auto& [key, value] : options.extra) {
     if (is_shared(key))
-      throw InputError("online method '" + method + "' option " + key +
+      throw InputError("online method " + quoted(method, 200) + " option " + key +
                        " is a field of OnlineSolverOptions; set the field (or use options_from_map)");
     check_key(m, key);
     validate_option_value(method, *find_spec(m, key), value);
@@ -357,7 +357,7 @@ void check_extra_options(const OnlineSolverOptions& options, const std::string& 
                          const std::vector<std::string>& known) {
   for (const auto& entry : options.extra) {
     if (std::find(known.begin(), known.end(), entry.first) != known.end()) continue;
-    throw InputError("online method '" + method + "' has no option '" + entry.first + "'; it knows: " +
+    throw InputError("online method " + quoted(method, 200) + " has no option " + quoted(entry.first, 200) + "; it knows: " +
                      (known.empty() ? "none" : join(known, ", ")));
   }
 }

@@ -1,5 +1,7 @@
 #include "rom/reduced_model.hpp"
 
+#include "core/format.hpp"
+
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <chrono>
@@ -28,7 +30,7 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
   const auto t0 = std::chrono::steady_clock::now();
   const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
   if (db.num_dofs() != nd || db.num_constraints() != nc)
-    throw InputError("database of problem '" + db.problem + "' has " + std::to_string(db.num_dofs()) + " dofs and " +
+    throw InputError("database of problem " + quoted(db.problem, 200) + " has " + std::to_string(db.num_dofs()) + " dofs and " +
                      std::to_string(db.num_constraints()) + " contact rows, but " + problem.name() + " has " +
                      std::to_string(nd) + " and " + std::to_string(nc));
   if (!(options.delta >= 0.0))
@@ -37,7 +39,7 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
   for (int j = 0; j < db.num_snapshots(); ++j)
     if (options.include_failed_snapshots || db.status[j] == Status::Success) m_dict_snapshots.push_back(j);
   if (m_dict_snapshots.empty())
-    throw InputError("database of problem '" + db.problem + "' holds no successful snapshot");
+    throw InputError("database of problem " + quoted(db.problem, 200) + " holds no successful snapshot");
   const int m = static_cast<int>(m_dict_snapshots.size());
 
   const int nt = problem.num_load_terms();
@@ -67,11 +69,13 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
   Pod pod(pod_options);
   pod.compute(primal);
   if (pod.info() != Status::Success)
-    throw InputError("POD of the primal snapshots of '" + db.problem + "' failed (" + to_string(pod.info()) + ")");
+    throw InputError("POD of the primal snapshots of " + quoted(db.problem, 200) + " failed (" + to_string(pod.info()) + ")");
   m_phi = pod.basis();
   m_sigma = pod.singular_values();
   const std::vector<char>& dirichlet = problem.is_dirichlet();
-  for (int i = 0; i < nd; ++i)
+  // (A basis of rank 0, δ = 1, has no row to clear: row() of an empty matrix is
+  // an offset on a null pointer.)
+  for (int i = 0; i < nd && m_phi.cols() > 0; ++i)
     if (dirichlet[i]) m_phi.row(i).setZero();
 
   // Affine reduced operators (file comment).
@@ -133,7 +137,7 @@ ReducedModel::ReducedModel(const fom::Problem& problem, ReducedModelData data)
   const long m = data.dictionary.cols(), nq = problem.num_stiffness_terms(), nt = problem.num_load_terms();
   const auto require = [&](bool ok, const std::string& what, long got, long expected) {
     if (!ok)
-      throw InputError("reduced model of '" + problem.name() + "': " + what + " has size " + std::to_string(got) +
+      throw InputError("reduced model of " + quoted(problem.name(), 200) + ": " + what + " has size " + std::to_string(got) +
                        ", expected " + std::to_string(expected));
   };
   require(data.basis.rows() == n, "the basis' row count", data.basis.rows(), n);
@@ -202,7 +206,7 @@ void ReducedModel::derive() {
   m_siblings.assign(static_cast<size_t>(snapshots), {});
   for (int c = 0; c < dictionary_size(); ++c) m_siblings[static_cast<size_t>(m_dict_snapshots[static_cast<size_t>(c)])].push_back(c);
   m_phi_s.resize(ns, r);
-  for (int a = 0; a < ns; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
+  for (int a = 0; a < ns && r > 0; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
   m_phi_s_rows = m_phi_s;
   m_lift_s.resize(ns, nt);
   for (int k = 0; k < nt; ++k)

@@ -21,6 +21,7 @@
 #include <memory>
 #include <string>
 
+#include "core/atomic_file.hpp"
 #include "fom/problem.hpp"
 #include "rom/online_solver.hpp"
 #include "rom/online_methods.hpp"
@@ -88,5 +89,8 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
 /// (Σ weights · pressure), time_s (online core), selected (space-separated database
 /// snapshot indices) and coefficients (space-separated, in the order of `selected`).
 void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results);
+
+/// \brief The content of write_query_csv() (for a set of files published together).
+FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResult>& results);
 
 }  // namespace contactrom::rom

@@ -163,7 +163,7 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
       write_problem_record(f, dcpl, problem_record(db));
     });
   } catch (const Hdf5Failure& e) {
-    throw InputError("cannot write database '" + path + "': HDF5 failed on " + e.what());
+    throw InputError("cannot write database " + quoted(path, 200) + ": HDF5 failed on " + e.what());
   }
 }
 
@@ -173,10 +173,10 @@ SnapshotDatabase read_database(const std::string& path) {
   try {
     const hid_t f = file.id();
     if (!has_attribute(f, "format_version"))
-      throw InputError("database '" + path + "' has no format_version attribute; not a contactrom database");
+      throw InputError("database " + quoted(path, 200) + " has no format_version attribute; not a contactrom database");
     const int version = hdf5::read_int_attribute(f, "format_version");
     if (version != kDatabaseFormatVersion)
-      throw InputError("database '" + path + "' has format_version " + std::to_string(version) +
+      throw InputError("database " + quoted(path, 200) + " has format_version " + std::to_string(version) +
                        ", but this contactrom reads version " + std::to_string(kDatabaseFormatVersion) + "; rebuild it with contactrom offline");
     db.created_by = read_string_attribute(f, "created_by");
     db.training_kind = read_string_attribute(f, "training_kind");
@@ -208,13 +208,13 @@ SnapshotDatabase read_database(const std::string& path) {
       throw hdf5::Refused("dataset /parameters has " + std::to_string(db.parameters.rows()) +
                         " columns but param_names lists " + std::to_string(db.param_names.size()));
     if (db.training_kind != "train" && db.training_kind != "level" && db.training_kind != "list")
-      throw hdf5::Refused("attribute training_kind is '" + db.training_kind + "', expected 'train', 'level' or 'list'");
+      throw hdf5::Refused("attribute training_kind is " + quoted(db.training_kind, 200) + ", expected 'train', 'level' or 'list'");
     validate_values(db);
     file.close("file close");
   } catch (const hdf5::Refused& e) {
-    throw InputError("database '" + path + "' is not a valid contactrom database: " + e.what());
+    throw InputError("database " + quoted(path, 200) + " is not a valid contactrom database: " + e.what());
   } catch (const Hdf5Failure& e) {
-    throw InputError("database '" + path + "' is truncated or corrupt (HDF5 cannot read " + e.what() + ")");
+    throw InputError("database " + quoted(path, 200) + " is truncated or corrupt (HDF5 cannot read " + e.what() + ")");
   }
   return db;
 }
@@ -223,21 +223,21 @@ void check_database(const SnapshotDatabase& db, const fom::Problem& problem, con
   check_database_problem(db, problem, path);
   const std::string selector = problem.definition().training.selector();
   if (db.training_kind != selector)
-    throw InputError("database '" + path + "' selects its training set by '" + db.training_kind + "', but " +
-                     problem.name() + " uses '" + selector + "'");
+    throw InputError("database " + quoted(path, 200) + " selects its training set by " + quoted(db.training_kind, 200) + ", but " +
+                     problem.name() + " uses " + quoted(selector, 200));
   check_training_set(db, problem, path);
 }
 
 void check_database_problem(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path) {
   if (db.problem != problem.name())
-    throw InputError("database '" + path + "' was built for problem '" + db.problem + "', not '" + problem.name() + "'");
+    throw InputError("database " + quoted(path, 200) + " was built for problem " + quoted(db.problem, 200) + ", not " + quoted(problem.name(), 200));
   if (db.mesh_fingerprint != problem.fingerprint())
-    throw InputError("database '" + path + "' was built for mesh fingerprint " + db.mesh_fingerprint +
+    throw InputError("database " + quoted(path, 200) + " was built for mesh fingerprint " + db.mesh_fingerprint +
                      " but the current " + problem.name() + " mesh is " + problem.fingerprint() +
                      "; rebuild it with contactrom offline");
   if (db.num_dofs() != problem.num_dofs() || db.num_constraints() != problem.contact().num_constraints() ||
       db.parameters.rows() != problem.num_params())
-    throw InputError("database '" + path + "' holds " + std::to_string(db.num_dofs()) + " dofs, " +
+    throw InputError("database " + quoted(path, 200) + " holds " + std::to_string(db.num_dofs()) + " dofs, " +
                      std::to_string(db.num_constraints()) + " contact rows and " +
                      std::to_string(db.parameters.rows()) + " parameters, but " + problem.name() + " has " +
                      std::to_string(problem.num_dofs()) + ", " + std::to_string(problem.contact().num_constraints()) +
@@ -249,7 +249,7 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
     try {
       problem.check_param(db.parameter(j));
     } catch (const InputError& e) {
-      throw InputError("database '" + path + "' dataset /parameters row " + std::to_string(j) + ": " + e.what());
+      throw InputError("database " + quoted(path, 200) + " dataset /parameters row " + std::to_string(j) + ": " + e.what());
     }
   }
   const std::string option = db.training_kind == "level" ? "level " : db.training_kind == "list" ? "the list of " : "training size ";
@@ -257,10 +257,10 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
   try {
     expected = fom::training_set(problem, db.training_size);
   } catch (const InputError& e) {
-    throw InputError("database '" + path + "' attribute training_size: " + e.what());
+    throw InputError("database " + quoted(path, 200) + " attribute training_size: " + e.what());
   }
   const auto mismatch = [&](const std::string& why) {
-    return InputError("database '" + path + "' claims " + option + std::to_string(db.training_size) + " of " +
+    return InputError("database " + quoted(path, 200) + " claims " + option + std::to_string(db.training_size) + " of " +
                       problem.name() + ", but " + why + "; expected the snapshots of that training set");
   };
   if (static_cast<int>(expected.size()) != db.num_snapshots())
@@ -277,8 +277,12 @@ void describe_problem(const fom::Problem& problem, SnapshotDatabase& db) {
   set_problem_record(db, record_problem(problem));
 }
 
+std::unique_ptr<fom::Problem> rebuild_database_problem(const SnapshotDatabase& db, const std::string& path) {
+  return rebuild_problem(problem_record(db), "database " + quoted(path, 200));
+}
+
 std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, const std::string& path) {
-  auto problem = rebuild_problem(problem_record(db), "database '" + path + "'");
+  auto problem = rebuild_database_problem(db, path);
   check_database(db, *problem, path);
   return problem;
 }

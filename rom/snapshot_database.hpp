@@ -99,8 +99,12 @@ void check_database(const SnapshotDatabase& db, const fom::Problem& problem, con
 void check_database_problem(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path);
 
 /// \brief Rebuilds the problem from the database alone (problem-file text and mesh;
-/// `rope` by name) and checks that it matches (check_database).
+/// `rope` by name), whatever snapshots it holds (a part of a run, for `merge`).
 /// \throws InputError naming `path` if the stored problem cannot be rebuilt.
+std::unique_ptr<fom::Problem> rebuild_database_problem(const SnapshotDatabase& db, const std::string& path);
+
+/// \brief rebuild_database_problem(), then check_database(): the database must be
+/// that problem's complete training set, in order.
 std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, const std::string& path);
 
 /// \brief Fills the problem fields of `db` (name, fingerprint, text, mesh, contact

@@ -25,6 +25,7 @@ struct ReduceArgs : MethodArgs {
 
 void run_reduce(const ReduceArgs& a) {
   check_output_path(a.out);
+  check_output_not_input(a.out, {a.db});
   rom::check_online_method(a.method);
   const auto t0 = std::chrono::steady_clock::now();
   const rom::SnapshotDatabase db = rom::read_database(a.db);

@@ -16,6 +16,7 @@
 #include "common/run_command.hpp"
 #include "fom/kkt.hpp"
 #include "fom/problem.hpp"
+#include "rom/hdf5_io.hpp"
 #include "rom/offline.hpp"
 #include "rom/reduced_model_file.hpp"
 
@@ -67,8 +68,9 @@ void check_same_answers(const OnlineModel& a, const OnlineModel& b) {
   }
 }
 
-/// Overwrites element 0 of a double dataset of an HDF5 file.
-void poke(const std::string& path, const char* dataset, double value) {
+/// Overwrites element 0 of a double dataset of an HDF5 file; with `checksum`, also
+/// stores the checksum of the new data (so that the reader's other checks see it).
+void poke(const std::string& path, const char* dataset, double value, bool checksum = true) {
   const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   BOOST_REQUIRE(f >= 0);
   const hid_t d = H5Dopen2(f, dataset, H5P_DEFAULT);
@@ -79,6 +81,15 @@ void poke(const std::string& path, const char* dataset, double value) {
   const hsize_t one[1] = {1};
   const hid_t mem = H5Screate_simple(1, one, nullptr);
   BOOST_REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, &value) >= 0);
+  if (checksum) {
+    std::vector<double> all(static_cast<size_t>(H5Sget_simple_extent_npoints(space)));
+    BOOST_REQUIRE(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, all.data()) >= 0);
+    const std::uint32_t sum = contactrom::rom::hdf5::data_checksum(all.data(), all.size() * sizeof(double));
+    const hid_t attr = H5Aopen(d, contactrom::rom::hdf5::kChecksumAttribute, H5P_DEFAULT);
+    BOOST_REQUIRE(attr >= 0);
+    BOOST_REQUIRE(H5Awrite(attr, H5T_NATIVE_UINT32, &sum) >= 0);
+    H5Aclose(attr);
+  }
   H5Sclose(mem), H5Sclose(space), H5Dclose(d), H5Fclose(f);
 }
 
@@ -197,6 +208,39 @@ BOOST_AUTO_TEST_CASE(damaged_or_wrong_files_are_refused_with_one_line) {
   const auto bad_param = run_command(exe + " query --rom " + good + " --param 0.5");
   BOOST_TEST(bad_param.exit_code == 2);
   BOOST_TEST(bad_param.err.find("0.5") != std::string::npos, bad_param.err);
+}
+
+BOOST_AUTO_TEST_CASE(every_stored_list_and_number_is_checked) {
+  const std::string good = work_dir() + "/hertz10_lists.h5";
+  OnlineModel(hertz(), hertz_db(), {}, "greedy").save(good);
+  // NaN or Inf in the singular values or the surface rows of the basis.
+  for (const char* dataset : {"singular_values", "surface_basis"})
+    for (double bad : {std::nan(""), HUGE_VAL}) {
+      const std::string damaged = work_dir() + "/damaged.h5";
+      fs::copy_file(good, damaged, fs::copy_options::overwrite_existing);
+      poke(damaged, dataset, bad);
+      const std::string e = one_line_error([&] { OnlineModel::load(damaged); });
+      BOOST_TEST(e.find(std::string("/") + dataset) != std::string::npos, e);
+    }
+  // The node list of the Dirichlet curve of the load without its last node: another
+  // problem (that node no longer pushed), which the stored fingerprint must refuse.
+  const std::string emptied = work_dir() + "/emptied.h5";
+  fs::copy_file(good, emptied, fs::copy_options::overwrite_existing);
+  const auto py = run_command(
+      "/usr/bin/python3 -c \"import h5py, numpy; f = h5py.File('" + emptied + "', 'a'); "
+      "names = [n.decode() for n in f['mesh/curve_names'][()]]; k = 'mesh/curve_%d_nodes' % names.index('top_load'); "
+      "data = f[k][()][:-1]; del f[k]; f.create_dataset(k, data=data); "
+      "import sys; sys.path.insert(0, '" + std::string(CONTACTROM_SOURCE_DIR) + "/fuzz'); "
+      "from hdf5_checksum import lookup3; f[k].attrs.create('checksum_lookup3', lookup3(data.tobytes()), dtype='<u4')\"");
+  BOOST_REQUIRE_MESSAGE(py.exit_code == 0, "needs /usr/bin/python3 with h5py: " << py.err);
+  const std::string e = one_line_error([&] { OnlineModel::load(emptied); });
+  BOOST_TEST(e.find("fingerprint") != std::string::npos, e);
+  // A number changed without its checksum: the file is damaged.
+  const std::string flipped = work_dir() + "/flipped.h5";
+  fs::copy_file(good, flipped, fs::copy_options::overwrite_existing);
+  poke(flipped, "dictionary", 0.5, false);
+  const std::string f = one_line_error([&] { OnlineModel::load(flipped); });
+  BOOST_TEST(f.find("/dictionary fails its checksum") != std::string::npos, f);
 }
 
 BOOST_AUTO_TEST_CASE(parameter_csv_is_checked_row_by_row) {
