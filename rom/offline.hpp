@@ -35,6 +35,14 @@ struct OfflineOptions {
   /// Label written as the `created_by` attribute. Default "contactrom " + version().
   std::string created_by = "contactrom " + version();
   ProgressCallback progress;  ///< called after every snapshot (optional)
+  /// Stream the primal snapshots, as they are computed, into a database file at this
+  /// path (rom::DatabaseWriter; the caller renames or merges it, and removes it on
+  /// failure) instead of holding them in memory: the returned database then refers
+  /// to that file (primal_files) and the run's memory does not grow with the number
+  /// of snapshots (the pressures, n_c per snapshot, stay in memory). Default "" (in memory).
+  std::string stream_to;
+  /// The database named in error messages about `stream_to` (default: stream_to itself).
+  std::string stream_label;
 };
 
 /// \brief Computes the FOM snapshots of `problem` at `params` (in parallel; see the

@@ -20,7 +20,8 @@ struct MergeArgs {
 
 void run_merge(const MergeArgs& a) {
   std::vector<rom::SnapshotDatabase> dbs;
-  for (const auto& path : a.inputs) dbs.push_back(rom::read_database(path));
+  // The primal snapshots stay on disk: the merged file is written one snapshot at a time.
+  for (const auto& path : a.inputs) dbs.push_back(rom::read_database(path, false));
   const rom::SnapshotDatabase merged = rom::merge_databases(dbs, a.inputs);
   rom::write_database(a.out, merged);
   if (a.json) {
