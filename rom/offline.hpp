@@ -13,7 +13,9 @@
 /// all worker threads; every parameter is solved from scratch (no warm start from
 /// a neighbouring parameter) and its snapshot is written into the column
 /// preassigned to it, so the arrays are bit-identical whatever the thread count
-/// and scheduling. Only the timing fields differ between runs.
+/// and scheduling. Only the timing fields differ between runs. With
+/// OfflineOptions::stream_to each primal snapshot goes to the file as soon as it is
+/// computed (rom::DatabaseWriter), with the same arrays.
 #include <chrono>
 #include <functional>
 #include <iosfwd>
