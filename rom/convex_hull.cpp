@@ -289,6 +289,9 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
   // them, d_p = u_j − u_lift(μ_j) (Dirichlet lifting, so that u = u_lift(μ) + D_p α
   // is a convex combination of the snapshots up to the Dirichlet data): the reduced
   // model measures its snapshots from its own offset u_off, which is undone here.
+  if (!model.has_primal_snapshots())
+    throw InputError("convex-hull combines the primal training snapshots, which this reduced model of '" +
+                     problem.name() + "' does not keep (build it with keep_primal_snapshots = true)");
   MatrixXd dp = model.primal_snapshots();
   const MatrixXd& dd = model.dictionary();
   const Index m = dp.cols();

@@ -1,6 +1,7 @@
 #include "rom/database_merge.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "core/format.hpp"
 
@@ -38,7 +39,10 @@ SnapshotDatabase reordered(const SnapshotDatabase& db, const std::vector<int>& o
   for (size_t j = 0; j < order.size(); ++j) {
     const int k = order[j];
     out.parameters.col(j) = db.parameters.col(k);
-    out.primal.col(j) = db.primal.col(k);
+    if (db.primal_in_memory())
+      out.primal.col(j) = db.primal.col(k);
+    else
+      out.primal_refs[j] = db.primal_refs[k];
     out.dual.col(j) = db.dual.col(k);
     out.status[j] = db.status[k];
     out.iterations[j] = db.iterations[k];
@@ -64,9 +68,16 @@ SnapshotDatabase merge_databases(const std::vector<SnapshotDatabase>& databases,
   int n = 0;
   for (const auto& db : databases) n += db.num_snapshots();
 
+  // Snapshots on disk stay there: the merged database refers to their files.
+  const bool on_disk = !databases[0].primal_in_memory();
+  for (const auto& db : databases)
+    if (db.primal_in_memory() == on_disk)
+      throw std::invalid_argument("merge_databases: databases with primal snapshots in memory and on disk");
   SnapshotDatabase out = databases[0];
   out.parameters.resize(databases[0].parameters.rows(), n);
-  out.primal.resize(databases[0].num_dofs(), n);
+  out.primal.resize(databases[0].num_dofs(), on_disk ? 0 : n);
+  out.primal_files.clear();
+  out.primal_refs.clear();
   out.dual.resize(databases[0].num_constraints(), n);
   out.status.clear();
   out.iterations.clear();
@@ -83,10 +94,14 @@ SnapshotDatabase merge_databases(const std::vector<SnapshotDatabase>& databases,
           throw InputError("cannot merge '" + names[d] + "': its snapshot " + std::to_string(k) +
                            " has the parameter of an earlier snapshot; expected disjoint parts");
       out.parameters.col(j) = db.parameters.col(k);
-      out.primal.col(j) = db.primal.col(k);
+      if (on_disk)
+        out.primal_refs.push_back({db.primal_refs[k].file + static_cast<int>(out.primal_files.size()), db.primal_refs[k].row});
+      else
+        out.primal.col(j) = db.primal.col(k);
       out.dual.col(j) = db.dual.col(k);
       ++j;
     }
+    out.primal_files.insert(out.primal_files.end(), db.primal_files.begin(), db.primal_files.end());
     out.status.insert(out.status.end(), db.status.begin(), db.status.end());
     out.iterations.insert(out.iterations.end(), db.iterations.begin(), db.iterations.end());
     out.pairing_iterations.insert(out.pairing_iterations.end(), db.pairing_iterations.begin(),

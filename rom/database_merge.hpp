@@ -23,7 +23,10 @@ namespace contactrom::rom {
 std::pair<int, int> part_range(int n, int k, int parts);
 
 /// \brief Concatenates the snapshots of `databases` in the given order (timing
-/// fields: setup and wall times summed, threads the largest).
+/// fields: setup and wall times summed, threads the largest). Databases whose primal
+/// snapshots are on disk (read_database(path, false), streamed offline runs) are
+/// merged by reference: the result refers to their files, and write_database()
+/// copies the snapshots one at a time (all inputs alike: in memory or on disk).
 /// \param names file names of the databases, for error messages (same size)
 /// \throws InputError naming the two files if they differ in problem, mesh
 ///   fingerprint, parameter names, training options (kind and size), numbers of dofs

@@ -200,7 +200,7 @@ std::vector<OnlineMethod> rom_online_methods() {
           {"greedy-nested", "greedy active set, contact operators rebuilt on a nested schedule", greedy_specs(false),
            nested},
           {"convex-hull", "convex-hull approximation: nnFOCUSS on the monolithic dictionary (paper app. B)",
-           convex_hull_specs(), make_convex_hull_solver}};
+           convex_hull_specs(), make_convex_hull_solver, false, /*needs_primal_snapshots=*/true}};
 }
 
 void register_online_method(OnlineMethod method) {
@@ -224,6 +224,7 @@ void register_online_solver(const std::string& name, OnlineSolverFactory factory
   m.name = name;
   m.summary = "registered at run time";
   m.open_options = true;
+  m.needs_primal_snapshots = true;  // unknown: keep everything the method could read
   m.factory = std::move(factory);
   register_online_method(std::move(m));
 }
@@ -253,6 +254,10 @@ OnlineMethod online_method(const std::string& name) {
                      " is in the library contactrom::baselines, which this program does not link; link it "
                      "(CMake: target_link_libraries(app PRIVATE contactrom::baselines))");
   throw InputError("unknown online method " + quoted(name) + "; expected one of: " + join(online_solver_names(), ", "));
+}
+
+bool online_method_needs_primal_snapshots(const std::string& name) {
+  return online_method(name).needs_primal_snapshots;
 }
 
 std::string describe_option_type(const OptionSpec& spec) {

@@ -96,7 +96,9 @@ void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
   for (size_t c = 0; c < d.dictionary_parameters.size(); ++c)
     params.col(static_cast<Eigen::Index>(c)) = d.dictionary_parameters[c];
   write_columns(f, dcpl, "dictionary_parameters", params);
-  write_columns(f, dcpl, "primal_snapshots", d.primal_snapshots);
+  write_columns(f, dcpl, "snapshot_coordinates", d.snapshot_coordinates);
+  // The primal snapshots (n × m, most of the file) only for a method that combines them.
+  if (d.primal_snapshots.cols() > 0) write_columns(f, dcpl, "primal_snapshots", d.primal_snapshots);
   write_problem_record(f, dcpl, record_problem(rom.problem()));
 }
 
@@ -114,7 +116,9 @@ OnlineModel::OnlineModel(std::shared_ptr<const fom::Problem> problem, const Snap
     : m_problem(std::move(problem)), m_method(method), m_options(options) {
   // The method name first: building the model costs a POD.
   check_online_method(method);
-  m_model = std::make_unique<ReducedModel>(*m_problem, db, model_options);
+  ReducedModelOptions kept = model_options;
+  kept.keep_primal_snapshots = online_method_needs_primal_snapshots(method);
+  m_model = std::make_unique<ReducedModel>(*m_problem, db, kept);
   m_solver = make_online_solver(m_method, *m_model, m_options);
 }
 
@@ -144,7 +148,7 @@ OnlineModel OnlineModel::load(const std::string& path) {
       throw InputError(label + " is not a contactrom reduced model (attribute kind is not '" + kKind +
                        "'; a snapshot database is read with --db, not --rom)");
     const int version = hdf5::read_int_attribute(f, "format_version");
-    if (version != kReducedModelFormatVersion)
+    if (version != kReducedModelFormatVersion && version != 1)
       throw InputError(label + " has format_version " + std::to_string(version) + ", but this contactrom reads version " +
                        std::to_string(kReducedModelFormatVersion) + "; rebuild it with contactrom reduce");
     method = hdf5::read_string_attribute(f, "method");
@@ -192,7 +196,20 @@ OnlineModel OnlineModel::load(const std::string& path) {
     const auto [mp, np] = shape2(f, "dictionary_parameters");
     const Eigen::MatrixXd params = read_columns(f, "dictionary_parameters", np, m);
     for (hsize_t c = 0; c < m; ++c) d.dictionary_parameters.push_back(params.col(static_cast<Eigen::Index>(c)));
-    d.primal_snapshots = read_columns(f, "primal_snapshots", n, m);
+    // Version 1 stored the primal snapshots always and no coordinates; version 2 the
+    // coordinates always and the snapshots only for a method that needs them.
+    bool needs_primal = false;
+    try {
+      needs_primal = online_method_needs_primal_snapshots(method);
+    } catch (const InputError&) {  // an unknown method is reported below, naming the file
+    }
+    if (version == 1 || needs_primal) d.primal_snapshots = read_columns(f, "primal_snapshots", n, m);
+    if (version == 1) {
+      d.snapshot_coordinates = d.basis.transpose() * d.primal_snapshots;
+      if (!needs_primal) d.primal_snapshots.resize(0, 0);
+    } else {
+      d.snapshot_coordinates = read_columns(f, "snapshot_coordinates", r, m);
+    }
     const double scale = std::max(1.0, d.dictionary.size() ? d.dictionary.cwiseAbs().maxCoeff() : 0.0);
     if (d.dictionary.size() && d.dictionary.minCoeff() < -1e-9 * scale)
       throw hdf5::Refused("dataset /dictionary holds a negative pressure");

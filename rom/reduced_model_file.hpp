@@ -31,7 +31,9 @@
 namespace contactrom::rom {
 
 /// \brief Version of the reduced-model file layout (attribute `format_version`).
-inline constexpr int kReducedModelFormatVersion = 1;
+/// Version 2 stores the snapshots' reduced coordinates and the primal snapshots only
+/// for a method that needs them; version-1 files are still read.
+inline constexpr int kReducedModelFormatVersion = 2;
 
 /// \brief A reduced model with its online method, ready to query; see the file comment.
 /// Immutable after construction; solve() is thread-safe.

@@ -23,7 +23,8 @@ void run_merge(const MergeArgs& a) {
   check_output_path(a.out);
   check_output_not_input(a.out, a.inputs);
   std::vector<rom::SnapshotDatabase> dbs;
-  for (const auto& path : a.inputs) dbs.push_back(rom::read_database(path));
+  // The primal snapshots stay on disk: the merged file is written one snapshot at a time.
+  for (const auto& path : a.inputs) dbs.push_back(rom::read_database(path, false));
   const rom::SnapshotDatabase merged = rom::merge_in_training_order(dbs, a.inputs);
   rom::write_database(a.out, merged);
   if (a.json) {

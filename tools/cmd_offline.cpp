@@ -61,6 +61,14 @@ std::vector<fom::Param> training_part(const std::vector<fom::Param>& params, con
   return std::vector<fom::Param>(params.begin() + begin, params.begin() + end);
 }
 
+/// Removes the file of a streamed part when the run ends (a no-op once it was renamed into place).
+struct TemporaryPart {
+  std::string path;
+  TemporaryPart(const TemporaryPart&) = delete;
+  TemporaryPart& operator=(const TemporaryPart&) = delete;
+  ~TemporaryPart() { std::remove(path.c_str()); }
+};
+
 /// Rank and size of the MPI run this process belongs to ({0, 1} when serial).
 struct Ranks {
   int rank = 0, size = 1;
@@ -116,7 +124,7 @@ void run_offline(const OfflineArgs& a) {
   // The database appended to is read on every rank (all refuse alike) and checked
   // against the run before any snapshot is computed.
   rom::SnapshotDatabase existing;
-  if (appending) existing = rom::read_database(a.append);
+  if (appending) existing = rom::read_database(a.append, false);
   // --append without --train/--level: the database's training set.
   const bool size_from_db = appending && !a.train && !a.level && plan.selector() != "list";
   const int n = size_from_db ? existing.training_size
@@ -154,6 +162,12 @@ void run_offline(const OfflineArgs& a) {
   rom::ProgressBar bar(std::cerr, label, ranks.root() && (a.progress || ::isatty(STDERR_FILENO)));
   rom::OfflineOptions options;
   options.threads = a.threads;
+  // Snapshots are streamed to a file of this process as they are computed; it
+  // becomes the database (serial), or is copied into it (append, MPI ranks), and is
+  // removed when this function ends.
+  options.stream_to = temporary_path_for(out);
+  options.stream_label = out;
+  const TemporaryPart part{options.stream_to};
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
   const std::string kind = plan.selector();
 #ifdef CONTACTROM_HAVE_MPI
@@ -169,6 +183,9 @@ void run_offline(const OfflineArgs& a) {
     if (appending) appended = rom::append_snapshots(existing, a.append, db, training);
     return appending ? appended : db;
   };
+  if (!appending && ranks.size == 1) {  // the streamed file is the database: publish it as it is
+    commit_temporary(options.stream_to, out);
+  }
   if (!ranks.root()) {
     write_on_root(out, result, ranks);
     return;
@@ -182,7 +199,7 @@ void run_offline(const OfflineArgs& a) {
               << ") status " << to_string(db.status[j]) << "; stored with its status and left out of the ROM\n";
   }
   const int stored = appending ? existing.num_snapshots() : 0;
-  write_on_root(out, result, ranks);
+  if (appending || ranks.size > 1) write_on_root(out, result, ranks);
 
   double fom_sum = 0.0;
   for (double t : db.time_s) fom_sum += t;

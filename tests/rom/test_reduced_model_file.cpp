@@ -123,6 +123,85 @@ BOOST_AUTO_TEST_CASE(saved_model_answers_like_the_original_for_every_method) {
   }
 }
 
+namespace {
+
+bool has_dataset(const std::string& path, const char* name) {
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  BOOST_REQUIRE(f >= 0);
+  const bool found = H5Lexists(f, name, H5P_DEFAULT) > 0;
+  H5Fclose(f);
+  return found;
+}
+
+/// Turns a file written by save() back into the version-1 layout: primal snapshots
+/// always (here: the convex hull's), no snapshot coordinates, format_version 1.
+void make_version_1(const std::string& path) {
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  BOOST_REQUIRE(f >= 0);
+  BOOST_REQUIRE(H5Ldelete(f, "snapshot_coordinates", H5P_DEFAULT) >= 0);
+  const hid_t a = H5Aopen(f, "format_version", H5P_DEFAULT);
+  const int one = 1;
+  BOOST_REQUIRE(H5Awrite(a, H5T_NATIVE_INT, &one) >= 0);
+  H5Aclose(a), H5Fclose(f);
+}
+
+/// Adds the m × n dataset /primal_snapshots (one column of `primal` per row).
+void add_primal_snapshots(const std::string& path, const Eigen::MatrixXd& primal) {
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  BOOST_REQUIRE(f >= 0);
+  const hsize_t dims[2] = {static_cast<hsize_t>(primal.cols()), static_cast<hsize_t>(primal.rows())};
+  const hid_t space = H5Screate_simple(2, dims, nullptr);
+  const hid_t d = H5Dcreate2(f, "primal_snapshots", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  BOOST_REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, primal.data()) >= 0);
+  H5Dclose(d), H5Sclose(space), H5Fclose(f);
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(files_store_primal_snapshots_only_for_methods_that_combine_them) {
+  const std::string greedy = work_dir() + "/hertz10_greedy_lean.h5", hull = work_dir() + "/hertz10_hull_lean.h5";
+  const OnlineModel g(hertz(), hertz_db(), {}, "greedy"), h(hertz(), hertz_db(), {}, "convex-hull");
+  g.save(greedy);
+  h.save(hull);
+  BOOST_TEST(!has_dataset(greedy, "primal_snapshots"));
+  BOOST_TEST(has_dataset(hull, "primal_snapshots"));
+  BOOST_TEST(!g.model().has_primal_snapshots());
+  BOOST_TEST(fs::file_size(greedy) < fs::file_size(hull));
+  // The coordinates are the projections of the snapshots (as computed from them).
+  const OnlineModel loaded = OnlineModel::load(greedy);
+  const Eigen::MatrixXd& coords = loaded.model().snapshot_coordinates();
+  const Eigen::MatrixXd expected = h.model().basis().transpose() * h.model().primal_snapshots();
+  BOOST_TEST((coords - expected).cwiseAbs().maxCoeff() <= 1e-12 * expected.cwiseAbs().maxCoeff());
+  check_same_answers(g, loaded);
+  // A convex hull on a model without primal snapshots is refused, naming what is missing.
+  contactrom::rom::ReducedModelOptions lean;
+  lean.keep_primal_snapshots = false;
+  const contactrom::rom::ReducedModel model(*hertz(), hertz_db(), lean);
+  BOOST_TEST(one_line_error([&] { (void)contactrom::rom::make_online_solver("convex-hull", model); })
+                 .find("primal training snapshots") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(version_1_files_are_still_read) {
+  // Version 1 stored the primal snapshots for every method and no coordinates.
+  const OnlineModel hull(hertz(), hertz_db(), {}, "convex-hull");
+  const Eigen::MatrixXd& primal = hull.model().primal_snapshots();
+  const Eigen::MatrixXd expected = hull.model().basis().transpose() * primal;
+  for (const std::string method : {"greedy", "convex-hull"}) {
+    BOOST_TEST_CONTEXT("method " << method) {
+      const std::string path = work_dir() + "/hertz10_v1_" + method + ".h5";
+      const OnlineModel original(hertz(), hertz_db(), {}, method);
+      original.save(path);
+      if (method == "greedy") add_primal_snapshots(path, primal);
+      make_version_1(path);
+      const OnlineModel loaded = OnlineModel::load(path);
+      BOOST_TEST(loaded.method() == method);
+      BOOST_TEST(loaded.model().has_primal_snapshots() == (method == "convex-hull"));
+      BOOST_TEST((loaded.model().snapshot_coordinates() - expected).cwiseAbs().maxCoeff() == 0.0);
+      check_same_answers(original, loaded);
+    }
+  }
+}
+
 BOOST_AUTO_TEST_CASE(loaded_model_reproduces_training_snapshots) {
   // The property the offline stage promises: at a training parameter the ROM gives
   // back (to the POD tolerance) the FOM snapshot it was built from.
