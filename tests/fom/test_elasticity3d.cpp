@@ -9,6 +9,7 @@
 #include <functional>
 #include <random>
 
+#include "common/box_mesh.hpp"
 #include "fom/elasticity.hpp"
 
 using namespace contactrom::fom;
@@ -16,48 +17,15 @@ using Eigen::Vector3d;
 
 namespace {
 
-/// The box [0,a]x[0,b]x[0,c] in n^3 hexahedra (gmsh node order); interior nodes
-/// jittered by up to `jitter` of a cell; `tets`: each hexahedron split into six
-/// tetrahedra around its diagonal 0-6 (a conforming split).
+/// The box [0,1]x[0,1]x[0,h] in n^3 hexahedra or tetrahedra, interior nodes jittered.
 Mesh box(int n, double jitter, bool tets, unsigned seed = 7, Vector3d size = Vector3d(1.0, 1.0, 1.0)) {
-  Mesh m;
-  m.dim = 3;
-  m.body_names = {"block"};
-  const int p = n + 1;
-  m.nodes.resize(3, p * p * p);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-jitter / n, jitter / n);
-  auto id = [p](int i, int j, int k) { return (k * p + j) * p + i; };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) {
-        const bool inner = i > 0 && j > 0 && k > 0 && i < n && j < n && k < n;
-        Vector3d x(double(i) / n, double(j) / n, double(k) / n);
-        if (inner) x += Vector3d(u(rng), u(rng), u(rng));
-        m.nodes.col(id(i, j, k)) = x.cwiseProduct(size);
-      }
-  const int split[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const std::array<int, 8> h = {id(i, j, k),         id(i + 1, j, k),         id(i + 1, j + 1, k),
-                                      id(i, j + 1, k),     id(i, j, k + 1),         id(i + 1, j, k + 1),
-                                      id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)};
-        if (!tets) {
-          m.cells.push_back(h);
-          m.cell_body.push_back(0);
-          continue;
-        }
-        for (const auto& t : split) {
-          std::array<int, 8> c = {h[t[0]], h[t[1]], h[t[2]], h[t[3]], -1, -1, -1, -1};
-          const Vector3d a = m.nodes.col(c[1]) - m.nodes.col(c[0]), b = m.nodes.col(c[2]) - m.nodes.col(c[0]),
-                         d = m.nodes.col(c[3]) - m.nodes.col(c[0]);
-          if (a.cross(b).dot(d) < 0) std::swap(c[1], c[2]);
-          m.cells.push_back(c);
-          m.cell_body.push_back(0);
-        }
-      }
-  return m;
+  contactrom::test::BoxSpec b;
+  b.cells = {n, n, n};
+  b.size = size;
+  b.tets = tets;
+  b.jitter = jitter;
+  b.seed = seed;
+  return contactrom::test::box_mesh(b);
 }
 
 /// Solves K u = 0 with u = `value(x)` on the dofs `fixed(node, component)` selects.
