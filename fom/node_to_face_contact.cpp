@@ -261,9 +261,14 @@ bool NodeToFaceContact::beyond_boundary(const Pair& pair, const Eigen::Matrix3Xd
     const Vector3d n = nv == 3 ? Vector3d((xm.col(facet[1]) - xm.col(facet[0])).cross(xm.col(facet[2]) - xm.col(facet[0])))
                                : Vector3d((xm.col(facet[2]) - xm.col(facet[0])).cross(xm.col(facet[3]) - xm.col(facet[1])));
     // The edge's in-plane outward direction: counter-clockwise seen along n, t × n points out.
+    // Beyond: farther out than off the facet's plane (and than the tolerance). A node
+    // off a tilted facet whose edge lies on a symmetry plane moves out of the plane
+    // only by the tilt times its normal distance, and stays paired.
     const Vector3d m = (b - a).cross(n);
-    const double mn = m.norm();
-    return mn > 0 && (x - pr.point).dot(m) / mn > m_options.boundary_tolerance * (b - a).norm();
+    const double mn = m.norm(), nn = n.norm();
+    if (!(mn > 0 && nn > 0)) return false;
+    const double out = (x - pr.point).dot(m) / mn, off = std::abs((x - pr.point).dot(n)) / nn;
+    return out > std::max(m_options.boundary_tolerance * (b - a).norm(), off);
   };
   if (pr.edge >= 0) return pair.boundary[static_cast<size_t>(f)][static_cast<size_t>(pr.edge)] && beyond_edge(f, pr.edge);
   if (pr.vertex < 0) return false;

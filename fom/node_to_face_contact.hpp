@@ -32,9 +32,11 @@ struct NodeToFaceOptions {
   /// Newton stops when the step in (ξ, η) is below this (default 1e-14).
   double newton_tolerance = 1e-14;
   /// A slave node whose closest point is on the boundary of the master surface is
-  /// unpaired when it lies beyond that boundary edge by more than this fraction of
-  /// the edge's length (the 3D form of a projection beyond the end of a 2D master
-  /// chain); nodes on a symmetry plane through the boundary stay paired. Default 1e-8.
+  /// unpaired when it lies beyond that boundary edge (along the facet's plane, away
+  /// from the facet) by more than this fraction of the edge's length and by more than
+  /// its distance from the facet's plane (the 3D form of a projection beyond the end
+  /// of a 2D master chain). The second bound keeps nodes on a symmetry plane through
+  /// the boundary paired when the facet tilts. Default 1e-8.
   double boundary_tolerance = 1e-8;
 };
 
