@@ -375,6 +375,27 @@ void NodeToFaceContact::search_pair(const Pair& pair, const Eigen::VectorXd& u_s
     FacetProjection pr;
   };
   const int max_ring = dims.maxCoeff();
+  // Squared lower bound of the distance from x to the cells outside the cube of
+  // rings 0..r around cell c: the nearest of the (up to six) slabs of the grid
+  // beyond the cube, each a box (∞: the cube covers the grid).
+  auto beyond_ring = [&](const Eigen::Array3i& c, int r, const Vector3d& x) {
+    double bound = std::numeric_limits<double>::infinity();
+    Vector3d grid_hi;
+    for (int i = 0; i < 3; ++i) grid_hi(i) = box_lo(i) + dims(i) * h;
+    for (int i = 0; i < 3; ++i)
+      for (int side : {-1, 1}) {
+        Vector3d slab_lo = box_lo, slab_hi = grid_hi;
+        if (side < 0) {
+          if (c(i) - r - 1 < 0) continue;
+          slab_hi(i) = box_lo(i) + (c(i) - r) * h;
+        } else {
+          if (c(i) + r + 1 > dims(i) - 1) continue;
+          slab_lo(i) = box_lo(i) + (c(i) + r + 1) * h;
+        }
+        bound = std::min(bound, (x - x.cwiseMax(slab_lo).cwiseMin(slab_hi)).squaredNorm());
+      }
+    return bound;
+  };
   for (int r = 0; r < nrows; ++r) {
     const int k = rows ? rows[r] : pair.row_begin + r;
     const Vector3d x = m_slave_x.col(k) + u_surface.segment<3>(3 * k);
@@ -382,6 +403,9 @@ void NodeToFaceContact::search_pair(const Pair& pair, const Eigen::VectorXd& u_s
     auto visit = [&](int f) {
       if (stamp[static_cast<size_t>(f)] == k) return;
       stamp[static_cast<size_t>(f)] = k;
+      // A facet whose bounding box is farther than the best so far cannot be closer.
+      const double box2 = (x - x.cwiseMax(lo.col(f)).cwiseMin(hi.col(f))).squaredNorm();
+      if (best.facet >= 0 && box2 > best.dist2 * (1.0 + 1e-12)) return;
       const FacetProjection pr = project(pair, xm, f, x);
       // Ties (a node exactly on a shared edge) go to the lower facet index.
       if (pr.distance2 < best.dist2 * (1.0 - 1e-14) ||
@@ -400,8 +424,7 @@ void NodeToFaceContact::search_pair(const Pair& pair, const Eigen::VectorXd& u_s
             const size_t cell = static_cast<size_t>(flat({i, j, kk}));
             for (int e = start[cell]; e < start[cell + 1]; ++e) visit(list[static_cast<size_t>(e)]);
           }
-      // Cells of the next rings are at least ring·h away from x.
-      if (best.facet >= 0 && std::sqrt(best.dist2) <= ring * h) break;
+      if (best.facet >= 0 && best.dist2 <= beyond_ring(c, ring, x)) break;
     }
     if (best.facet < 0 || beyond_boundary(pair, xm, best.facet, best.pr, x)) continue;
     p.segment[static_cast<size_t>(k)] = best.facet;

@@ -83,8 +83,10 @@ struct ContactPairFacets {
 ///
 /// The search uses a uniform bucket grid over the deformed master facets' bounding
 /// boxes (about one cell per facet): a slave node visits the cells in rings of
-/// growing distance around its own and stops once the next ring is farther than the
-/// closest facet found, so a search costs about O(1) facets per node.
+/// growing distance around its own (projecting only onto facets whose bounding box is
+/// nearer than the closest facet found) and stops once the grid beyond the rings is
+/// farther than that facet, so a search tries a few facets per node, also for nodes
+/// far from the master surface.
 class NodeToFaceContact final : public ContactModel {
  public:
   /// \param nodes reference coordinates of the mesh (3 x n_nodes)
