@@ -86,7 +86,7 @@ ReducedActiveSet::ReducedActiveSet(std::string name, const rom::ReducedModel& mo
   }
 }
 
-rom::OnlineResult ReducedActiveSet::solve(const fom::Param& mu) const { return solve_from(mu, m_options.init); }
+rom::OnlineResult ReducedActiveSet::solve_reduced(const fom::Param& mu) const { return solve_from(mu, m_options.init); }
 
 rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmStart init) const {
   using clock = std::chrono::steady_clock;

@@ -127,7 +127,6 @@ class ReducedActiveSet : public rom::OnlineSolver {
 
   std::string name() const override { return m_name; }
   const rom::ReducedModel& model() const override { return m_model; }
-  rom::OnlineResult solve(const fom::Param& mu) const override;
 
   /// Dictionary columns forming W, in the order of W's columns.
   const std::vector<int>& dual_columns() const { return m_columns; }
@@ -154,6 +153,7 @@ class ReducedActiveSet : public rom::OnlineSolver {
   };
   std::vector<Start> m_starts;
   rom::OnlineResult solve_from(const fom::Param& mu, rom::WarmStart init) const;
+  rom::OnlineResult solve_reduced(const fom::Param& mu) const override;
 };
 
 /// \brief Reduced-level penetration \f$ \max_p D_d[:,p]^T (C(u)\,u - g(u)) \f$ over the

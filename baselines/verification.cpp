@@ -96,7 +96,10 @@ MethodVerification verify_method(const rom::OnlineSolver& solver, const rom::Onl
     row.time_s = res.time_s;
     m.max_reduced_penetration = std::max(m.max_reduced_penetration, row.reduced_penetration);
     if (row.reduced_penetration > m.tau + r.reduced_penetration_slack) ++m.reduced_violations;
-    if (!row.converged || row.status != Status::Success) ++m.nonconverged;
+    if (row.status == Status::Inaccurate)
+      ++m.inaccurate;
+    else if (!row.converged || row.status != Status::Success)
+      ++m.nonconverged;
     m.mean_time_s += row.time_s / n;
     m.mean_sparsity += double(row.sparsity) / n;
     m.mean_iterations += double(row.iterations) / n;

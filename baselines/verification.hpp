@@ -86,7 +86,8 @@ struct MethodVerification {
   rom::ErrorStatistics errors;
   double max_reduced_penetration = -std::numeric_limits<double>::infinity();  ///< over the rows
   int reduced_violations = 0;        ///< rows whose reduced penetration exceeds τ + slack
-  int nonconverged = 0;              ///< rows not converged or not Success
+  int nonconverged = 0;              ///< rows not converged or failed (not counting `inaccurate`)
+  int inaccurate = 0;                ///< rows with Status::Inaccurate (contact residuals above tolerance)
   double mean_time_s = 0.0;          ///< mean online core time
   double mean_sparsity = 0.0;        ///< mean |I|
   double mean_iterations = 0.0;      ///< mean iterations

@@ -23,7 +23,11 @@ enum class Status {
   Success,         ///< converged to the requested tolerance
   NoConvergence,   ///< iteration cap reached; results are the last iterate
   NumericalIssue,  ///< factorisation failed or a NaN appeared
-  InvalidInput     ///< dimensions or values inconsistent (numerical API only)
+  InvalidInput,    ///< dimensions or values inconsistent (numerical API only)
+  /// The method's own iteration converged, but the answer fails the full-order
+  /// checks a user would make (e.g. a reduced answer whose contact residuals, row
+  /// by row at its own pairing, exceed their tolerance: fom/contact_residuals.hpp)
+  Inaccurate
 };
 
 /// \brief Lower-case name of a status, as written in JSON and CSV output.
@@ -33,6 +37,7 @@ inline const char* to_string(Status s) {
     case Status::NoConvergence: return "no_convergence";
     case Status::NumericalIssue: return "numerical_issue";
     case Status::InvalidInput: return "invalid_input";
+    case Status::Inaccurate: return "inaccurate";
   }
   return "unknown";
 }

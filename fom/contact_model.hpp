@@ -71,6 +71,13 @@ class ContactModel {
   const Eigen::MatrixXd& constraint_points() const { return m_points; }
   /// Whether C and g depend on the displacement through a pairing.
   virtual bool has_pairing() const = 0;
+  /// Number of contact pairs (slave/master couples); 1 for an obstacle.
+  virtual int num_pairs() const { return 1; }
+  /// The contact pair a constraint row belongs to (0 … num_pairs() − 1).
+  virtual int pair_of_row(int row) const {
+    (void)row;
+    return 0;
+  }
 
   /// \brief Contact search in the deformed configuration, every row.
   /// \param u_surface full displacement restricted to surface_dofs()
@@ -155,9 +162,9 @@ class NodeToSegmentContact final : public ContactModel {
 
   /// Slave node ids of every row, in row order.
   const std::vector<int>& slave_nodes() const { return m_slave; }
-  int num_pairs() const { return static_cast<int>(m_pairs.size()); }
+  int num_pairs() const override { return static_cast<int>(m_pairs.size()); }
   /// Pair of a constraint row.
-  int pair_of_row(int row) const;
+  int pair_of_row(int row) const override;
 
  private:
   struct Pair {

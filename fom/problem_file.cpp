@@ -341,13 +341,20 @@ class Reader {
 
   void read_rom(const toml::table* t) {
     if (!t) return;
-    allow_keys(*t, "rom.", {"convex_hull", "cpg_tolerance"});
+    allow_keys(*t, "rom.", {"convex_hull", "cpg_tolerance", "penetration_tolerance", "complementarity_tolerance",
+                            "negative_pressure_tolerance"});
     m_def.rom.convex_hull = boolean(*t, "rom.", "convex_hull", false);
-    if (const toml::node* n = t->get("cpg_tolerance")) {
-      m_def.rom.cpg_tolerance = number(n, "rom.cpg_tolerance");
-      if (!(m_def.rom.cpg_tolerance > 0 && m_def.rom.cpg_tolerance < 1))
-        fail(n, "rom.cpg_tolerance", "is " + format_number(m_def.rom.cpg_tolerance) + "; expected a number in (0, 1)");
-    }
+    const auto fraction = [&](const char* key, double& out) {
+      if (const toml::node* n = t->get(key)) {
+        out = number(n, std::string("rom.") + key);
+        if (!(out > 0 && out < 1))
+          fail(n, std::string("rom.") + key, "is " + format_number(out) + "; expected a number in (0, 1)");
+      }
+    };
+    fraction("cpg_tolerance", m_def.rom.cpg_tolerance);
+    fraction("penetration_tolerance", m_def.rom.penetration_tolerance);
+    fraction("complementarity_tolerance", m_def.rom.complementarity_tolerance);
+    fraction("negative_pressure_tolerance", m_def.rom.negative_pressure_tolerance);
   }
 
   ProblemDefinition& m_def;

@@ -62,6 +62,13 @@ struct RomSettings {
   bool convex_hull = false;
   /// Default CPG tolerance for this problem (0: the method's own default).
   double cpg_tolerance = 0.0;
+  /// Tolerances of the row-by-row contact residuals a reduced answer must meet to
+  /// report `success` (fom/contact_residuals.hpp; 0: the defaults of
+  /// fom::ContactTolerances): penetration and separation under pressure in units of
+  /// the displacement scale U, negative pressure relative to the largest pressure.
+  double penetration_tolerance = 0.0;
+  double complementarity_tolerance = 0.0;
+  double negative_pressure_tolerance = 0.0;
 };
 
 /// \brief A problem file read into plain data; see the file comment.

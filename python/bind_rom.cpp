@@ -61,7 +61,7 @@ py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& probl
     std::visit([&d, &k = key](const auto& v) { d[k.c_str()] = v; }, value);
   const py::ssize_t n = static_cast<py::ssize_t>(s.rows.size());
   std::vector<fom::Param> mus;
-  py::array_t<double> primal(n), dual(n), time(n);
+  py::array_t<double> primal(n), dual(n), time(n), penetration(n), separation(n);
   py::array_t<int> sparsity(n), iterations(n);
   py::array_t<bool> converged(n), absolute(n);
   py::list status;
@@ -75,6 +75,8 @@ py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& probl
     iterations.mutable_at(i) = row.iterations;
     converged.mutable_at(i) = row.converged;
     absolute.mutable_at(i) = row.absolute_errors;
+    penetration.mutable_at(i) = row.contact.penetration;
+    separation.mutable_at(i) = row.contact.complementarity;
     status.append(to_string(row.status));
   }
   py::dict rows;
@@ -87,6 +89,8 @@ py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& probl
   rows["converged"] = converged;
   rows["status"] = status;
   rows["absolute_errors"] = absolute;
+  rows["penetration"] = penetration;
+  rows["separation"] = separation;
   d["rows"] = rows;
   return d;
 }
@@ -198,6 +202,12 @@ works in memory but is refused when read back from a file.)doc");
       .def_readonly("converged", &rom::OnlineResult::converged)
       .def_property_readonly("status", [](const rom::OnlineResult& r) { return std::string(to_string(r.status)); })
       .def_readonly("message", &rom::OnlineResult::message)
+      .def_property_readonly(
+          "penetration", [](const rom::OnlineResult& r) { return r.contact.penetration; },
+          "Largest penetration of the answer at its own pairing, in units of the displacement scale U.")
+      .def_property_readonly(
+          "separation", [](const rom::OnlineResult& r) { return r.contact.complementarity; },
+          "Separation under pressure (pressure-weighted mean |gap|) at its own pairing, in units of U.")
       .def_readonly("time_s", &rom::OnlineResult::time_s)
       .def("__repr__", [](const rom::OnlineResult& r) {
         return "<contactrom.RomSolution " + std::string(to_string(r.status)) + ", " + std::to_string(r.selected.size()) +
@@ -295,7 +305,7 @@ errors of rows whose FOM displacement is near zero are absolute, counted in
 'absolute_error_rows' with their maxima 'max_absolute_primal_error' and
 'max_absolute_dual_error', and left out of the relative means and maxima) plus
 'rows', the per-parameter arrays (mu, primal_error, dual_error, sparsity,
-iterations, time_s, converged, status, absolute_errors).)doc")
+iterations, time_s, converged, status, absolute_errors, penetration, separation).)doc")
       .def("__repr__", [](const ReducedModel& r) {
         return "<contactrom.ReducedModel '" + r.rom->problem().name() + "' " + r.rom->method() + ": rank " +
                std::to_string(r.rom->model().primal_rank()) + ", dictionary " +

@@ -261,6 +261,13 @@ void check_convex_hull_applicable(const fom::Problem& problem) {
 MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const ConvexHullOptions& options)
     : m_model(model), m_options(options) {
   const auto t0 = std::chrono::steady_clock::now();
+  // A convex combination of training solutions pairs each primal snapshot with its
+  // whole pressure: a dictionary split by contact pair has no such columns.
+  for (int p = 0; p < model.dictionary_size(); ++p)
+    if (model.sibling_columns(p).size() != 1)
+      throw InputError("convex-hull needs one dictionary column per snapshot; the reduced model of '" +
+                       model.problem().name() + "' splits its " + std::to_string(model.problem().contact().num_pairs()) +
+                       " contact pairs (build it with ReducedModelOptions::split_pairs = false)");
   const fom::Problem& problem = model.problem();
   const double delta = options.basis_delta < 0.0 ? model.delta() : options.basis_delta;
   if (!(delta >= 0.0) || !std::isfinite(delta))
@@ -393,6 +400,12 @@ ConvexHullSolver::ConvexHullSolver(const ReducedModel& model, const Options& opt
     : m_dictionary((check_convex_hull_applicable(model.problem()), model), options) {}
 
 ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
+  ConvexHullResult res = run(mu);
+  check_contact(model(), contact_tolerances(), res.online);
+  return res;
+}
+
+ConvexHullResult ConvexHullSolver::run(const fom::Param& mu) const {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   const MonolithicDictionary& dict = m_dictionary;

@@ -233,14 +233,16 @@ class ConvexHullSolver final : public OnlineSolver {
 
   std::string name() const override { return "convex-hull"; }
   const ReducedModel& model() const override { return m_dictionary.model(); }
-  OnlineResult solve(const fom::Param& mu) const override { return solve_detailed(mu).online; }
-  /// \brief Solves at μ and returns the method-specific statistics too.
+  /// \brief Solves at μ and returns the method-specific statistics too (`online`
+  /// with the contact check of solve()).
   ConvexHullResult solve_detailed(const fom::Param& mu) const;
 
   const MonolithicDictionary& dictionary() const { return m_dictionary; }
   const Options& options() const { return m_dictionary.options(); }
 
  private:
+  OnlineResult solve_reduced(const fom::Param& mu) const override { return run(mu).online; }
+  ConvexHullResult run(const fom::Param& mu) const;  // solve_detailed() before the contact check
   MonolithicDictionary m_dictionary;
 };
 

@@ -114,7 +114,8 @@ void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Para
   // (A quadratic stencil for û, tried on hertz 30, needed more pairing updates on
   // average: the solutions are not smooth in μ where nodes enter contact.)
   if (init != WarmStart::Primal)
-    for (const auto& s : stencil) columns.push_back(s.column);
+    for (const auto& s : stencil)
+      for (int c : model.sibling_columns(s.column)) columns.push_back(c);
   const Eigen::MatrixXd& coords = model.snapshot_coordinates();
   u_hat.setZero(model.primal_rank());
   for (const auto& s : stencil) u_hat.noalias() += s.weight * coords.col(s.column);
@@ -138,8 +139,12 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
   g.time_operators = options.time_operators;
   for (const auto& [key, value] : options.extra) {
     if (key == "schedule") {
-      g.schedule = greedy_choice<GreedySchedule>(
-          key, value, {{"interleaved", GreedySchedule::Interleaved}, {"nested", GreedySchedule::Nested}});
+      g.schedule = greedy_choice<GreedySchedule>(key, value,
+                                                 {{"fixed-point", GreedySchedule::FixedPoint},
+                                                  {"interleaved", GreedySchedule::Interleaved},
+                                                  {"paper", GreedySchedule::Interleaved},
+                                                  {"nested", GreedySchedule::Nested}});
+      if (value == "paper") g.anderson_depth = 0, g.nested_on_cycle = false;
     } else if (key == "anderson_depth") {
       g.anderson_depth = greedy_int_option(key, value, 0);
     } else if (key == "max_solves") {
@@ -149,6 +154,10 @@ GreedyOptions greedy_options(const OnlineSolverOptions& options) {
     } else if (key == "rebuild") {
       g.rebuild = greedy_choice<OperatorRebuild>(
           key, value, {{"partial", OperatorRebuild::Partial}, {"full", OperatorRebuild::Full}});
+    } else if (key == "surface_step") {
+      g.surface_step = parse_option_number("greedy", key, value);
+      if (!(g.surface_step > 0.0))
+        throw InputError("greedy option surface_step = '" + value + "' invalid; expected a number > 0");
     } else if (key == "on_cycle") {
       g.nested_on_cycle = greedy_choice<bool>(key, value, {{"nested", true}, {"continue", false}});
     }
@@ -274,7 +283,7 @@ void numerical_issue(OnlineResult& res) {
 
 }  // namespace
 
-OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
+OnlineResult GreedyActiveSet::solve_reduced(const fom::Param& mu) const {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   const int r = m_model.primal_rank(), nc = static_cast<int>(m_model.dictionary().rows());
@@ -300,7 +309,9 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   // The first search starts from the one made offline at the nearest training snapshot.
   if (q.nearest >= 0) q.ops.seed(m_model.snapshot_search_memory(q.nearest));
 
-  if (m_options.schedule == GreedySchedule::Nested)
+  if (m_options.schedule == GreedySchedule::FixedPoint)
+    solve_fixed_point(q, res);
+  else if (m_options.schedule == GreedySchedule::Nested)
     solve_nested(q, res, m_options.max_iterations);
   else
     solve_interleaved(q, res);
@@ -311,7 +322,7 @@ OnlineResult GreedyActiveSet::solve(const fom::Param& mu) const {
   res.lambda = m_model.reconstruct_dual(res.selected, res.coefficients);
   if (res.status == Status::Success && !res.converged) {
     res.status = Status::NoConvergence;
-    const bool nested = m_options.schedule == GreedySchedule::Nested;
+    const bool nested = m_options.schedule != GreedySchedule::Interleaved;
     res.message = "greedy active set did not converge in " + std::to_string(m_options.max_iterations) +
                   (nested ? " operator rebuilds (or " + std::to_string(m_options.max_solves) + " solves)" : " iterations") +
                   (q.best_iterate_returned ? "; best iterate with non-negative multipliers returned" : "");
@@ -543,7 +554,7 @@ struct GreedyActiveSet::Nested {
     }
     mixer.reset(g->m_options.anderson_depth);
     seen.clear(), solved.clear();
-    n_lambda = 0, pending = false, finite = true, solves = 0;
+    n_lambda = 0, pending = false, failed_test = false, finite = true, solves = 0;
   }
   /// A selected column p with the operators frozen: its row Ĉ_p = d_pᵀ A of Ĉ_I,
   /// w_p = K̂⁻¹ Ĉ_pᵀ and z_p = D_dᵀ C_s Φ_s w_p, the change of every column's
@@ -569,8 +580,11 @@ struct GreedyActiveSet::Nested {
   std::vector<char> in_active;
   std::vector<int> solved;
   SelectionHistory seen;  // selections met on the current operators
+  std::vector<double> feasible;  // settle_exact: the non-negative multipliers of `cols`
+  std::vector<int> blocked;      // settle_exact: columns not offered again on these operators
   fom::AndersonMixer mixer{0};
   bool pending = false;  // settled: to be confirmed at the fresh pairing of û
+  bool failed_test = false;  // fixed-point schedule: the last settled û failed the physical test
   bool finite = true;    // every solve so far gave finite values
   int solves = 0;
 
@@ -688,6 +702,100 @@ struct GreedyActiveSet::Nested {
     }
   }
 
+  /// Drops selected column i (position in `cols`) and its multiplier in `feasible`.
+  void drop(int i) {
+    in_active[static_cast<size_t>(cols[i].p)] = 0;
+    spare.push_back(std::move(cols[i]));
+    cols.erase(cols.begin() + i);
+    if (static_cast<int>(feasible.size()) > i) feasible.erase(feasible.begin() + i);
+  }
+
+  /// The reduced problem on the frozen operators solved exactly (Lawson–Hanson on
+  /// its dual, min_{λ̂ ≥ 0} ½ λ̂ᵀ S λ̂ − v_freeᵀ λ̂ over all columns, S = Ĉ K̂⁻¹ Ĉᵀ):
+  /// the most violated column beyond τ enters with λ̂ = 0; when the equality solve on
+  /// the selection gives a negative multiplier, the step from the feasible λ̂ towards
+  /// it stops where the first multiplier reaches zero (the ratio test) and that column
+  /// leaves. The multipliers stay non-negative, so no column is added and removed in
+  /// turn, and the loop ends with λ̂ ≥ 0 and every unselected violation ≤ τ. A
+  /// column that enters and leaves at once (dependent on the selection) is not tried
+  /// again on these operators. Returns whether the selection changed.
+  bool settle_exact(int rebuild) {
+    bool changed = false;
+    // A feasible start: the equality solve on the previous selection, its most
+    // negative multiplier dropped until none is.
+    for (;;) {
+      if (!(finite = solve())) return changed;
+      const int remove = most_negative(lambda_i());
+      if (remove < 0) break;
+      trace_step(rebuild, remove, -1, 0.0);
+      drop(remove);
+      changed = true;
+    }
+    feasible.assign(lambda_i().data(), lambda_i().data() + n_lambda);
+    blocked.clear();
+    while (solves < g->m_options.max_solves) {
+      const double max_violation = violation.size() > 0 ? violation.maxCoeff() : 0.0;
+      q->offer(max_violation, u_hat, lambda_i(), solved);
+      const int add = most_violated(violation, in_active, g->m_threshold);
+      trace_step(rebuild, -1, add, max_violation);
+      if (add < 0) break;
+      in_active[static_cast<size_t>(add)] = 1;
+      make_column(take_spare(), add);
+      feasible.push_back(0.0);
+      changed = true;
+      // Equality solves with the ratio test until the multipliers are non-negative.
+      while (solves < g->m_options.max_solves) {
+        if (!(finite = solve())) return changed;
+        const auto z = lambda_i();
+        if (z.size() == 0 || z.minCoeff() >= 0.0) break;
+        double alpha = 1.0;
+        int blocking = -1;
+        for (int i = 0; i < z.size(); ++i)
+          if (z(i) < 0.0) {
+            const double a = feasible[static_cast<size_t>(i)] / (feasible[static_cast<size_t>(i)] - z(i));
+            if (a < alpha || blocking < 0) alpha = a, blocking = i;
+          }
+        for (int i = 0; i < z.size(); ++i) feasible[static_cast<size_t>(i)] += alpha * (z(i) - feasible[static_cast<size_t>(i)]);
+        for (int i = static_cast<int>(cols.size()) - 1; i >= 0; --i)
+          if (i == blocking || feasible[static_cast<size_t>(i)] <= 0.0) {
+            if (cols[i].p == add && alpha == 0.0) blocked.push_back(add);
+            trace_step(rebuild, i, -1, 0.0);
+            drop(i);
+          }
+      }
+      feasible.assign(lambda_i().data(), lambda_i().data() + n_lambda);
+      for (int p : blocked) in_active[static_cast<size_t>(p)] = 1;  // not offered again on these operators
+    }
+    for (int p : blocked) in_active[static_cast<size_t>(p)] = 0;
+    for (const Column& col : cols) in_active[static_cast<size_t>(col.p)] = 1;
+    return changed;
+  }
+
+  /// Physical test at the pairing of the last rebuild (made at û): on the support
+  /// rows, the largest penetration and the separation under pressure of
+  /// λ = D_d[:, I] λ̂_I, in units of U (fom/contact_residuals.hpp), within `tol`.
+  bool physically_converged(const fom::ContactTolerances& tol) {
+    const SupportRows& support = g->m_support;
+    support.violation(q->ops.c, q->ops.g, u_s, gap, violation);  // gap = C_R u_s − g_R
+    const Eigen::VectorXd& w = g->m_model.problem().contact().weights();
+    const double u_scale = g->m_model.problem().displacement_scale();
+    double penetration = 0.0, force = 0.0, separation = 0.0;
+    for (int i = 0; i < gap.size(); ++i) {
+      const double ws = w(support.rows[static_cast<size_t>(i)]);
+      const double d = ws > 0.0 ? gap(i) / ws : 0.0;
+      penetration = std::max(penetration, d / u_scale);
+      double l = 0.0;
+      for (int j = 0; j < n_lambda; ++j) l += (*dr)(i, cols[j].p) * lambda_storage(j);
+      force += ws * std::abs(l);
+      separation += ws * std::abs(l) * std::abs(d);
+    }
+    const double complementarity = force > 0.0 ? separation / (u_scale * force) : 0.0;
+    if (g->m_options.trace)
+      *g->m_options.trace << "greedy physical test: penetration=" << penetration
+                          << " U, separation under pressure=" << complementarity << " U\n";
+    return penetration <= tol.penetration && complementarity <= tol.complementarity;
+  }
+
   void trace_step(int rebuild, int remove, int add, double max_violation) {
     std::ostream* out = g->m_options.trace;
     if (!out) return;
@@ -728,6 +836,58 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds
     }
     // 4. Settled, or the next rebuild point.
     s.next_rebuild_point(changed, rebuild);
+  }
+  res.iterations = s.solves;
+  q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i(), s.solved);
+}
+
+double GreedyActiveSet::surface_step(const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x) const {
+  thread_local Eigen::VectorXd change;
+  change.noalias() = m_model.surface_basis() * (u_hat - x);
+  return (change.size() > 0 ? change.cwiseAbs().maxCoeff() : 0.0) / m_model.problem().displacement_scale();
+}
+
+void GreedyActiveSet::solve_fixed_point(Query& q, OnlineResult& res) const {
+  thread_local Nested s;  // its storage serves the thread's next queries
+  s.start(*this, q);
+  const fom::ContactTolerances tolerances = contact_tolerances();
+  for (int rebuild = 0;; ++rebuild) {
+    // 1. Operators at x (surface rows only); where x = û, the physical test at û's own pairing.
+    q.surface_displacement(s.x, s.u_s);
+    q.rebuild(s.u_s);
+    if (s.pending) {
+      // A settled û that fails the physical test at its own pairing twice in a row
+      // is a fixed point of the reduced problem: iterating cannot improve it. It is
+      // returned as converged; the full-order check then reports it inaccurate.
+      const bool physical = s.physically_converged(tolerances);
+      if (physical || s.failed_test) {
+        res.converged = true;
+        break;
+      }
+      s.failed_test = true;
+    } else {
+      s.failed_test = false;
+    }
+    s.pending = false;
+    if (rebuild >= m_options.max_iterations || s.solves >= m_options.max_solves) break;
+    // 2. û(x): the reduced problem solved exactly on the frozen operators.
+    s.freeze_operators();
+    s.settle_exact(rebuild);
+    if (!s.finite) {
+      numerical_issue(res);
+      break;
+    }
+    // 3. The next point: û itself once the step is within the basis' resolution
+    //    (then tested at its own pairing), else the Anderson extrapolation of the
+    //    map x ↦ û(x), with one history over the whole query.
+    const double step = surface_step(s.u_hat, s.x);
+    if (m_options.trace) *m_options.trace << "greedy rebuild=" << rebuild << " surface step=" << step << " U\n";
+    if (step <= m_options.surface_step) {
+      s.pending = true;
+      s.x = s.u_hat;
+    } else {
+      s.mixer.next(s.x, s.u_hat, s.x);
+    }
   }
   res.iterations = s.solves;
   q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i(), s.solved);

@@ -75,6 +75,12 @@ enum class TauScaling {
 
 /// \brief When the reduced contact operators are rebuilt (see docs/rom.md).
 enum class GreedySchedule {
+  /// Default: the fixed point x ↦ û(x), û(x) the reduced problem on the contact
+  /// operators built at x, solved exactly (Lawson–Hanson with a ratio test on its
+  /// dual: the multipliers never go negative); x Anderson-accelerated with one
+  /// history over the query; stopped by a physical test at û's own pairing (see the
+  /// file comment). k_max counts the rebuilds.
+  FixedPoint,
   /// Paper Alg. 1: operators rebuilt at the previous iterate before every
   /// one-change iteration.
   Interleaved,
@@ -145,8 +151,8 @@ struct GreedyOptions {
   /// Starting point of the iteration. Default WarmStart::Cell (measured best, see
   /// docs/rom.md); WarmStart::Empty is the paper's Alg. 1.
   WarmStart init = WarmStart::Cell;
-  /// Operator-rebuild schedule. Default Interleaved (paper Alg. 1).
-  GreedySchedule schedule = GreedySchedule::Interleaved;
+  /// Operator-rebuild schedule. Default FixedPoint; Interleaved is the paper's Alg. 1.
+  GreedySchedule schedule = GreedySchedule::FixedPoint;
   /// How each rebuild searches the contact pairs. Default Partial.
   OperatorRebuild rebuild = OperatorRebuild::Partial;
   /// Anderson depth of the rebuild point while the selection stays the same (0:
@@ -157,6 +163,12 @@ struct GreedyOptions {
   /// selection, with the rebuilds left). false: the paper's Alg. 1, which may cycle
   /// to the cap. Default true.
   bool nested_on_cycle = true;
+  /// Fixed-point schedule: û is tested at its own pairing once the contact surface
+  /// moved by at most this, in units of the displacement scale U, between the point
+  /// where the operators were built and û (max over the surface dofs of
+  /// \f$ |\Phi_s(\hat u - x)| \f$). Default 1e-3 (a fiftieth of the default
+  /// penetration tolerance). The other schedules use step_tolerance.
+  double surface_step = 1e-3;
   /// Nested schedule: cap on the one-change solves of a query, over all rebuilds.
   /// Default 1000.
   int max_solves = 1000;
@@ -177,9 +189,8 @@ class GreedyActiveSet final : public OnlineSolver {
   explicit GreedyActiveSet(const ReducedModel& model, const Options& options = {});
 
   std::string name() const override { return m_options.schedule == GreedySchedule::Nested ? "greedy-nested" : "greedy"; }
-  const ReducedModel& model() const override { return m_model; }
-  OnlineResult solve(const fom::Param& mu) const override;
 
+  const ReducedModel& model() const override { return m_model; }
   /// The threshold τ actually used, after defaulting and scaling (same units as
   /// \f$ D_d^T (Cu - g) \f$).
   double threshold() const { return m_threshold; }
@@ -191,6 +202,8 @@ class GreedyActiveSet final : public OnlineSolver {
   double m_threshold = 0.0;
   SupportRows m_support;  // contact rows R where D_d is not zero, D_d restricted to R
 
+  OnlineResult solve_reduced(const fom::Param& mu) const override;
+
   struct Query;        // the per-query quantities both schedules share
   struct Interleaved;  // the interleaved schedule's state between its steps
   struct Nested;       // the nested schedule's state between its steps
@@ -198,6 +211,9 @@ class GreedyActiveSet final : public OnlineSolver {
   /// \param max_rebuilds cap on the operator rebuilds (k_max, or what the
   /// interleaved schedule left of it when it hands over on a cycle)
   void solve_nested(Query& q, OnlineResult& res, int max_rebuilds) const;
+  void solve_fixed_point(Query& q, OnlineResult& res) const;
+  /// \f$ \|\Phi_s(\hat u - x)\|_\infty / U \f$: how far the contact surface moved from x.
+  double surface_step(const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x) const;
 };
 
 /// \brief The threshold τ that GreedyActiveSet applies with `options` (defaulted to δ

@@ -53,6 +53,7 @@ SummaryValues summary_values(const EvaluationSummary& s) {
                      {"mean_time_s", s.mean_time_s},
                      {"median_time_s", s.median_time_s},
                      {"nonconverged", static_cast<long long>(s.nonconverged)},
+                     {"inaccurate", static_cast<long long>(s.inaccurate)},
                      {"fom_failures", static_cast<long long>(s.fom_failures)}});
   if (s.kkt) v.emplace_back("max_kkt", s.max_kkt);
   return v;
@@ -96,6 +97,7 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
     row.time_s = res.time_s;
     row.converged = res.converged;
     row.status = res.status;
+    row.contact = res.contact;
     for (int c : res.selected) row.selected.push_back(model.dictionary_snapshots()[c]);
     row.fom_status = ref.status;
     row.fom_time_s = ref.time_s;
@@ -108,7 +110,10 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
     s.max_sparsity = std::max(s.max_sparsity, row.sparsity);
     s.mean_iterations += row.iterations;
     s.mean_time_s += row.time_s;
-    if (!res.converged || res.status != Status::Success) ++s.nonconverged;
+    if (res.status == Status::Inaccurate)
+      ++s.inaccurate;
+    else if (!res.converged || res.status != Status::Success)
+      ++s.nonconverged;
     if (ref.status != Status::Success) ++s.fom_failures;
     times.push_back(row.time_s);
     s.rows.push_back(std::move(row));
@@ -124,14 +129,16 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
 void write_evaluation_csv(const std::string& path, const fom::Problem& problem, const EvaluationSummary& summary) {
   write_file_atomically(path, [&](std::ostream& out) {
     for (const std::string& name : problem.param_names()) out << name << ',';
-    out << "primal_error,dual_error,sparsity,iterations,time_s,converged,status,selected,errors\n";
+    out << "primal_error,dual_error,sparsity,iterations,time_s,converged,status,selected,errors,penetration,"
+           "separation\n";
     for (const EvaluationRow& row : summary.rows) {
       for (int k = 0; k < row.mu.size(); ++k) out << format_number(row.mu(k)) << ',';
       out << format_number(row.primal_error) << ',' << format_number(row.dual_error) << ',' << row.sparsity << ','
           << row.iterations << ',' << format_number(row.time_s) << ',' << (row.converged ? 1 : 0) << ','
           << to_string(row.status) << ',';
       for (size_t j = 0; j < row.selected.size(); ++j) out << (j ? " " : "") << row.selected[j];
-      out << ',' << (row.absolute_errors ? "absolute" : "relative") << '\n';
+      out << ',' << (row.absolute_errors ? "absolute" : "relative") << ',' << format_number(row.contact.penetration)
+          << ',' << format_number(row.contact.complementarity) << '\n';
     }
   });
 }

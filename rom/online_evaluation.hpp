@@ -42,6 +42,7 @@ struct EvaluationRow {
   double time_s = 0.0;         ///< online core time (OnlineResult::time_s)
   bool converged = false;
   Status status = Status::Success;
+  fom::ContactResiduals contact;  ///< the answer's full-order contact residuals (OnlineResult::contact)
   std::vector<int> selected;   ///< selected columns as database snapshot indices
   Status fom_status = Status::Success;
   double fom_time_s = 0.0;     ///< FOM reference time (measured in parallel: indicative only)
@@ -86,6 +87,7 @@ struct EvaluationSummary : ErrorStatistics {
   double mean_iterations = 0.0;
   double mean_time_s = 0.0, median_time_s = 0.0;
   int nonconverged = 0;   ///< ROM queries that hit the iteration cap or failed
+  int inaccurate = 0;     ///< ROM queries that converged with contact residuals above tolerance (Status::Inaccurate)
   int fom_failures = 0;   ///< reference FOM solves whose status != Success
   bool kkt = false;       ///< whether the rows' KKT residuals were computed (EvaluationOptions::kkt)
   double max_kkt = 0.0;   ///< largest KKT residual over the rows (if computed)
@@ -103,7 +105,7 @@ using SummaryValues = std::vector<std::pair<std::string, SummaryValue>>;
 /// dual_basis_size, primal_rank, validation_size, mean_primal_error,
 /// max_primal_error, mean_dual_error, max_dual_error, absolute_error_rows,
 /// max_absolute_primal_error, max_absolute_dual_error, mean_sparsity, max_sparsity,
-/// mean_iterations, mean_time_s, median_time_s, nonconverged, fom_failures, and
+/// mean_iterations, mean_time_s, median_time_s, nonconverged, inaccurate, fom_failures, and
 /// max_kkt when the KKT residuals were computed.
 SummaryValues summary_values(const EvaluationSummary& summary);
 
@@ -122,7 +124,8 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
 /// \brief Writes the rows as CSV (atomically): one column per parameter (named
 /// after it), then primal_error, dual_error, sparsity, iterations, time_s,
 /// converged (0/1), status, selected (space-separated database snapshot indices),
-/// errors ("relative", or "absolute" where the FOM displacement is near zero).
+/// errors ("relative", or "absolute" where the FOM displacement is near zero),
+/// penetration and separation (the answer's contact residuals, units of U).
 void write_evaluation_csv(const std::string& path, const fom::Problem& problem, const EvaluationSummary& summary);
 
 }  // namespace contactrom::rom

@@ -34,6 +34,17 @@ OptionSpec flag(std::string key, std::string def, std::string help) {
   return {std::move(key), OptionType::Flag, std::move(def), std::move(help), {}, {}};
 }
 
+/// The tolerances of the full-order contact check that every online method runs.
+OptionSpec penetration_tolerance_spec() {
+  return number("penetration_tolerance", "-1",
+                "largest penetration (units of U) of an answer reported success; < 0: the problem's [rom] value, else 5e-2");
+}
+OptionSpec complementarity_tolerance_spec() {
+  return number("complementarity_tolerance", "-1",
+                "largest separation under pressure (units of U) of an answer reported success; < 0: the problem's "
+                "[rom] value, else 5e-2");
+}
+
 }  // namespace
 
 std::vector<OptionSpec> active_set_option_specs() {
@@ -43,7 +54,8 @@ std::vector<OptionSpec> active_set_option_specs() {
           integer("max_iterations", "50", "iteration cap k_max", 1, 1e6),
           number("step_tolerance", "1e-5", "relative change of u_hat under which the iteration may stop",
                  Interval::at_least(0)),
-          flag("time_operators", "false", "measure the time spent building the contact operators")};
+          flag("time_operators", "false", "measure the time spent building the contact operators"),
+          penetration_tolerance_spec(), complementarity_tolerance_spec()};
 }
 
 namespace {
@@ -53,9 +65,15 @@ std::vector<OptionSpec> greedy_specs(bool with_schedule) {
   o.push_back(choice("init", "cell", "starting point: empty (paper Alg. 1), cell, nearest or primal",
                      {"empty", "cell", "nearest", "primal"}));
   if (with_schedule)
-    o.push_back(choice("schedule", "interleaved", "operator rebuilds: interleaved (paper) or nested",
-                       {"interleaved", "nested"}));
+    o.push_back(choice("schedule", "fixed-point",
+                       "fixed-point (exact reduced solves, Anderson on the rebuild point), interleaved (one change "
+                       "per rebuild, Alg. 1 with safeguards), paper (Alg. 1 exactly) or nested",
+                       {"fixed-point", "interleaved", "paper", "nested"}));
   o.push_back(integer("anderson_depth", "5", "nested schedule: Anderson depth of the rebuild point (0: plain)", 0, 1e6));
+  o.push_back(number("surface_step", "1e-3",
+                     "fixed-point schedule: largest move of the contact surface (units of U) between the operators' "
+                     "point and the answer",
+                     Interval::greater_than(0)));
   o.push_back(integer("max_solves", "1000", "nested schedule: cap on the one-change solves of a query", 1, 1e9));
   o.push_back(choice("rebuild", "partial", "contact operators rebuilt on the changed rows only (partial) or all (full)",
                      {"partial", "full"}));
@@ -83,7 +101,9 @@ std::vector<OptionSpec> convex_hull_specs() {
                  Interval::at_least(0)),
           integer("focuss_max_iterations", "100", "nnFOCUSS iteration cap", 1, 1e6),
           number("focuss_tolerance", "1e-10", "nnFOCUSS stopping tolerance"),
-          number("prune_tolerance", "1e-8", "nnFOCUSS pruning threshold")};
+          number("prune_tolerance", "1e-8", "nnFOCUSS pruning threshold"),
+          penetration_tolerance_spec(),
+          complementarity_tolerance_spec()};
 }
 
 struct Registry {
@@ -120,6 +140,8 @@ std::string shared_value(const OnlineSolverOptions& o, const std::string& key) {
   if (key == "tau_scaling") return o.tau_scaling;
   if (key == "max_iterations") return std::to_string(o.max_iterations);
   if (key == "step_tolerance") return fom::format_number(o.step_tolerance);
+  if (key == "penetration_tolerance") return fom::format_number(o.penetration_tolerance);
+  if (key == "complementarity_tolerance") return fom::format_number(o.complementarity_tolerance);
   return o.time_operators ? "true" : "false";  // time_operators
 }
 
@@ -135,6 +157,10 @@ void set_shared(OnlineSolverOptions& o, const std::string& key, const std::strin
     o.max_iterations = static_cast<int>(parse_integer(value, key, 1, std::numeric_limits<int>::max()));
   else if (key == "step_tolerance")
     o.step_tolerance = parse_number(value, key);
+  else if (key == "penetration_tolerance")
+    o.penetration_tolerance = parse_number(value, key);
+  else if (key == "complementarity_tolerance")
+    o.complementarity_tolerance = parse_number(value, key);
   else
     o.time_operators = flag_value(value);
 }
@@ -153,8 +179,9 @@ void check_key(const OnlineMethod& m, const std::string& key) {
 }  // namespace
 
 const std::vector<std::string>& shared_option_keys() {
-  static const std::vector<std::string> keys{"tau", "tau_scaling", "max_iterations", "step_tolerance",
-                                             "time_operators"};
+  static const std::vector<std::string> keys{"tau",           "tau_scaling",           "max_iterations",
+                                             "step_tolerance", "time_operators",        "penetration_tolerance",
+                                             "complementarity_tolerance"};
   return keys;
 }
 
@@ -349,7 +376,12 @@ std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const 
                                                  const OnlineSolverOptions& options) {
   const OnlineMethod m = online_method(name);
   validate_online_options(name, options);
-  return m.factory(model, options);
+  std::unique_ptr<OnlineSolver> solver = m.factory(model, options);
+  fom::ContactTolerances tolerances = fom::default_contact_tolerances(model.problem());
+  if (options.penetration_tolerance >= 0) tolerances.penetration = options.penetration_tolerance;
+  if (options.complementarity_tolerance >= 0) tolerances.complementarity = options.complementarity_tolerance;
+  solver->set_contact_tolerances(tolerances);
+  return solver;
 }
 
 }  // namespace contactrom::rom

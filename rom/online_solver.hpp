@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "fom/contact_residuals.hpp"
 #include "fom/problem.hpp"
 #include "rom/reduced_model.hpp"
 
@@ -33,12 +34,22 @@ struct OnlineResult {
   Eigen::VectorXd coefficients;  ///< λ̂_I, in the order of `selected`
   int iterations = 0;            ///< iterations of the method (one reduced solve each for greedy)
   bool converged = false;        ///< stopping criterion met before the iteration cap
-  Status status = Status::Success;  ///< NoConvergence when !converged; NumericalIssue on a failed solve
+  /// NoConvergence when !converged; NumericalIssue on a failed solve; Inaccurate when
+  /// the method converged but the answer's full-order contact residuals (`contact`)
+  /// exceed the solver's tolerances (OnlineSolver::contact_tolerances()).
+  Status status = Status::Success;
+  /// Row-by-row full-order contact residuals of (u, λ) at their own pairing
+  /// (fom/contact_residuals.hpp), evaluated after every query on the contact surface.
+  fom::ContactResiduals contact;
   /// Wall time of the online core (seconds): everything from μ to (û, λ̂_I) and the
   /// full pressure, nonlinear contact operators included; the full-field
   /// reconstruction Φû + u_lift (a mesh-size operation needed only for output) is
-  /// excluded and timed in `reconstruction_time_s`.
+  /// excluded and timed in `reconstruction_time_s`. The full-order contact check
+  /// (`check_time_s`) is included: a status is part of the answer.
   double time_s = 0.0;
+  /// Wall time of the full-order contact check that sets `contact` (one contact
+  /// search and assembly on the surface), included in `time_s`.
+  double check_time_s = 0.0;
   double reconstruction_time_s = 0.0;  ///< wall time of u = Φû + u_lift (seconds)
   /// Part of `time_s` spent building the contact operators at the iterates (surface
   /// displacement Φ_s û, contact search, assembly of C_R and g_R, the rows Ĉ_I, ĝ_I
@@ -51,6 +62,12 @@ struct OnlineResult {
 };
 
 /// \brief An online ROM method. solve() is const and must be thread-safe.
+///
+/// solve() runs the method (solve_reduced()) and then judges its answer at the full
+/// order on the contact surface: a query the method reports converged whose
+/// row-by-row contact residuals (penetration, separation under pressure, negative
+/// pressure, at the answer's own pairing) exceed contact_tolerances() gets
+/// Status::Inaccurate, with the worst residual and its row in the message.
 class OnlineSolver {
  public:
   virtual ~OnlineSolver() = default;
@@ -58,12 +75,30 @@ class OnlineSolver {
   virtual std::string name() const = 0;
   /// The reduced model the solver works on.
   virtual const ReducedModel& model() const = 0;
-  /// \brief Solves the reduced problem at μ (range-checked by the caller).
-  virtual OnlineResult solve(const fom::Param& mu) const = 0;
+  /// \brief Solves the reduced problem at μ (range-checked by the caller) and checks
+  /// the answer's contact residuals; see the class comment.
+  OnlineResult solve(const fom::Param& mu) const;
   /// Number of dual columns the method draws from (the whole dictionary unless the
   /// method builds its own dual basis, e.g. CPG).
   virtual int dual_basis_size() const { return model().dictionary_size(); }
+  /// Tolerances of the contact check (default: the problem's, fom::default_contact_tolerances).
+  fom::ContactTolerances contact_tolerances() const;
+  /// Sets the tolerances of the contact check.
+  void set_contact_tolerances(const fom::ContactTolerances& tolerances) { m_tolerances = tolerances, m_tolerances_set = true; }
+
+ protected:
+  /// \brief The method itself: solves the reduced problem at μ.
+  virtual OnlineResult solve_reduced(const fom::Param& mu) const = 0;
+
+ private:
+  fom::ContactTolerances m_tolerances;
+  bool m_tolerances_set = false;
 };
+
+/// \brief The full-order contact check of an online answer: sets `res.contact` and
+/// `res.check_time_s`, and turns a Success whose residuals exceed `tolerances` into
+/// Status::Inaccurate (message: the residuals above tolerance and their rows).
+void check_contact(const ReducedModel& model, const fom::ContactTolerances& tolerances, OnlineResult& res);
 
 /// \brief Settings shared by the online methods (each documents which it reads).
 struct OnlineSolverOptions {
@@ -77,6 +112,10 @@ struct OnlineSolverOptions {
   int max_iterations = 50;
   /// Relative change of û under which the iteration may stop. Default 1e-5.
   double step_tolerance = 1e-5;
+  /// Tolerances of the full-order contact check of every answer (OnlineSolver);
+  /// each < 0: the problem's (`[rom]` of its file, else fom::ContactTolerances).
+  double penetration_tolerance = -1.0;
+  double complementarity_tolerance = -1.0;
   /// Measure OnlineResult::operator_time_s (greedy, greedy-nested, cpg,
   /// full-dictionary). Off by default: the clock reads add about 1 % to a query.
   bool time_operators = false;

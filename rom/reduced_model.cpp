@@ -87,8 +87,43 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
     for (int k = 0; k < nt; ++k) kl.col(k) = kphi.transpose() * m_offset[k];  // Φᵀ K_q L̃_k, K_q symmetric
     m_kl_hat.push_back(kl);
   }
+  if (options.split_pairs) split_by_pair();
   derive();
   m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void ReducedModel::split_by_pair() {
+  const fom::ContactModel& contact = m_problem.contact();
+  const int pairs = contact.num_pairs(), nc = static_cast<int>(m_dict.rows()), m = dictionary_size();
+  if (pairs < 2) return;
+  Eigen::MatrixXd dict(nc, 0), primal(m_primal.rows(), 0);
+  std::vector<int> snapshots;
+  std::vector<fom::Param> params;
+  std::vector<std::pair<int, int>> parts;  // (column, pair) of the new columns
+  for (int p = 0; p < m; ++p) {
+    const size_t before = parts.size();
+    for (int k = 0; k < pairs; ++k) {
+      bool nonzero = false;
+      for (int s = 0; s < nc && !nonzero; ++s) nonzero = contact.pair_of_row(s) == k && m_dict(s, p) != 0.0;
+      if (nonzero) parts.emplace_back(p, k);
+    }
+    if (parts.size() == before) parts.emplace_back(p, -1);  // no pressure at all: one (zero) column
+  }
+  const int n = static_cast<int>(parts.size());
+  dict.setZero(nc, n);
+  primal.resize(m_primal.rows(), n);
+  for (int c = 0; c < n; ++c) {
+    const auto [p, k] = parts[static_cast<size_t>(c)];
+    for (int s = 0; s < nc; ++s)
+      if (k < 0 || contact.pair_of_row(s) == k) dict(s, c) = m_dict(s, p);
+    primal.col(c) = m_primal.col(p);
+    snapshots.push_back(m_dict_snapshots[static_cast<size_t>(p)]);
+    params.push_back(m_dict_params[static_cast<size_t>(p)]);
+  }
+  m_dict = std::move(dict);
+  m_primal = std::move(primal);
+  m_dict_snapshots = std::move(snapshots);
+  m_dict_params = std::move(params);
 }
 
 ReducedModel::ReducedModel(const fom::Problem& problem, ReducedModelData data)
@@ -162,6 +197,10 @@ void ReducedModel::derive() {
   const int ns = static_cast<int>(surf.size()), r = primal_rank(), nt = static_cast<int>(m_offset.size());
   m_snapshot_coords = m_phi.transpose() * m_primal;
   build_parameter_grid();
+  int snapshots = 0;
+  for (int j : m_dict_snapshots) snapshots = std::max(snapshots, j + 1);
+  m_siblings.assign(static_cast<size_t>(snapshots), {});
+  for (int c = 0; c < dictionary_size(); ++c) m_siblings[static_cast<size_t>(m_dict_snapshots[static_cast<size_t>(c)])].push_back(c);
   m_phi_s.resize(ns, r);
   for (int a = 0; a < ns; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
   m_phi_s_rows = m_phi_s;

@@ -47,6 +47,13 @@ struct ReducedModelOptions {
   /// Keep snapshots whose FOM status is not Success in the basis and dictionary.
   /// Default false (they are left out; the offline stage warns about them).
   bool include_failed_snapshots = false;
+  /// With several contact pairs, each pressure snapshot enters the dictionary as one
+  /// column per pair (its restriction to that pair's rows, where it is not zero), so
+  /// that each pair's constraint has its own multiplier: a column spanning two pairs
+  /// would let one pair's penetration be paid for by the other's lift-off. The
+  /// columns of one snapshot share its parameter and primal snapshot
+  /// (sibling_columns()). Default true; false: one column per snapshot.
+  bool split_pairs = true;
   /// Offset of the reduced displacement; see LiftingKind. Default Harmonic.
   LiftingKind lifting = LiftingKind::Harmonic;
 };
@@ -112,6 +119,11 @@ class ReducedModel {
   const std::vector<int>& dictionary_snapshots() const { return m_dict_snapshots; }
   /// Parameter of each dictionary column.
   const std::vector<fom::Param>& dictionary_parameters() const { return m_dict_params; }
+  /// The columns made from the same pressure snapshot as column p (p included, in
+  /// column order): one per contact pair with ReducedModelOptions::split_pairs.
+  const std::vector<int>& sibling_columns(int p) const {
+    return m_siblings[static_cast<size_t>(m_dict_snapshots[static_cast<size_t>(p)])];
+  }
   /// Primal snapshots u − u_lift of the dictionary columns (n_dofs × m), for methods
   /// that need them (e.g. monolithic dictionaries).
   const Eigen::MatrixXd& primal_snapshots() const { return m_primal; }
@@ -189,6 +201,7 @@ class ReducedModel {
   Eigen::VectorXd m_sigma;
   std::vector<int> m_dict_snapshots;
   std::vector<fom::Param> m_dict_params;
+  std::vector<std::vector<int>> m_siblings;  // per database snapshot: its columns (derived)
   Eigen::MatrixXd m_snapshot_coords;  // Φᵀ primal, r × m
   std::vector<fom::SearchMemory> m_snapshot_memory;  // contact search at each reduced snapshot
   // Training parameters as a tensor grid: sorted distinct values per dimension and
@@ -196,6 +209,7 @@ class ReducedModel {
   std::vector<std::vector<double>> m_grid_values;
   std::vector<int> m_grid_columns;
   void build_parameter_grid();
+  void split_by_pair();  // ReducedModelOptions::split_pairs
   void derive();  // surface rows, snapshot coordinates and search memories, grid, factor of Φᵀ K₀ Φ
   std::vector<Eigen::VectorXd> m_offset;  // L̃_k
   std::vector<Eigen::MatrixXd> m_k_hat;   // Φᵀ K_q Φ

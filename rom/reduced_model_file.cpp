@@ -262,7 +262,7 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
 void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results) {
   write_file_atomically(path, [&](std::ostream& out) {
     for (const std::string& name : rom.problem().param_names()) out << name << ',';
-    out << "status,converged,iterations,sparsity,contact_force,time_s,selected,coefficients\n";
+    out << "status,converged,iterations,sparsity,contact_force,time_s,selected,coefficients,penetration,separation\n";
     for (const OnlineResult& res : results) {
       for (int k = 0; k < res.mu.size(); ++k) out << fom::format_number(res.mu(k)) << ',';
       out << to_string(res.status) << ',' << (res.converged ? 1 : 0) << ',' << res.iterations << ','
@@ -272,7 +272,8 @@ void write_query_csv(const std::string& path, const OnlineModel& rom, const std:
         out << (j ? " " : "") << rom.model().dictionary_snapshots()[static_cast<size_t>(res.selected[j])];
       out << ',';
       for (Eigen::Index j = 0; j < res.coefficients.size(); ++j) out << (j ? " " : "") << fom::format_number(res.coefficients(j));
-      out << '\n';
+      out << ',' << fom::format_number(res.contact.penetration) << ',' << fom::format_number(res.contact.complementarity)
+          << '\n';
     }
   });
 }

@@ -62,6 +62,8 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
   j["primal_rank"] = model.primal_rank();
   j["status"] = to_string(res.status);
   j["converged"] = res.converged;
+  j["penetration"] = res.contact.penetration;
+  j["separation"] = res.contact.complementarity;
   if (!res.message.empty()) j["message"] = res.message;
   j["iterations"] = res.iterations;
   j["sparsity"] = res.selected.size();
@@ -121,7 +123,8 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
             << std::setw(22) << "iterations" << std::setw(12) << s.mean_iterations << "\n"
             << std::setw(22) << "time per query (us)" << std::setw(12) << s.mean_time_s * 1e6 << "(median "
             << s.median_time_s * 1e6 << ")\n"
-            << "not converged: " << s.nonconverged << " of " << s.rows.size();
+            << "not converged: " << s.nonconverged << " of " << s.rows.size()
+            << "; inaccurate (contact residuals above tolerance): " << s.inaccurate;
   if (s.absolute_error_rows)
     std::cout << "; " << s.absolute_error_rows << " rows with a near-zero FOM displacement left out of the errors "
               << "(absolute errors: max primal " << s.max_absolute_primal_error << ", max dual "

@@ -95,6 +95,7 @@ nlohmann::json method_json(const baselines::MethodVerification& r, const rom::Re
   j["reduced_penetration_violations"] = r.reduced_violations;
   j["reduced_penetration_ok"] = r.reduced_violations == 0;
   j["nonconverged"] = r.nonconverged;
+  j["inaccurate"] = r.inaccurate;
   j["mean_iterations"] = r.mean_iterations;
   j["mean_sparsity"] = r.mean_sparsity;
   j["mean_time_s"] = r.mean_time_s;

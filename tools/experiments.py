@@ -117,13 +117,14 @@ def read_rows(path):
         sel = r.get("selected", "").split()
         out.append({
             "params": [float(r[k]) for k in r if k not in {"primal_error", "dual_error", "sparsity", "iterations",
-                                                           "time_s", "converged", "status", "selected", "errors"}],
+                                                           "time_s", "converged", "status", "selected", "errors",
+                                                           "penetration", "separation"}],
             "primal": float(r["primal_error"]),
             "dual": float(r["dual_error"]),
             "sparsity": int(r["sparsity"]),
             "iterations": int(r["iterations"]),
             "time": float(r["time_s"]),
-            "converged": r["converged"] == "1" and r["status"] == "success",
+            "converged": r["converged"] == "1" and r["status"] in ("success", "inaccurate"),
             "status": r["status"],
             "selected": [int(s) for s in sel],
         })
@@ -149,6 +150,7 @@ def summarize(rows, summary):
         "mean_time_per_iteration_s": float(np.mean(t[it > 0] / it[it > 0])) if np.any(it > 0) else float("nan"),
         "median_time_per_iteration_s": float(np.median(t[it > 0] / it[it > 0])) if np.any(it > 0) else float("nan"),
         "nonconverged": int(sum(not r["converged"] for r in rows)),
+        "inaccurate": int(sum(r["status"] == "inaccurate" for r in rows)),
         "statuses": ",".join(sorted({r["status"] for r in rows if not r["converged"]})),
     }
 
@@ -156,7 +158,7 @@ def summarize(rows, summary):
 SUMMARY_COLUMNS = ["problem", "kind", "n", "snapshots", "delta", "primal_rank", "validation_size",
                    "mean_primal_error", "max_primal_error", "mean_dual_error", "max_dual_error", "mean_sparsity",
                    "mean_iterations", "mean_time_s", "median_time_s", "mean_time_per_iteration_s", "median_time_per_iteration_s", "nonconverged",
-                   "statuses", "offline_wall_s", "mean_fom_time_s"]
+                   "inaccurate", "statuses", "offline_wall_s", "mean_fom_time_s"]
 
 
 def write_summary_csv(path, records):
@@ -170,8 +172,9 @@ def write_summary_csv(path, records):
 def markdown_summary(records, label):
     """One markdown table: one line per (training set, δ)."""
     head = (f"| {label} | snapshots | δ | primal rank | mean primal H¹ error | mean dual L² error | mean sparsity "
-            "| mean iterations | mean time (µs) | median time (µs) | time/iteration mean / median (µs) | not converged |\n"
-            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n")
+            "| mean iterations | mean time (µs) | median time (µs) | time/iteration mean / median (µs) | not converged "
+            "| inaccurate |\n"
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n")
     lines = []
     for r in records:
         nc = f"{r['nonconverged']}/{r['validation_size']}"
@@ -180,7 +183,8 @@ def markdown_summary(records, label):
         lines.append(f"| {r['n']} | {r['snapshots']} | {r['delta']:.0e} | {r['primal_rank']} | "
                      f"{fmt(r['mean_primal_error'])} | {fmt(r['mean_dual_error'])} | {r['mean_sparsity']:.2f} | "
                      f"{r['mean_iterations']:.1f} | {1e6 * r['mean_time_s']:.0f} | {1e6 * r['median_time_s']:.0f} | "
-                     f"{1e6 * r['mean_time_per_iteration_s']:.0f} / {1e6 * r['median_time_per_iteration_s']:.0f} | {nc} |")
+                     f"{1e6 * r['mean_time_per_iteration_s']:.0f} / {1e6 * r['median_time_per_iteration_s']:.0f} | {nc} | "
+                     f"{r.get('inaccurate', 0)} |")
     return head + "\n".join(lines) + "\n"
 
 
@@ -434,7 +438,7 @@ def load_study(outdir, problem, kind):
     path = os.path.join(outdir, f"{problem}_summary.csv")
     if not os.path.exists(path):
         sys.exit(f"experiments.py --replot: {path} is missing; run the {problem} stage first")
-    integers = {"n", "snapshots", "primal_rank", "validation_size", "nonconverged"}
+    integers = {"n", "snapshots", "primal_rank", "validation_size", "nonconverged", "inaccurate"}
     with open(path, newline="") as f:
         records = [{k: (v if k in {"problem", "kind", "statuses"} else int(v) if k in integers else float(v))
                     for k, v in r.items()} for r in csv.DictReader(f)]

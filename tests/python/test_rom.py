@@ -56,6 +56,22 @@ def test_single_query_equals_cli(hertz_db_path, rom, mu):
     assert snapshots == cli["selected"]
     assert np.allclose(r.coefficients, cli["coefficients"], rtol=1e-12, atol=0.0)
     assert rom.problem.contact_force(r.lam) == pytest.approx(cli["contact_force"], rel=1e-12)
+    # The full-order contact check: same residuals as the CLI's, within tolerance for a success.
+    assert r.penetration == pytest.approx(cli["penetration"], rel=1e-12, abs=1e-300)
+    assert r.separation == pytest.approx(cli["separation"], rel=1e-12, abs=1e-300)
+    assert r.status != "success" or (r.penetration <= 0.05 and r.separation <= 0.05)
+
+
+def test_inaccurate_answers_are_counted_and_reported_per_row(rom):
+    # Every row carries its contact residuals; a row is 'inaccurate' exactly when
+    # the method converged but they exceed the tolerance (0.05 U by default).
+    report = rom.evaluate(threads=2)
+    rows = report["rows"]
+    bad = [(p > 0.05 or s > 0.05) for p, s in zip(rows["penetration"], rows["separation"])]
+    flagged = [st == "inaccurate" for st in rows["status"]]
+    assert report["inaccurate"] == sum(flagged)
+    for b, f, c in zip(bad, flagged, rows["converged"]):
+        assert f == (b and c)
 
 
 def test_solution_is_the_dictionary_combination(rom):

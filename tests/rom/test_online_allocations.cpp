@@ -184,7 +184,9 @@ BOOST_AUTO_TEST_CASE(iterations_after_the_first_allocate_nothing) {
     rom::GreedySchedule schedule;
   };
   for (const auto& [label, init, schedule] :
-       {Case{"default start", rom::WarmStart::Cell, rom::GreedySchedule::Interleaved},
+       {Case{"fixed-point, default start", rom::WarmStart::Cell, rom::GreedySchedule::FixedPoint},
+        Case{"fixed-point, init=empty", rom::WarmStart::Empty, rom::GreedySchedule::FixedPoint},
+        Case{"interleaved, default start", rom::WarmStart::Cell, rom::GreedySchedule::Interleaved},
         Case{"init=empty", rom::WarmStart::Empty, rom::GreedySchedule::Interleaved},
         Case{"nested, default start", rom::WarmStart::Cell, rom::GreedySchedule::Nested},
         Case{"nested, init=empty", rom::WarmStart::Empty, rom::GreedySchedule::Nested}}) {

@@ -34,7 +34,7 @@ class FixedSolver final : public rom::OnlineSolver {
   explicit FixedSolver(const rom::ReducedModel& model) : m_model(model) {}
   std::string name() const override { return "fixed"; }
   const rom::ReducedModel& model() const override { return m_model; }
-  rom::OnlineResult solve(const fom::Param& mu) const override { return m_results.at(mu(0)); }
+  rom::OnlineResult solve_reduced(const fom::Param& mu) const override { return m_results.at(mu(0)); }
   std::map<double, rom::OnlineResult> m_results;
 
  private:
@@ -176,7 +176,7 @@ BOOST_AUTO_TEST_CASE(csv_rows_read_back) {
   std::istringstream in(test::slurp(path));
   std::string line;
   std::getline(in, line);
-  BOOST_TEST(line == "gamma,primal_error,dual_error,sparsity,iterations,time_s,converged,status,selected,errors");
+  BOOST_TEST(line == "gamma,primal_error,dual_error,sparsity,iterations,time_s,converged,status,selected,errors,penetration,separation");
   for (const rom::EvaluationRow& row : e.summary.rows) {
     BOOST_REQUIRE(std::getline(in, line));
     std::vector<std::string> f;

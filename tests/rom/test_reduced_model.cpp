@@ -126,3 +126,42 @@ BOOST_AUTO_TEST_CASE(two_parameter_stencil_is_the_enclosing_cell) {
   // On a cell edge: the two corners of that edge.
   BOOST_TEST(model.interpolation_stencil(Eigen::Vector2d(2.0, 0.25)).size() == 2u);
 }
+
+BOOST_AUTO_TEST_CASE(two_contact_pairs_give_one_column_per_pair) {
+  // punch_beam: the punch on the beam and the beam on the foundation. Every
+  // dictionary column lives on one pair's rows; the columns of one snapshot
+  // (siblings, same parameter and primal snapshot) add up to its pressure; the
+  // unsplit model has one column per snapshot. A query at a training parameter
+  // reproduces its snapshot with the split dictionary.
+  Built b("punch_beam", 8, 1e-10);
+  const rom::ReducedModel& model = *b.model;
+  const fom::ContactModel& contact = b.problem->contact();
+  BOOST_REQUIRE(contact.num_pairs() == 2);
+  BOOST_TEST(model.dictionary_size() > b.db.num_snapshots());
+  for (int p = 0; p < model.dictionary_size(); ++p) {
+    int pair = -1;
+    for (int s = 0; s < model.dictionary().rows(); ++s)
+      if (model.dictionary()(s, p) != 0.0) {
+        if (pair < 0) pair = contact.pair_of_row(s);
+        BOOST_TEST(contact.pair_of_row(s) == pair, "column " << p << " row " << s);
+      }
+  }
+  for (int j = 0; j < b.db.num_snapshots(); ++j) {
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(model.dictionary().rows());
+    int found = 0;
+    for (int p = 0; p < model.dictionary_size(); ++p)
+      if (model.dictionary_snapshots()[p] == j) {
+        sum += model.dictionary().col(p);
+        ++found;
+        BOOST_TEST((model.dictionary_parameters()[p] - b.db.parameter(j)).norm() == 0.0);
+      }
+    BOOST_TEST(found >= 1);
+    for (int p = 0; p < model.dictionary_size(); ++p)
+      if (model.dictionary_snapshots()[p] == j) BOOST_TEST(model.sibling_columns(p).size() == static_cast<size_t>(found));
+    BOOST_TEST((sum - b.db.dual.col(j)).norm() == 0.0, "snapshot " << j);
+  }
+  rom::ReducedModelOptions whole;
+  whole.delta = 1e-10;
+  whole.split_pairs = false;
+  BOOST_TEST(rom::ReducedModel(*b.problem, b.db, whole).dictionary_size() == b.db.num_snapshots());
+}
