@@ -18,10 +18,16 @@ constexpr double kChainEndExtension = 0.1;
 }  // namespace
 
 bool Pairing::same_as(const Pairing& other, double tol) const {
-  if (segment.size() != other.segment.size()) return false;
+  if (segment.size() != other.segment.size() || eta.size() != other.eta.size()) return false;
   for (size_t s = 0; s < segment.size(); ++s) {
     if ((segment[s] < 0) != (other.segment[s] < 0)) return false;
     if (segment[s] < 0) continue;
+    if (!eta.empty()) {  // 3D: the same facet, local coordinates and normal
+      if (segment[s] != other.segment[s] || std::abs(xi[s] - other.xi[s]) > tol || std::abs(eta[s] - other.eta[s]) > tol ||
+          (normal.col(s) - other.normal.col(s)).cwiseAbs().maxCoeff() > tol)
+        return false;
+      continue;
+    }
     // Position along the master chain, continuous across segment ends: a slave
     // node moving from the end of segment j to the start of j+1 is no change.
     if (std::abs(segment[s] + xi[s] - other.segment[s] - other.xi[s]) > tol) return false;
@@ -141,6 +147,7 @@ void NodeToSegmentContact::search_all(const Eigen::VectorXd& u_surface, const st
   const int ns = static_cast<int>(m_slave.size());
   p.segment.assign(ns, -1);
   p.xi.assign(ns, 0.0);
+  p.eta.clear();
   p.normal.setZero(2, ns);
   // The listed rows are ascending, so each pair's rows are one contiguous run of them.
   size_t r = 0;
@@ -448,7 +455,7 @@ ObstacleContact::ObstacleContact(const Eigen::VectorXd& x, const Eigen::VectorXd
                                  const Eigen::VectorXd& weights)
     : m_psi(psi) {
   m_weights = weights;
-  m_points = Eigen::Matrix2Xd::Zero(2, x.size());
+  m_points = Eigen::MatrixXd::Zero(2, x.size());
   m_points.row(0) = x.transpose();
   for (int i = 0; i < x.size(); ++i) m_surface_dofs.push_back(i);
 }

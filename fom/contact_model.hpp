@@ -21,16 +21,20 @@ namespace contactrom::fom {
 /// Row-major sparse matrix: the constraint operator restricted to surface dofs.
 using ConstraintMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
-/// \brief Contact pairing: for every constraint row, the master segment it is
-/// projected on (closest point, -1: unpaired), the local coordinate ξ ∈ [0,1] on
-/// it and the master's outward unit normal there, all in the deformed
+/// \brief Contact pairing: for every constraint row, the master segment (2D) or
+/// facet (3D) it is projected on (closest point, -1: unpaired), the local
+/// coordinates there and the master's outward unit normal, all in the deformed
 /// configuration. The normal interpolates nodal (averaged) normals so that it
-/// is continuous along the master chain.
+/// is continuous along the master surface.
 /// Empty vectors for models without pairing (obstacles).
 struct Pairing {
-  std::vector<int> segment;
+  std::vector<int> segment;  ///< master segment (2D) or facet (3D) index within its pair, −1: unpaired
+  /// 2D: ξ ∈ [0,1] along the segment. 3D: first local coordinate on the facet
+  /// (triangle: barycentric weight of its node 1; quad: ξ ∈ [−1,1]).
   std::vector<double> xi;
-  Eigen::Matrix2Xd normal;
+  /// 3D only (empty in 2D): second local coordinate (triangle: weight of node 2; quad: η ∈ [−1,1]).
+  std::vector<double> eta;
+  Eigen::MatrixXd normal;    ///< outward unit normals of the master, dim x n_c
   /// True when both pairings pair the same rows, their chain positions
   /// (segment + ξ) and normals agree to `tol`.
   bool same_as(const Pairing& other, double tol) const;
@@ -61,10 +65,10 @@ class ContactModel {
   int num_constraints() const { return static_cast<int>(m_weights.size()); }
   /// Global dof indices the constraint rows may touch, in the column order of C.
   const std::vector<int>& surface_dofs() const { return m_surface_dofs; }
-  /// Tributary length \f$ w_s \f$ of each row (reference configuration).
+  /// Tributary length (2D) or area (3D) \f$ w_s \f$ of each row (reference configuration).
   const Eigen::VectorXd& weights() const { return m_weights; }
-  /// Reference coordinates of the constrained nodes (2 x n_c; rope: x and 0).
-  const Eigen::Matrix2Xd& constraint_points() const { return m_points; }
+  /// Reference coordinates of the constrained nodes (dim x n_c; rope: x and 0).
+  const Eigen::MatrixXd& constraint_points() const { return m_points; }
   /// Whether C and g depend on the displacement through a pairing.
   virtual bool has_pairing() const = 0;
   /// Number of contact pairs (slave/master couples); 1 for an obstacle.
@@ -116,7 +120,7 @@ class ContactModel {
  protected:
   std::vector<int> m_surface_dofs;
   Eigen::VectorXd m_weights;
-  Eigen::Matrix2Xd m_points;
+  Eigen::MatrixXd m_points;
 };
 
 /// \brief One contact pair of NodeToSegmentContact: node chains of the slave and

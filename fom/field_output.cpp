@@ -31,28 +31,33 @@ FileWriter vtu_writer(const Problem& problem, const Param& mu, const Eigen::Vect
     const ContactModel& contact = problem.contact();
     out << std::setprecision(std::numeric_limits<double>::max_digits10);
     const int np = mesh ? mesh->num_nodes() : static_cast<int>(problem.rope_x().size());
-    const int ncell = mesh ? mesh->num_quads() : np - 1;
+    const int ncell = mesh ? mesh->num_elements() : np - 1;
     out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
         << "  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"" << np << "\" NumberOfCells=\"" << ncell << "\">\n";
     Eigen::MatrixXd pts = Eigen::MatrixXd::Zero(np, 3);
     for (int i = 0; i < np; ++i) {
-      if (mesh) pts.row(i).head(2) = mesh->nodes.col(i).transpose();
+      if (mesh) pts.row(i).head(mesh->dim) = mesh->nodes.col(i).transpose();
       else pts(i, 0) = problem.rope_x()(i);
     }
     out << "      <Points>\n";
     data_array(out, "Points", 3, pts);
     out << "      </Points>\n      <Cells>\n"
         << "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+    // VTK cell types: 3 line, 9 quad, 10 tetra, 12 hexahedron (gmsh's node order is VTK's).
+    std::vector<int> offsets, types;
+    int offset = 0;
     for (int c = 0; c < ncell; ++c) {
       out << "         ";
-      if (mesh) for (int a = 0; a < 4; ++a) out << ' ' << mesh->quads[c][a];
-      else out << ' ' << c << ' ' << c + 1;
+      const std::vector<int> nodes = mesh ? mesh->element_nodes(c) : std::vector<int>{c, c + 1};
+      for (int v : nodes) out << ' ' << v;
       out << '\n';
+      offsets.push_back(offset += static_cast<int>(nodes.size()));
+      types.push_back(!mesh ? 3 : mesh->dim == 2 ? 9 : nodes.size() == 4 ? 10 : 12);
     }
     out << "        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n         ";
-    for (int c = 0; c < ncell; ++c) out << ' ' << (mesh ? 4 : 2) * (c + 1);
+    for (int o : offsets) out << ' ' << o;
     out << "\n        </DataArray>\n        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n         ";
-    for (int c = 0; c < ncell; ++c) out << ' ' << (mesh ? 9 : 3);
+    for (int t : types) out << ' ' << t;
     out << "\n        </DataArray>\n      </Cells>\n      <PointData Vectors=\"displacement\">\n";
     Eigen::MatrixXd disp = Eigen::MatrixXd::Zero(np, 3), press = Eigen::MatrixXd::Zero(np, 1);
     // The rope's one dof per node is its transverse deflection: the y component.
@@ -69,10 +74,11 @@ FileWriter vtu_writer(const Problem& problem, const Param& mu, const Eigen::Vect
     if (mesh) {
       const Eigen::MatrixXd stress = element_stresses(*mesh, problem.materials(mu), u);
       Eigen::MatrixXd body(ncell, 1);
-      for (int c = 0; c < ncell; ++c) body(c, 0) = mesh->quad_body[c];
+      for (int c = 0; c < ncell; ++c) body(c, 0) = mesh->element_body(c);
       out << "      <CellData>\n";
-      data_array(out, "stress", 4, stress.leftCols(4));
-      data_array(out, "von_mises", 1, stress.col(4));
+      const int components = static_cast<int>(stress.cols()) - 1;  // 2D: 4, 3D: 6, then von Mises
+      data_array(out, "stress", components, stress.leftCols(components));
+      data_array(out, "von_mises", 1, stress.col(components));
       data_array(out, "body", 1, body);
       out << "      </CellData>\n";
     }
@@ -86,9 +92,20 @@ FileWriter surface_csv_writer(const Problem& problem, const Eigen::VectorXd& u, 
     const ContactModel& contact = problem.contact();
     const Eigen::VectorXd gap = normal_gaps(problem, u);
     out << std::setprecision(std::numeric_limits<double>::max_digits10);
-    out << "x,y,gap,pressure,u_x,u_y\n";
     const std::vector<int>& surf = contact.surface_dofs();
     const int per_node = problem.dofs_per_node();
+    if (per_node == 3) {
+      out << "x,y,z,gap,pressure,u_x,u_y,u_z\n";
+      for (int s = 0; s < contact.num_constraints(); ++s) {
+        const int dof = surf[static_cast<size_t>(3 * s)];
+        for (int c = 0; c < 3; ++c) out << contact.constraint_points()(c, s) << ',';
+        if (std::isfinite(gap(s))) out << gap(s);
+        else out << "inf";
+        out << ',' << lambda(s) << ',' << u(dof) << ',' << u(dof + 1) << ',' << u(dof + 2) << '\n';
+      }
+      return;
+    }
+    out << "x,y,gap,pressure,u_x,u_y\n";
     for (int s = 0; s < contact.num_constraints(); ++s) {
       // Reference coordinates (the rope lies on y = 0), then the node's displacement
       // (the rope's is transverse: u_y).

@@ -2,7 +2,8 @@
 /// \file field_output.hpp
 /// \brief Field output for ParaView and plotting: VTU (XML UnstructuredGrid,
 /// ASCII) with displacement, stress and contact pressure, and a CSV of the
-/// contact surface (x, y, gap, pressure, u_x, u_y). Files are written atomically.
+/// contact surface (x, y, gap, pressure, u_x, u_y; in 3D x, y, z, gap, pressure,
+/// u_x, u_y, u_z). Files are written atomically.
 #include <Eigen/Dense>
 #include <string>
 #include <utility>
@@ -15,13 +16,15 @@ namespace contactrom::fom {
 
 /// \brief Writes `path` (.vtu): points in the reference configuration, point data
 /// `displacement` (3 components) and `contact_pressure` (on constrained nodes),
-/// cell data `stress` (σxx, σyy, σxy, σzz), `von_mises` and `body`.
+/// cell data `stress` (2D: σxx, σyy, σxy, σzz; 3D: σxx, σyy, σzz, σxy, σyz, σxz),
+/// `von_mises` and `body`; cells are quads (2D), tetrahedra and hexahedra (3D).
 /// The 1D rope is written as line cells; its transverse deflection is the y
 /// component of `displacement`.
 void write_vtu(const std::string& path, const Problem& problem, const Param& mu, const Eigen::VectorXd& u,
                const Eigen::VectorXd& lambda);
 
-/// \brief Writes the contact surface CSV: columns `x,y,gap,pressure,u_x,u_y` (one
+/// \brief Writes the contact surface CSV: columns `x,y,gap,pressure,u_x,u_y` (3D:
+/// `x,y,z,gap,pressure,u_x,u_y,u_z`) (one
 /// row per constraint: reference coordinates, gap with the pairing recomputed from
 /// u, pressure, the node's displacement; rope: y = 0 and u_y is the deflection).
 void write_surface_csv(const std::string& path, const Problem& problem, const Eigen::VectorXd& u,

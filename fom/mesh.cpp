@@ -43,6 +43,8 @@ namespace {
 constexpr int kGmshLine2 = 1;
 constexpr int kGmshQuad4 = 3;
 constexpr int kGmshTriangle3 = 2;
+constexpr int kGmshTetrahedron4 = 4;
+constexpr int kGmshHexahedron8 = 5;
 
 // Coordinates are hashed after rounding to this resolution, so that the last-bit
 // noise of a different libm does not change the fingerprint of the same mesh.
@@ -167,7 +169,7 @@ std::vector<std::size_t> group_elements(int dim, const PhysicalGroup& g, int wan
   return result;
 }
 
-double signed_area(const Eigen::Matrix2Xd& x, const std::array<int, 4>& q) {
+double signed_area(const Eigen::MatrixXd& x, const std::array<int, 4>& q) {
   double a = 0.0;
   for (int i = 0; i < 4; ++i) {
     const int j = (i + 1) % 4;
@@ -176,9 +178,11 @@ double signed_area(const Eigen::Matrix2Xd& x, const std::array<int, 4>& q) {
   return 0.5 * a;
 }
 
-std::string point_string(const Eigen::Matrix2Xd& x, int node) {
+std::string point_string(const Eigen::MatrixXd& x, int node) {
   std::ostringstream s;
-  s << "(" << x(0, node) << ", " << x(1, node) << ")";
+  s << "(" << x(0, node);
+  for (Eigen::Index i = 1; i < x.rows(); ++i) s << ", " << x(i, node);
+  s << ")";
   return s.str();
 }
 
@@ -186,7 +190,7 @@ std::string point_string(const Eigen::Matrix2Xd& x, int node) {
 /// owning the first segment lies on its left (the quad containing the segment
 /// has it as a counter-clockwise edge); for a closed curve it starts at the
 /// smallest node id.
-void order_chain(const std::string& where, const std::string& name, const Eigen::Matrix2Xd& x,
+void order_chain(const std::string& where, const std::string& name, const Eigen::MatrixXd& x,
                  const std::vector<std::array<int, 4>>& quads, std::vector<std::array<int, 2>> segs,
                  std::vector<std::array<int, 2>>& out_segments, std::vector<int>& out_nodes) {
   if (segs.empty()) throw InputError(where + ": physical curve " + quoted(name, 200) + " has no line elements");
@@ -257,6 +261,41 @@ void order_chain(const std::string& where, const std::string& name, const Eigen:
   for (std::size_t k = 0; k < nseg; ++k) out_segments.push_back({nodes[k], nodes[(k + 1) % nodes.size()]});
 }
 
+/// Contiguous node numbering: body after body, and within a body by ascending gmsh
+/// tag; a node shared by two bodies (bonded) keeps the id of the first.
+std::unordered_map<std::size_t, int> number_nodes(const std::vector<std::vector<std::size_t>>& body_tags) {
+  std::unordered_map<std::size_t, int> id_of;
+  int next = 0;
+  for (const auto& tags : body_tags) {
+    std::vector<std::size_t> sorted(tags);
+    std::sort(sorted.begin(), sorted.end());
+    sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+    for (std::size_t t : sorted)
+      if (id_of.emplace(t, next).second) ++next;
+  }
+  return id_of;
+}
+
+/// Coordinates (dim x n) of the numbered nodes; a 2D mesh must lie in z = 0.
+Eigen::MatrixXd node_coordinates(const std::string& where, const std::unordered_map<std::size_t, int>& id_of, int dim) {
+  std::vector<std::size_t> all_tags;
+  std::vector<double> coord, param;
+  gmsh::model::mesh::getNodes(all_tags, coord, param, -1, -1, true, false);
+  Eigen::MatrixXd nodes(dim, static_cast<Eigen::Index>(id_of.size()));
+  std::vector<char> found(id_of.size(), 0);
+  for (std::size_t k = 0; k < all_tags.size(); ++k) {
+    auto it = id_of.find(all_tags[k]);
+    if (it == id_of.end()) continue;
+    if (dim == 2 && std::abs(coord[3 * k + 2]) > 1e-12)
+      throw InputError(where + ": node at z = " + std::to_string(coord[3 * k + 2]) + "; expected a planar mesh in z = 0");
+    for (int i = 0; i < dim; ++i) nodes(i, it->second) = coord[3 * k + static_cast<std::size_t>(i)];
+    found[static_cast<std::size_t>(it->second)] = 1;
+  }
+  if (std::find(found.begin(), found.end(), 0) != found.end())
+    throw InputError(where + ": an element refers to a node without coordinates");
+  return nodes;
+}
+
 Mesh read_current_model(const std::string& where) {
   const auto surfaces = physical_groups(2);
   const auto curves = physical_groups(1);
@@ -287,33 +326,8 @@ Mesh read_current_model(const std::string& where) {
     body_quads.push_back(std::move(tags));
   }
 
-  // Contiguous numbering: body after body, and within a body by ascending gmsh tag.
-  std::unordered_map<std::size_t, int> id_of;
-  std::vector<std::size_t> gmsh_tag_of;
-  for (const auto& tags : body_quads) {
-    std::vector<std::size_t> sorted(tags);
-    std::sort(sorted.begin(), sorted.end());
-    sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
-    for (std::size_t t : sorted)
-      if (id_of.emplace(t, static_cast<int>(gmsh_tag_of.size())).second) gmsh_tag_of.push_back(t);
-  }
-
-  std::vector<std::size_t> all_tags;
-  std::vector<double> coord, param;
-  gmsh::model::mesh::getNodes(all_tags, coord, param, -1, -1, true, false);
-  mesh.nodes.resize(2, static_cast<Eigen::Index>(gmsh_tag_of.size()));
-  std::vector<char> found(gmsh_tag_of.size(), 0);
-  for (std::size_t k = 0; k < all_tags.size(); ++k) {
-    auto it = id_of.find(all_tags[k]);
-    if (it == id_of.end()) continue;
-    if (std::abs(coord[3 * k + 2]) > 1e-12)
-      throw InputError(where + ": node at z = " + std::to_string(coord[3 * k + 2]) + "; expected a planar mesh in z = 0");
-    mesh.nodes(0, it->second) = coord[3 * k];
-    mesh.nodes(1, it->second) = coord[3 * k + 1];
-    found[it->second] = 1;
-  }
-  if (std::find(found.begin(), found.end(), 0) != found.end())
-    throw InputError(where + ": an element refers to a node without coordinates");
+  const std::unordered_map<std::size_t, int> id_of = number_nodes(body_quads);
+  mesh.nodes = node_coordinates(where, id_of, 2);
 
   for (std::size_t b = 0; b < body_quads.size(); ++b) {
     const auto& tags = body_quads[b];
@@ -370,6 +384,212 @@ Mesh read_current_model(const std::string& where) {
   return mesh;
 }
 
+// --- 3D ----------------------------------------------------------------------
+
+/// Elements of dimension `dim` on the entities of a group, by gmsh type, as flat
+/// node-tag lists.
+std::map<int, std::vector<std::size_t>> group_elements_by_type(int dim, const PhysicalGroup& g) {
+  std::map<int, std::vector<std::size_t>> result;
+  for (int entity : g.entities) {
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> element_tags, node_tags;
+    gmsh::model::mesh::getElements(types, element_tags, node_tags, dim, entity);
+    for (std::size_t k = 0; k < types.size(); ++k)
+      if (!node_tags[k].empty())
+        result[types[k]].insert(result[types[k]].end(), node_tags[k].begin(), node_tags[k].end());
+  }
+  return result;
+}
+
+Eigen::Vector3d point3(const Eigen::MatrixXd& x, int node) { return x.col(node).head<3>(); }
+
+double tetra_volume(const Eigen::MatrixXd& x, const std::array<int, 8>& c) {
+  const Eigen::Vector3d a = point3(x, c[1]) - point3(x, c[0]), b = point3(x, c[2]) - point3(x, c[0]),
+                        d = point3(x, c[3]) - point3(x, c[0]);
+  return a.cross(b).dot(d) / 6.0;
+}
+
+/// Jacobian determinant of a trilinear hexahedron at its corner k (the triple
+/// product of the three edges leaving it, in the order of the reference axes).
+double hexa_corner_jacobian(const Eigen::MatrixXd& x, const std::array<int, 8>& c, int k) {
+  // Neighbours of corner k along ξ, η, ζ, with the sign of the step.
+  static const int along[8][3] = {{1, 3, 4}, {0, 2, 5}, {3, 1, 6}, {2, 0, 7},
+                                  {5, 7, 0}, {4, 6, 1}, {7, 5, 2}, {6, 4, 3}};
+  static const double sx[8] = {-1, 1, 1, -1, -1, 1, 1, -1}, sy[8] = {-1, -1, 1, 1, -1, -1, 1, 1},
+                      sz[8] = {-1, -1, -1, -1, 1, 1, 1, 1};
+  const Eigen::Vector3d o = point3(x, c[k]);
+  const Eigen::Vector3d e0 = -sx[k] * (point3(x, c[along[k][0]]) - o), e1 = -sy[k] * (point3(x, c[along[k][1]]) - o),
+                        e2 = -sz[k] * (point3(x, c[along[k][2]]) - o);
+  return e0.cross(e1).dot(e2);
+}
+
+double cell_diameter(const Eigen::MatrixXd& x, const std::array<int, 8>& c) {
+  double d2 = 0.0;
+  const int n = Mesh::cell_size(c);
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) d2 = std::max(d2, (x.col(c[i]) - x.col(c[j])).squaredNorm());
+  return std::sqrt(d2);
+}
+
+/// Orients a cell positively (tetrahedron: positive volume; hexahedron: positive
+/// Jacobian at every corner), mirroring a negatively numbered one.
+void orient_cell(const std::string& where, const std::string& body, const Eigen::MatrixXd& x, std::array<int, 8>& c) {
+  const double h = cell_diameter(x, c), floor = kDegenerateAreaRatio * h * h * h;
+  if (Mesh::cell_size(c) == 4) {
+    const double v = tetra_volume(x, c);
+    if (!(std::abs(v) > floor))
+      throw InputError(where + ": tetrahedron at " + point_string(x, c[0]) + " in body '" + body +
+                       "' is degenerate (zero volume)");
+    if (v < 0) std::swap(c[1], c[2]);
+    return;
+  }
+  if (hexa_corner_jacobian(x, c, 0) < 0) std::swap_ranges(c.begin(), c.begin() + 4, c.begin() + 4);  // top <-> bottom
+  for (int k = 0; k < 8; ++k)
+    if (!(hexa_corner_jacobian(x, c, k) > floor))
+      throw InputError(where + ": hexahedron at " + point_string(x, c[0]) + " in body '" + body +
+                       "' is inverted, degenerate or not convex (corner Jacobian " +
+                       std::to_string(hexa_corner_jacobian(x, c, k)) + "); expected gmsh's node order");
+}
+
+/// Cells containing each node (compressed rows).
+struct NodeCells {
+  std::vector<int> start, cells;
+  NodeCells(int num_nodes, const std::vector<std::array<int, 8>>& all) : start(static_cast<size_t>(num_nodes) + 1, 0) {
+    for (const auto& c : all)
+      for (int a = 0; a < Mesh::cell_size(c); ++a) ++start[static_cast<size_t>(c[a]) + 1];
+    for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    cells.resize(static_cast<size_t>(start.back()));
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (int e = 0; e < static_cast<int>(all.size()); ++e)
+      for (int a = 0; a < Mesh::cell_size(all[static_cast<size_t>(e)]); ++a)
+        cells[static_cast<size_t>(fill[static_cast<size_t>(all[static_cast<size_t>(e)][a])]++)] = e;
+  }
+  /// Cells holding every node of the facet.
+  std::vector<int> holding(const std::array<int, 4>& f, const std::vector<std::array<int, 8>>& all) const {
+    std::vector<int> out;
+    for (int k = start[static_cast<size_t>(f[0])]; k < start[static_cast<size_t>(f[0]) + 1]; ++k) {
+      const auto& c = all[static_cast<size_t>(cells[static_cast<size_t>(k)])];
+      bool all_in = true;
+      for (int a = 1; a < 4 && f[a] >= 0; ++a) all_in = all_in && std::find(c.begin(), c.end(), f[a]) != c.end();
+      if (all_in) out.push_back(cells[static_cast<size_t>(k)]);
+    }
+    return out;
+  }
+};
+
+Eigen::Vector3d facet_normal(const Eigen::MatrixXd& x, const std::array<int, 4>& f) {
+  if (f[3] < 0) return (point3(x, f[1]) - point3(x, f[0])).cross(point3(x, f[2]) - point3(x, f[0]));
+  return (point3(x, f[2]) - point3(x, f[0])).cross(point3(x, f[3]) - point3(x, f[1]));
+}
+
+Mesh read_current_model_3d(const std::string& where) {
+  const auto volumes = physical_groups(3);
+  Mesh mesh;
+  mesh.dim = 3;
+  std::vector<std::vector<std::size_t>> body_tags;
+  std::vector<std::vector<std::pair<int, std::size_t>>> body_cells;  // (type, offset into body_tags)
+  std::map<int, std::string> entity_owner;
+  for (const auto& g : volumes) {
+    for (int e : g.entities) {
+      auto [it, inserted] = entity_owner.emplace(e, g.name);
+      if (!inserted)
+        throw InputError(where + ": volume " + std::to_string(e) + " belongs to physical volumes '" + it->second +
+                         "' and '" + g.name + "'; each element must belong to one body");
+    }
+    if (std::find(mesh.body_names.begin(), mesh.body_names.end(), g.name) != mesh.body_names.end())
+      throw InputError(where + ": two physical volumes are named '" + g.name + "'");
+    std::vector<std::size_t> tags;
+    std::vector<std::pair<int, std::size_t>> cells;
+    for (const auto& [type, list] : group_elements_by_type(3, g)) {
+      if (type != kGmshTetrahedron4 && type != kGmshHexahedron8)
+        throw InputError(where + ": volume elements must be 4-node tetrahedra or 8-node hexahedra, found " +
+                         element_kind(type));
+      const std::size_t n = type == kGmshTetrahedron4 ? 4 : 8;
+      for (std::size_t e = 0; e + n <= list.size(); e += n) cells.emplace_back(type, tags.size() + e);
+      tags.insert(tags.end(), list.begin(), list.end());
+    }
+    if (tags.empty()) throw InputError(where + ": physical volume '" + g.name + "' has no elements");
+    mesh.body_names.push_back(g.name);
+    body_tags.push_back(std::move(tags));
+    body_cells.push_back(std::move(cells));
+  }
+  const std::unordered_map<std::size_t, int> id_of = number_nodes(body_tags);
+  mesh.nodes = node_coordinates(where, id_of, 3);
+  for (std::size_t b = 0; b < body_tags.size(); ++b)
+    for (const auto& [type, offset] : body_cells[b]) {
+      std::array<int, 8> c;
+      c.fill(-1);
+      const int n = type == kGmshTetrahedron4 ? 4 : 8;
+      for (int a = 0; a < n; ++a) c[static_cast<size_t>(a)] = id_of.at(body_tags[b][offset + static_cast<size_t>(a)]);
+      orient_cell(where, mesh.body_names[b], mesh.nodes, c);
+      mesh.cells.push_back(c);
+      mesh.cell_body.push_back(static_cast<int>(b));
+    }
+
+  // Boundary groups: facets of physical surfaces, oriented out of the body whose cell has them.
+  const NodeCells node_cells(mesh.num_nodes(), mesh.cells);
+  for (const auto& g : physical_groups(2)) {
+    if (mesh.curve_nodes.count(g.name)) throw InputError(where + ": two physical surfaces are named '" + g.name + "'");
+    std::vector<std::array<int, 4>>& facets = mesh.faces[g.name];
+    for (const auto& [type, list] : group_elements_by_type(2, g)) {
+      if (type != kGmshTriangle3 && type != kGmshQuad4)
+        throw InputError(where + ": facets of the physical surface '" + g.name +
+                         "' must be 3-node triangles or 4-node quads, found " + element_kind(type));
+      const std::size_t n = type == kGmshTriangle3 ? 3 : 4;
+      for (std::size_t e = 0; e + n <= list.size(); e += n) {
+        std::array<int, 4> f{-1, -1, -1, -1};
+        for (std::size_t a = 0; a < n; ++a) {
+          auto it = id_of.find(list[e + a]);
+          if (it == id_of.end())
+            throw InputError(where + ": physical surface '" + g.name + "' has nodes that belong to no physical volume");
+          f[a] = it->second;
+        }
+        const std::vector<int> owners = node_cells.holding(f, mesh.cells);
+        if (owners.empty())
+          throw InputError(where + ": physical surface '" + g.name + "' has the facet at " +
+                           point_string(mesh.nodes, f[0]) + " that is no face of a volume element");
+        // Outward: the owner's centroid lies behind the facet.
+        const auto& c = mesh.cells[static_cast<size_t>(owners.front())];
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero(), mid = Eigen::Vector3d::Zero();
+        for (int a = 0; a < Mesh::cell_size(c); ++a) centre += point3(mesh.nodes, c[a]) / Mesh::cell_size(c);
+        for (std::size_t a = 0; a < n; ++a) mid += point3(mesh.nodes, f[a]) / static_cast<double>(n);
+        if (facet_normal(mesh.nodes, f).dot(centre - mid) > 0) std::swap(f[1], f[n - 1]);
+        facets.push_back(f);
+      }
+    }
+    if (facets.empty()) throw InputError(where + ": physical surface '" + g.name + "' has no elements");
+    std::vector<int>& nodes = mesh.curve_nodes[g.name];
+    for (const auto& f : facets)
+      for (int v : f)
+        if (v >= 0) nodes.push_back(v);
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  }
+  // Physical curves and points: node groups (Dirichlet data on an edge or a point).
+  for (int dim : {1, 0})
+    for (const auto& g : physical_groups(dim)) {
+      const char* kind = dim == 1 ? "curve" : "point";
+      if (mesh.curve_nodes.count(g.name))
+        throw InputError(where + ": the physical " + kind + " '" + g.name + "' has the name of another group");
+      std::vector<int>& nodes = mesh.curve_nodes[g.name];
+      for (int entity : g.entities) {
+        std::vector<std::size_t> tags;
+        std::vector<double> coord, param;
+        gmsh::model::mesh::getNodes(tags, coord, param, dim, entity, true, false);
+        for (std::size_t t : tags) {
+          auto it = id_of.find(t);
+          if (it == id_of.end())
+            throw InputError(where + ": physical " + kind + " '" + g.name + "' has a node of no physical volume");
+          nodes.push_back(it->second);
+        }
+      }
+      std::sort(nodes.begin(), nodes.end());
+      nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+      if (nodes.empty()) throw InputError(where + ": physical " + kind + " '" + g.name + "' has no mesh node");
+    }
+  return mesh;
+}
+
 template <class T>
 void fnv1a(std::uint64_t& h, T value) {
   // Hash the value's bytes least significant first, independent of endianness.
@@ -409,7 +629,8 @@ std::string Mesh::fingerprint() const {
   std::uint64_t h = 14695981039346656037ull;  // FNV-1a 64 offset basis
   fnv1a(h, static_cast<std::int64_t>(nodes.cols()));
   for (Eigen::Index j = 0; j < nodes.cols(); ++j)
-    for (int i = 0; i < 2; ++i) fnv1a(h, static_cast<std::int64_t>(std::llround(nodes(i, j) / kFingerprintResolution)));
+    for (Eigen::Index i = 0; i < nodes.rows(); ++i)
+      fnv1a(h, static_cast<std::int64_t>(std::llround(nodes(i, j) / kFingerprintResolution)));
   fnv1a(h, static_cast<std::int64_t>(quads.size()));
   for (std::size_t e = 0; e < quads.size(); ++e) {
     for (int n : quads[e]) fnv1a(h, static_cast<std::int32_t>(n));
@@ -431,9 +652,32 @@ std::string Mesh::fingerprint() const {
     fnv1a(h, static_cast<std::int64_t>(chain.size()));
     for (int n : chain) fnv1a(h, static_cast<std::int32_t>(n));
   }
+  if (dim == 3) {  // (2D meshes keep the fingerprint they had before 3D existed)
+    fnv1a(h, static_cast<std::int32_t>(dim));
+    fnv1a(h, static_cast<std::int64_t>(cells.size()));
+    for (std::size_t e = 0; e < cells.size(); ++e) {
+      for (int n : cells[e]) fnv1a(h, static_cast<std::int32_t>(n));
+      fnv1a(h, static_cast<std::int32_t>(e < cell_body.size() ? cell_body[e] : -1));
+    }
+    for (const auto& [name, list] : faces) {
+      fnv1a(h, name);
+      fnv1a(h, static_cast<std::int64_t>(list.size()));
+      for (const auto& f : list)
+        for (int n : f) fnv1a(h, static_cast<std::int32_t>(n));
+    }
+  }
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
   return buf;
+}
+
+std::vector<int> Mesh::element_nodes(int e) const {
+  if (dim == 3) {
+    const auto& c = cells[static_cast<size_t>(e)];
+    return std::vector<int>(c.begin(), c.begin() + cell_size(c));
+  }
+  const auto& q = quads[static_cast<size_t>(e)];
+  return std::vector<int>(q.begin(), q.end());
 }
 
 namespace {
@@ -522,6 +766,7 @@ class MeshReader {
 std::string serialize(const Mesh& mesh) {
   MeshWriter w;
   w.put(kMeshFollows);
+  w.put<std::int32_t>(mesh.dim);
   w.put_vector(std::vector<double>(mesh.nodes.data(), mesh.nodes.data() + mesh.nodes.size()));
   w.put_vector(mesh.quads);
   w.put_vector(mesh.quad_body);
@@ -531,6 +776,10 @@ std::string serialize(const Mesh& mesh) {
   for (const auto& [name, segs] : mesh.segments) w.put(name), w.put_vector(segs);
   w.put<std::uint64_t>(mesh.curve_nodes.size());
   for (const auto& [name, nodes] : mesh.curve_nodes) w.put(name), w.put_vector(nodes);
+  w.put_vector(mesh.cells);
+  w.put_vector(mesh.cell_body);
+  w.put<std::uint64_t>(mesh.faces.size());
+  for (const auto& [name, facets] : mesh.faces) w.put(name), w.put_vector(facets);
   return std::move(w.bytes());
 }
 
@@ -538,8 +787,11 @@ Mesh deserialize(const std::string& bytes, const std::string& where) {
   MeshReader r(bytes, where);
   if (r.get<char>() != kMeshFollows) throw InputError(where + ": the gmsh process sent no mesh");
   Mesh mesh;
+  mesh.dim = r.get<std::int32_t>();
+  if (mesh.dim != 2 && mesh.dim != 3) throw InputError(where + ": the gmsh process sent a broken mesh");
   const auto coords = r.get_vector<double>();
-  mesh.nodes = Eigen::Map<const Eigen::Matrix2Xd>(coords.data(), 2, static_cast<Eigen::Index>(coords.size() / 2));
+  mesh.nodes = Eigen::Map<const Eigen::MatrixXd>(coords.data(), mesh.dim,
+                                                 static_cast<Eigen::Index>(coords.size()) / mesh.dim);
   mesh.quads = r.get_vector<std::array<int, 4>>();
   mesh.quad_body = r.get_vector<int>();
   for (auto n = r.get<std::uint64_t>(); n > 0; --n) mesh.body_names.push_back(r.get_string());
@@ -551,6 +803,12 @@ Mesh deserialize(const std::string& bytes, const std::string& where) {
     std::string name = r.get_string();
     mesh.curve_nodes[name] = r.get_vector<int>();
   }
+  mesh.cells = r.get_vector<std::array<int, 8>>();
+  mesh.cell_body = r.get_vector<int>();
+  for (auto n = r.get<std::uint64_t>(); n > 0; --n) {
+    std::string name = r.get_string();
+    mesh.faces[name] = r.get_vector<std::array<int, 4>>();
+  }
   return mesh;
 }
 
@@ -561,10 +819,10 @@ std::size_t node_count() {
   return tags.size();
 }
 
-std::size_t surface_element_count() {
+std::size_t element_count(int dim) {
   std::vector<int> types;
   std::vector<std::vector<std::size_t>> element_tags, node_tags;
-  gmsh::model::mesh::getElements(types, element_tags, node_tags, 2, -1);
+  gmsh::model::mesh::getElements(types, element_tags, node_tags, dim, -1);
   std::size_t n = 0;
   for (const auto& tags : element_tags) n += tags.size();
   return n;
@@ -587,16 +845,23 @@ Mesh mesh_with_gmsh(const std::string& path, const MeshOptions& options) {
     gmsh::open(path);
     if (std::string err = session.take_first_error(); !err.empty())
       throw InputError(where + ": gmsh could not read it: " + err);
+    // A model with physical volumes is 3D (bodies are volumes), else 2D.
+    gmsh::vectorpair volumes;
+    gmsh::model::getPhysicalGroups(volumes, 3);
+    const int dim = volumes.empty() ? 2 : 3;
     if (lower_extension(path) == ".geo") {
-      gmsh::model::mesh::generate(2);
+      gmsh::model::mesh::generate(dim);
       if (std::string err = session.take_first_error(); !err.empty())
         throw InputError(where + ": gmsh meshing failed: " + err);
     }
     if (const std::size_t n = node_count(); n > static_cast<std::size_t>(options.max_nodes))
       refuse_size(where, std::to_string(n), 0, options.max_nodes);
     // Each level multiplies the surface elements by four, and a quad mesh has at
-    // least as many nodes as quads: refuse before refining what would be too large.
-    const double at_least = static_cast<double>(surface_element_count()) * std::pow(4.0, options.refine);
+    // least as many nodes as quads; it multiplies the volume elements by eight, and a
+    // mesh of tetrahedra has at least an eighth as many nodes as tetrahedra (about a
+    // fifth in practice): refuse before refining what would be too large.
+    const double at_least = dim == 2 ? static_cast<double>(element_count(2)) * std::pow(4.0, options.refine)
+                                     : static_cast<double>(element_count(3)) * std::pow(8.0, options.refine) / 8.0;
     if (at_least > static_cast<double>(options.max_nodes))
       refuse_size(where, "at least " + std::to_string(static_cast<long long>(at_least)), options.refine,
                   options.max_nodes);
@@ -608,7 +873,7 @@ Mesh mesh_with_gmsh(const std::string& path, const MeshOptions& options) {
       if (std::string err = session.take_first_error(); !err.empty())
         throw InputError(where + ": gmsh refinement failed: " + err);
     }
-    Mesh mesh = read_current_model(where);
+    Mesh mesh = dim == 3 ? read_current_model_3d(where) : read_current_model(where);
     if (mesh.num_nodes() > options.max_nodes)
       refuse_size(where, std::to_string(mesh.num_nodes()), options.refine, options.max_nodes);
     return mesh;

@@ -1,8 +1,9 @@
 #pragma once
 /// \file mesh.hpp
-/// \brief 2D bilinear-quad meshes read from gmsh `.geo`/`.msh` files through the
-/// gmsh API. Boundary groups (Dirichlet faces, slave and master surfaces) come
-/// from the file's physical groups, never from coordinates guessed in code.
+/// \brief Meshes read from gmsh `.geo`/`.msh` files through the gmsh API: 2D
+/// bilinear quads, or 3D linear tetrahedra and trilinear hexahedra. Boundary groups
+/// (Dirichlet faces, slave and master surfaces) come from the file's physical
+/// groups, never from coordinates guessed in code.
 #include <Eigen/Dense>
 #include <array>
 #include <cstdint>
@@ -12,7 +13,8 @@
 
 namespace contactrom::fom {
 
-/// \brief A 2D Q1 mesh with named node/segment groups.
+/// \brief A 2D Q1 mesh with named node/segment groups, or a 3D mesh of tetrahedra
+/// and hexahedra with named node/facet groups (`dim` says which).
 ///
 /// Node numbering is contiguous 0..num_nodes()-1, body after body (in
 /// `body_names` order), and within a body by ascending gmsh node tag; it is
@@ -25,11 +27,29 @@ namespace contactrom::fom {
 /// \f$ n = (t_y, -t_x) \f$. (The body is the one whose quad has the first
 /// segment as an edge; an open chain therefore starts at the end that keeps the
 /// body on the left; a closed chain starts at its smallest node id.)
+///
+/// In 3D (`dim == 3`) the bodies are physical volumes, their elements `cells`
+/// (a tetrahedron has positive volume, a hexahedron a positive Jacobian at its
+/// corners, both in gmsh's node order) and the boundary groups physical surfaces,
+/// whose facets (`faces`, triangles or quads) are numbered counter-clockwise seen
+/// from outside their body, so that the right-hand normal
+/// \f$ (x_1 - x_0) \times (x_2 - x_0) \f$ of a triangle (of the quad's diagonals
+/// \f$ (x_2 - x_0) \times (x_3 - x_1) \f$) points out of the body. Physical
+/// surfaces, curves and points all give node groups (`curve_nodes`, ascending ids in
+/// 3D); `quads` and `segments` are empty.
 struct Mesh {
-  Eigen::Matrix2Xd nodes;                     ///< reference coordinates, 2 x n
-  std::vector<std::array<int, 4>> quads;      ///< node ids, counter-clockwise
-  std::vector<int> quad_body;                 ///< body index (0-based) of each quad
-  std::vector<std::string> body_names;        ///< physical surface names, by body index
+  int dim = 2;                                ///< spatial dimension: 2 (quads) or 3 (tetrahedra, hexahedra)
+  Eigen::MatrixXd nodes;                      ///< reference coordinates, dim x n
+  std::vector<std::array<int, 4>> quads;      ///< 2D: node ids, counter-clockwise
+  std::vector<int> quad_body;                 ///< 2D: body index (0-based) of each quad
+  /// 3D: node ids of each volume element in gmsh order: a tetrahedron's 4 then −1s,
+  /// a hexahedron's 8 (bottom face 0-3, top face 4-7 above it).
+  std::vector<std::array<int, 8>> cells;
+  std::vector<int> cell_body;                 ///< 3D: body index (0-based) of each cell
+  /// 3D: physical surface name -> its facets (triangle: 3 ids and −1; quad: 4 ids),
+  /// counter-clockwise seen from outside the body they bound.
+  std::map<std::string, std::vector<std::array<int, 4>>> faces;
+  std::vector<std::string> body_names;        ///< physical surface (2D) or volume (3D) names, by body index
   /// Physical curve name -> its line elements (node pairs), ordered as a chain
   /// from one end of the curve to the other (consecutive segments share a node).
   std::map<std::string, std::vector<std::array<int, 2>>> segments;
@@ -39,6 +59,15 @@ struct Mesh {
 
   int num_nodes() const { return static_cast<int>(nodes.cols()); }
   int num_quads() const { return static_cast<int>(quads.size()); }
+  int num_cells() const { return static_cast<int>(cells.size()); }
+  /// Elements of the mesh: quads in 2D, cells in 3D.
+  int num_elements() const { return dim == 3 ? num_cells() : num_quads(); }
+  /// Body index of element e (quads in 2D, cells in 3D).
+  int element_body(int e) const { return dim == 3 ? cell_body[static_cast<size_t>(e)] : quad_body[static_cast<size_t>(e)]; }
+  /// Node ids of element e: its 4 quad corners, or a cell's 4 or 8 nodes.
+  std::vector<int> element_nodes(int e) const;
+  /// Nodes of a 3D cell (4: tetrahedron, 8: hexahedron).
+  static int cell_size(const std::array<int, 8>& cell) { return cell[4] < 0 ? 4 : 8; }
   /// Node ids of a named curve; throws InputError naming the group if absent.
   const std::vector<int>& group_nodes(const std::string& name) const;
   /// Segments of a named curve; throws InputError naming the group if absent.
@@ -52,8 +81,9 @@ struct Mesh {
 /// \brief Options of load_mesh (documented defaults).
 struct MeshOptions {
   /// Uniform refinement levels applied after meshing (or reading): each level splits
-  /// every quad in four (`gmsh::model::mesh::refine()`), so node and quad counts grow
-  /// about fourfold per level and every boundary division doubles. New boundary nodes
+  /// every quad in four, every tetrahedron and hexahedron in eight
+  /// (`gmsh::model::mesh::refine()`), so node and element counts grow about fourfold
+  /// (2D) or eightfold (3D) per level and every boundary division doubles. New boundary nodes
   /// of a `.geo` model are placed on the geometry's curves (arcs stay round); a `.msh`
   /// file has no geometry, so its new boundary nodes are segment midpoints. Physical
   /// groups keep their names and stay chains. Range 0..kMaxRefine; default 0.
@@ -73,7 +103,11 @@ struct MeshOptions {
 };
 
 /// \brief Meshes a `.geo` file (or reads a `.msh`) with the gmsh API and returns
-/// the Q1 mesh. Only quadrilateral surface elements are accepted.
+/// the mesh. A model with physical volumes is 3D (meshed with
+/// `gmsh::model::mesh::generate(3)`; 4-node tetrahedra and 8-node hexahedra, mixed
+/// as gmsh gives them; boundary groups are the physical surfaces, of 3-node triangles
+/// and 4-node quads that are faces of the volume elements); otherwise it is 2D and
+/// only quadrilateral surface elements are accepted.
 ///
 /// Bodies are the physical surfaces, in ascending physical tag order; named
 /// boundaries are the physical curves (each must be one chain of 2-node lines

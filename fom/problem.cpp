@@ -9,6 +9,7 @@
 #include "core/errors.hpp"
 #include "core/format.hpp"
 #include "fom/contact_checks.hpp"
+#include "fom/node_to_face_contact.hpp"
 
 namespace contactrom::fom {
 namespace {
@@ -23,7 +24,9 @@ std::string hash_text(const std::string& text) {
 
 std::string point_text(const Mesh& mesh, int node) {
   std::ostringstream s;
-  s << "(" << mesh.nodes(0, node) << ", " << mesh.nodes(1, node) << ")";
+  s << "(" << mesh.nodes(0, node);
+  for (Eigen::Index i = 1; i < mesh.nodes.rows(); ++i) s << ", " << mesh.nodes(i, node);
+  s << ")";
   return s.str();
 }
 
@@ -49,17 +52,29 @@ class Builder {
  public:
   Builder(const ProblemDefinition& def, const Mesh& mesh) : m_def(def), m_mesh(mesh) {}
 
+  /// The formulation and the mesh agree on the dimension.
+  void check_dimension() {
+    if (m_def.dimension == m_mesh.dim) return;
+    throw InputError(m_def.where(m_def.formulation_where) + ": the problem is " +
+                     (m_def.dimension == 3 ? "3D (formulation = \"3d\")" : "2D") + " but the mesh '" + m_def.mesh +
+                     "' is " + (m_mesh.dim == 3 ? "3D (physical volumes)" : "2D (physical surfaces of quads)") +
+                     "; expected " + (m_mesh.dim == 3 ? "formulation = \"3d\"" : "a 2D formulation") +
+                     " for this mesh");
+  }
+
   void check_bodies() {
+    const std::string kind = m_mesh.dim == 3 ? "physical volume" : "physical surface";
     for (const BodySpec& b : m_def.bodies)
       if (body_index(b.group) < 0)
-        throw InputError(m_def.where(b.where) + ": the mesh has no physical surface '" + b.group +
+        throw InputError(m_def.where(b.where) + ": the mesh has no " + kind + " '" + b.group +
                          "'; expected one of: " + body_list());
-    for (const std::string& surface : m_mesh.body_names) {
+    for (const std::string& body : m_mesh.body_names) {
       bool listed = false;
-      for (const BodySpec& b : m_def.bodies) listed = listed || b.group == surface;
+      for (const BodySpec& b : m_def.bodies) listed = listed || b.group == body;
       if (!listed)
-        throw InputError(m_def.where({0, "bodies"}) + ": the mesh's physical surface '" + surface +
-                         "' has no [[bodies]] entry; expected every surface of " + quoted(m_def.mesh, 200) + " listed");
+        throw InputError(m_def.where({0, "bodies"}) + ": the mesh's " + kind + " '" + body +
+                         "' has no [[bodies]] entry; expected every " + (m_mesh.dim == 3 ? "volume" : "surface") +
+                         " of " + quoted(m_def.mesh, 200) + " listed");
     }
   }
 
@@ -89,11 +104,12 @@ class Builder {
     std::vector<int> owner(is_dirichlet.size(), -1);
     for (size_t s = 0; s < m_def.dirichlet.size(); ++s) {
       const DirichletSpec& d = m_def.dirichlet[s];
-      for (int node : group_nodes(d.group, d.where, "physical curve or point")) {
-        for (int c = 0; c < 2; ++c) {
+      const int dim = m_mesh.dim;
+      for (int node : group_nodes(d.group, d.where, dim == 3 ? "physical surface, curve or point" : "physical curve or point")) {
+        for (int c = 0; c < dim; ++c) {
           const auto& value = d.displacement[static_cast<size_t>(c)];
           if (!value) continue;
-          const int dof = 2 * node + c;
+          const int dof = dim * node + c;
           if (owner[dof] >= 0) {
             const auto& other = *m_def.dirichlet[static_cast<size_t>(owner[dof])].displacement[static_cast<size_t>(c)];
             if (other.constant != value->constant || other.coefficients != value->coefficients)
@@ -112,6 +128,7 @@ class Builder {
 
   /// Consistent nodal forces of the tractions (force per unit length, linear elements).
   void tractions(AffineVectors& fext) const {
+    if (m_mesh.dim == 3) return surface_tractions(fext);
     for (const TractionSpec& t : m_def.traction) {
       group_nodes(t.group, t.where, "physical curve");
       if (m_mesh.group_segments(t.group).empty())
@@ -124,7 +141,77 @@ class Builder {
     }
   }
 
+  /// 3D: consistent nodal forces ∫ N_a t dA of the tractions (force per unit area).
+  void surface_tractions(AffineVectors& fext) const {
+    for (const TractionSpec& t : m_def.traction) {
+      group_nodes(t.group, t.where, "physical surface");
+      if (m_mesh.faces.count(t.group) == 0)
+        throw InputError(m_def.where(t.where) + ": '" + t.group + "' is not a physical surface; expected one");
+      for (const auto& f : m_mesh.faces.at(t.group)) {
+        const std::array<double, 4> area = facet_node_areas(m_mesh.nodes, f);
+        for (int a = 0; a < 4 && f[static_cast<size_t>(a)] >= 0; ++a)
+          for (int c = 0; c < 3; ++c)
+            fext.add(3 * f[static_cast<size_t>(a)] + c, t.traction[static_cast<size_t>(c)], area[static_cast<size_t>(a)]);
+      }
+    }
+  }
+
+  /// 3D: node-to-face contact of the physical surfaces named by the pairs, which
+  /// must be made of boundary facets (faces of one cell only).
+  std::unique_ptr<ContactModel> face_contact() const {
+    std::set<int> contact_nodes;
+    for (const ContactPairSpec& c : m_def.contact)
+      for (const std::string* name : {&c.slave, &c.master}) {
+        group_nodes(*name, c.where, "physical surface");
+        if (m_mesh.faces.count(*name) == 0)
+          throw InputError(m_def.where(c.where) + ": '" + *name + "' is not a physical surface with facets");
+        for (const auto& f : m_mesh.faces.at(*name))
+          for (int v : f)
+            if (v >= 0) contact_nodes.insert(v);
+      }
+    // Faces of cells on the contact surfaces, counted by their sorted nodes.
+    static const int tet_faces[4][4] = {{0, 2, 1, -1}, {0, 1, 3, -1}, {1, 2, 3, -1}, {0, 3, 2, -1}};
+    static const int hex_faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+    std::map<std::array<int, 4>, int> face_count;
+    auto key = [](std::array<int, 4> f) {
+      std::sort(f.begin(), f.end());  // −1 first for triangles
+      return f;
+    };
+    for (const auto& cell : m_mesh.cells) {
+      const bool tet = Mesh::cell_size(cell) == 4;
+      for (int k = 0; k < (tet ? 4 : 6); ++k) {
+        const int* local = tet ? tet_faces[k] : hex_faces[k];
+        std::array<int, 4> f{-1, -1, -1, -1};
+        bool on_surface = true;
+        for (int a = 0; a < (tet ? 3 : 4); ++a) {
+          f[static_cast<size_t>(a)] = cell[static_cast<size_t>(local[a])];
+          on_surface = on_surface && contact_nodes.count(f[static_cast<size_t>(a)]) > 0;
+        }
+        if (on_surface) ++face_count[key(f)];
+      }
+    }
+    std::vector<ContactPairFacets> pairs;
+    for (const ContactPairSpec& c : m_def.contact) {
+      ContactPairFacets facets;
+      facets.slave = m_mesh.faces.at(c.slave);
+      facets.master = m_mesh.faces.at(c.master);
+      for (const std::string* name : {&c.slave, &c.master})
+        for (const auto& f : m_mesh.faces.at(*name))
+          if (face_count[key(f)] != 1)
+            throw InputError(m_def.where(c.where) + ": the surface '" + *name + "' has the facet at " +
+                             point_text(m_mesh, f[0]) +
+                             " inside a body; expected a contact surface on the boundary of its body");
+      pairs.push_back(std::move(facets));
+    }
+    try {
+      return std::make_unique<NodeToFaceContact>(m_mesh.nodes, pairs);
+    } catch (const InputError& e) {
+      throw InputError(m_def.where({0, "contact"}) + ": " + e.what());
+    }
+  }
+
   std::unique_ptr<ContactModel> contact() const {
+    if (m_mesh.dim == 3) return face_contact();
     // Boundary edges: quad edges used once.
     std::map<std::pair<int, int>, int> edge_count;
     for (const auto& q : m_mesh.quads)
@@ -267,8 +354,10 @@ std::unique_ptr<Problem> build_problem(ProblemDefinition definition, Mesh mesh) 
   p->m_mesh = std::make_unique<Mesh>(std::move(mesh));
   const ProblemDefinition& def = p->m_definition;
   const Mesh& m = *p->m_mesh;
-  const int n = 2 * m.num_nodes(), np = def.parameters.size();
+  const int n = m.dim * m.num_nodes(), np = def.parameters.size();
+  p->m_dofs_per_node = m.dim;
   Builder b(def, m);
+  b.check_dimension();
   b.check_bodies();
   b.assemble_stiffness_terms(p->m_k_terms, p->m_k_coeff);
   p->m_h1 = assemble_h1_gram(m);

@@ -54,7 +54,7 @@ class Problem {
   std::string range_text() const { return parameters().range_text(); }
 
   int num_dofs() const { return static_cast<int>(m_is_dirichlet.size()); }
-  /// Spatial dimension of a node's displacement (2, or 1 for rope).
+  /// Spatial dimension of a node's displacement (2 or 3 = the mesh's dimension, 1 for rope).
   int dofs_per_node() const { return m_dofs_per_node; }
   const std::vector<char>& is_dirichlet() const { return m_is_dirichlet; }
   /// Indices of the free dofs, ascending.
@@ -82,7 +82,7 @@ class Problem {
   const ContactModel& contact() const { return *m_contact; }
   /// Gram matrix of the H¹ norm used for primal errors.
   const SparseMatrix& h1_gram() const { return m_h1; }
-  /// The Q1 mesh (nullptr for the 1D rope).
+  /// The mesh, 2D or 3D (nullptr for the 1D rope).
   const Mesh* mesh() const { return m_mesh.get(); }
   /// Material of each body at μ (Young's moduli evaluated).
   std::vector<Material> materials(const Param& mu) const;

@@ -140,15 +140,22 @@ class Reader {
     return AffineExpression::constant_value(number(n, key), m_def.parameters.size());
   }
 
-  /// A two-component array of affine values; `allow_free` accepts "free".
-  std::array<std::optional<AffineExpression>, 2> vector2(const toml::table& t, const std::string& prefix,
-                                                         const char* key, bool allow_free) const {
+  /// A vector of one affine value per dimension (two in 2D, three in 3D);
+  /// `allow_free` accepts "free" for a component without a value.
+  std::array<std::optional<AffineExpression>, 3> vector_value(const toml::table& t, const std::string& prefix,
+                                                              const char* key, bool allow_free) const {
     const toml::node* n = node(t, prefix, key, true);
-    if (!n->is_array() || n->as_array()->size() != 2)
-      fail(n, prefix + key, std::string("expected an array of two components [x, y]") +
-                                (allow_free ? " (number, affine expression or \"free\")" : ""));
-    std::array<std::optional<AffineExpression>, 2> out;
-    for (int c = 0; c < 2; ++c) {
+    const int dim = m_def.dimension;
+    if (!n->is_array() || static_cast<int>(n->as_array()->size()) != dim)
+      fail(n, prefix + key, std::string(dim == 3 ? "expected an array of three components [x, y, z]"
+                                                 : "expected an array of two components [x, y]") +
+                                (allow_free ? " (number, affine expression or \"free\")" : "") +
+                                (n->is_array() && n->as_array()->size() == (dim == 3 ? 2u : 3u)
+                                     ? std::string("; the problem's formulation is ") +
+                                           (dim == 3 ? "\"3d\"" : "2D (formulation = \"3d\" for three)")
+                                     : std::string()));
+    std::array<std::optional<AffineExpression>, 3> out;
+    for (int c = 0; c < dim; ++c) {
       const toml::node& e = *n->as_array()->get(static_cast<size_t>(c));
       const std::string ckey = prefix + key + "[" + std::to_string(c) + "]";
       if (allow_free && e.is_string() && e.as_string()->get() == "free") continue;
@@ -170,10 +177,12 @@ class Reader {
     const fs::path base = m_def.path.empty() ? fs::path(".") : fs::path(m_def.path).parent_path();
     m_def.mesh = fs::path(mesh).is_absolute() ? mesh : (base / mesh).lexically_normal().string();
     const std::string formulation = string(*t, p, "formulation", false, "plane_strain");
-    if (formulation != "plane_strain" && formulation != "plane_stress")
+    if (formulation != "plane_strain" && formulation != "plane_stress" && formulation != "3d")
       fail(t->get("formulation"), p + "formulation",
-           quoted(formulation, 200) + " is unknown; expected \"plane_strain\" or \"plane_stress\"");
+           quoted(formulation, 200) + " is unknown; expected \"plane_strain\", \"plane_stress\" or \"3d\"");
     m_def.plane_stress = formulation == "plane_stress";
+    m_def.dimension = formulation == "3d" ? 3 : 2;
+    m_def.formulation_where = at(t->get("formulation") ? t->get("formulation") : t, p + "formulation");
     m_def.refine = static_cast<int>(integer(*t, p, "refine", 0, 0, 6));
     m_def.max_mesh_nodes = integer(*t, p, "max_mesh_nodes", static_cast<long>(m_def.max_mesh_nodes), 1,
                                    std::numeric_limits<long>::max());
@@ -250,7 +259,7 @@ class Reader {
       DirichletSpec d;
       d.group = string(t, p, "group", true);
       d.where = at(&t, p + "group");
-      d.displacement = vector2(t, p, "displacement", true);
+      d.displacement = vector_value(t, p, "displacement", true);
       m_def.dirichlet.push_back(std::move(d));
     }
   }
@@ -264,8 +273,8 @@ class Reader {
       TractionSpec s;
       s.group = string(t, p, "group", true);
       s.where = at(&t, p + "group");
-      const auto v = vector2(t, p, "traction", false);
-      s.traction = {*v[0], *v[1]};
+      const auto v = vector_value(t, p, "traction", false);
+      for (int c = 0; c < m_def.dimension; ++c) s.traction[static_cast<size_t>(c)] = *v[static_cast<size_t>(c)];
       m_def.traction.push_back(std::move(s));
     }
   }

@@ -24,7 +24,7 @@ struct SourceLocation {
   std::string key;  ///< e.g. "bodies[1].young"
 };
 
-/// \brief One body: a physical surface of the mesh and its material.
+/// \brief One body: a physical surface (2D) or volume (3D) of the mesh and its material.
 struct BodySpec {
   std::string group;
   AffineExpression young;  ///< Young's modulus, affine in the parameters (> 0 over the box)
@@ -32,22 +32,24 @@ struct BodySpec {
   SourceLocation where;
 };
 
-/// \brief Prescribed displacement on a physical curve or point; a component
-/// without a value is free.
+/// \brief Prescribed displacement on a physical curve or point (3D: surface, curve
+/// or point); a component without a value is free. 2D uses the first two components.
 struct DirichletSpec {
   std::string group;
-  std::array<std::optional<AffineExpression>, 2> displacement;
+  std::array<std::optional<AffineExpression>, 3> displacement;
   SourceLocation where;
 };
 
-/// \brief Force per unit length on a physical curve (global x, y components).
+/// \brief Force per unit length on a physical curve (global x, y components); in 3D
+/// force per unit area on a physical surface (x, y, z).
 struct TractionSpec {
   std::string group;
-  std::array<AffineExpression, 2> traction;
+  std::array<AffineExpression, 3> traction;  ///< 2D: the third is unused
   SourceLocation where;
 };
 
-/// \brief A contact pair: slave curve (its nodes carry the pressure) against master curve.
+/// \brief A contact pair: slave curve (its nodes carry the pressure) against master
+/// curve; in 3D slave and master physical surfaces.
 struct ContactPairSpec {
   std::string slave, master;
   SourceLocation where;
@@ -76,7 +78,9 @@ struct ProblemDefinition {
   std::string text;                      ///< the file's text (stored in databases)
   std::string mesh;                      ///< mesh path, resolved against the file's folder
   bool plane_stress = false;             ///< `formulation = "plane_stress"` (unit thickness)
-  int refine = 0;                        ///< uniform refinements of the mesh (each splits a quad in four)
+  int dimension = 2;                     ///< 3 for `formulation = "3d"` (a mesh of physical volumes), else 2
+  SourceLocation formulation_where;      ///< where `formulation` is (or the [problem] table), for messages
+  int refine = 0;                        ///< uniform refinements of the mesh (each splits a quad in four, a cell in eight)
   long long max_mesh_nodes = MeshOptions{}.max_nodes;   ///< `[problem] max_mesh_nodes` (MeshOptions::max_nodes)
   double mesh_time_limit = MeshOptions{}.time_limit_s;  ///< `[problem] mesh_time_limit` in s (MeshOptions::time_limit_s)
   double displacement_scale = 0.0;       ///< U for relative residuals; 0: max |Dirichlet value| over the box

@@ -17,10 +17,10 @@ std::vector<std::string> unheld_bodies(const Problem& problem) {
   if (!mesh) return out;
   const int dpn = problem.dofs_per_node();
   std::vector<char> held(mesh->body_names.size(), 0);
-  for (int q = 0; q < mesh->num_quads(); ++q)
-    for (int node : mesh->quads[q])
+  for (int e = 0; e < mesh->num_elements(); ++e)
+    for (int node : mesh->element_nodes(e))
       for (int d = 0; d < dpn; ++d)
-        if (problem.is_dirichlet()[dpn * node + d]) held[mesh->quad_body[q]] = 1;
+        if (problem.is_dirichlet()[static_cast<size_t>(dpn * node + d)]) held[static_cast<size_t>(mesh->element_body(e))] = 1;
   for (size_t b = 0; b < held.size(); ++b)
     if (!held[b]) out.push_back(mesh->body_names[b]);
   return out;

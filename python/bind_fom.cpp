@@ -124,14 +124,14 @@ with u = u_lift(mu) + u0 on all dofs (Dirichlet dofs kept).)doc");
           "Tributary length of each contact row (the pressure lam is per unit length).")
       .def_property_readonly(
           "contact_points", [](const fom::Problem& p) { return Eigen::MatrixXd(p.contact().constraint_points().transpose()); },
-          "Reference coordinates of the contact rows, shape (n_c, 2).")
+          "Reference coordinates of the contact rows, shape (n_c, dim) (dim = 2 or 3).")
       .def_property_readonly(
           "node_coordinates",
           [](const fom::Problem& p) -> py::object {
             if (!p.mesh()) return py::cast(p.rope_x());
             return py::cast(Eigen::MatrixXd(p.mesh()->nodes.transpose()));
           },
-          "Node coordinates, shape (n_nodes, 2) (rope: the 1-D abscissae).")
+          "Node coordinates, shape (n_nodes, dim) (dim = 2 or 3; rope: the 1-D abscissae).")
       .def_property_readonly("fingerprint", &fom::Problem::fingerprint)
       .def_property_readonly("displacement_scale", &fom::Problem::displacement_scale)
       .def("check_param", [](const fom::Problem& p, py::handle mu) { return to_param(p, mu); }, py::arg("mu"),

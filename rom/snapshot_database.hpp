@@ -42,7 +42,7 @@ struct SnapshotDatabase {
   /// Text of the problem file the snapshots were computed for ("" for `rope`, which is built in).
   std::string problem_text;
   std::shared_ptr<const fom::Mesh> mesh;  ///< the (refined) mesh; null for `rope`
-  Eigen::Matrix2Xd contact_points;        ///< reference coordinates of the constraint rows (2 × n_c)
+  Eigen::MatrixXd contact_points;         ///< reference coordinates of the constraint rows (dim × n_c)
   Eigen::VectorXd contact_weights;        ///< tributary lengths of the constraint rows
   Eigen::MatrixXd lifting_terms;          ///< n_dofs × n_terms: the lifting basis L_k
   std::string mesh_fingerprint;  ///< Problem::fingerprint() of the discretisation

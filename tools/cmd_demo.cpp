@@ -45,7 +45,7 @@ struct DemoArgs {
 /// Contact half-width: midway between the outermost active node and the next
 /// node, averaged over both sides of the symmetric contact.
 double half_width(const fom::Problem& problem, const Eigen::VectorXd& lambda) {
-  const Eigen::Matrix2Xd& x = problem.contact().constraint_points();
+  const Eigen::MatrixXd& x = problem.contact().constraint_points();
   double half = 0.0;
   for (int side : {-1, 1}) {
     double last_active = 0.0, first_free = 1e300;

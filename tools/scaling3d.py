@@ -1,0 +1,62 @@
+#!/usr/bin/python3
+"""FOM setup time, query time and peak memory of 3D problems against their size
+(the 3D scale table of docs/results.md).
+
+Each case is hertz3d's geometry (meshes/hertz3d.geo) with the mesh constants
+overridden before it is included (element size hmin at the contact point, growth
+alpha, contact cap and disk radii rc and rm), solved once at d = 0.02 by
+`contactrom fom` under /usr/bin/time -v:
+
+    /usr/bin/python3 tools/scaling3d.py --exe build/tools/contactrom
+
+Columns: dofs, contact rows (slave nodes), surface dofs (slave and master nodes,
+three each: the size of the condensed contact problem), setup (factorisation and
+condensation, s), query (s), peak resident memory (GiB) of the whole process.
+"""
+import argparse
+import json
+import os
+import re
+import subprocess
+import tempfile
+
+CASES = [  # hmin, alpha, rc, rm, refine
+    (0.03, 0.15, 0.2, 0.25, 0),
+    (0.02, 0.03, 0.2, 0.25, 0),
+    (0.03, 0.015, 0.2, 0.25, 0),
+    (0.035, 0.008, 0.2, 0.25, 0),
+    (0.015, 0.08, 0.3, 0.4, 0),
+    (0.015, 0.08, 0.3, 0.4, 1),
+]
+
+parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+parser.add_argument("--exe", default="build/tools/contactrom")
+parser.add_argument("--cases", type=int, nargs="+", default=list(range(len(CASES))))
+args = parser.parse_args()
+root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+shipped = open(os.path.join(root, "problems", "hertz3d.toml")).read()
+
+print("| hmin | alpha | rc | refine | dofs | contact rows | surface dofs | setup (s) | query (s) | peak memory (GiB) |")
+print("|---|---|---|---|---|---|---|---|---|---|")
+with tempfile.TemporaryDirectory() as tmp:
+    for i in args.cases:
+        hmin, alpha, rc, rm, refine = CASES[i]
+        geo = os.path.join(tmp, f"case{i}.geo")
+        with open(geo, "w") as f:
+            f.write(f"hmin = {hmin}; alpha = {alpha}; rc = {rc}; rm = {rm};\n"
+                    f'Include "{os.path.join(root, "meshes", "hertz3d.geo")}";\n')
+        toml = os.path.join(tmp, f"case{i}.toml")
+        with open(toml, "w") as f:
+            f.write(shipped.replace('"../meshes/hertz3d.geo"', f'"{geo}"').replace('name = "hertz3d"', f'name = "case{i}"'))
+        proc = subprocess.run(["/usr/bin/time", "-v", args.exe, "fom", "--problem", toml, "--param", "0.02",
+                               "--refine", str(refine), "--json"], capture_output=True, text=True)
+        j = json.loads(proc.stdout)
+        rss_kib = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", proc.stderr).group(1))
+        py = subprocess.run(["/usr/bin/python3", "-c",
+                             "import contactrom,sys; p = contactrom.Problem.from_file(sys.argv[1], refine=int(sys.argv[2]));"
+                             " print(len(p.surface_dofs))", toml, str(refine)],
+                            capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=os.path.join(root, "build", "python")))
+        surface = py.stdout.strip() or "?"
+        print(f"| {hmin} | {alpha} | {rc} | {refine} | {j['dofs']} | {j['constraints']} | {surface} | "
+              f"{j['setup_time_s']:.1f} | {j['time_s']:.3f} | {rss_kib / 2**20:.2f} |", flush=True)
+        assert j["status"] == "success", j
