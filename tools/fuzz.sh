@@ -32,7 +32,7 @@ triage() {
   report=$(timeout 300 "$1" "$2" -timeout=30 -rss_limit_mb=4096 2>&1)
   frames=$(printf '%s\n' "$report" | grep -E '^ +#[0-9]+ ')
   [ -z "$frames" ] && { echo "not reproduced"; return; }
-  first=$(printf '%s\n' "$frames" | grep -vE ' in (__interceptor_|__asan|__sanitizer|__ubsan|__lsan|malloc|calloc|realloc|free|memcpy|memmove|memset|strlen|operator new|operator delete|fuzzer::)|libc\.so|sysdeps/|libFuzzer|StaticAlarmHandler' | head -1)
+  first=$(printf '%s\n' "$frames" | grep -vE 'libstdc\+\+| in (__interceptor_|__asan|__sanitizer|__ubsan|__lsan|malloc|calloc|realloc|free|memcpy|memmove|memset|strlen|operator new|operator delete|fuzzer::)|libc\.so|sysdeps/|libFuzzer|StaticAlarmHandler' | head -1)
   case "$first" in *libhdf5*) echo libhdf5 ;; *libgmsh* | *libOCC* | *libTK*) echo libgmsh ;; *) echo contactrom ;; esac
 }
 
