@@ -1,6 +1,11 @@
 #include "rom/snapshot_database.hpp"
 
+#include <fcntl.h>
 #include <hdf5.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <algorithm>
 #include <cmath>
@@ -200,6 +205,7 @@ struct DatabaseWriter::Impl {
   std::string path, label;
   int num_dofs = 0, num_snapshots = 0;
   std::mutex mutex;
+  bool failed = false;
   std::unique_ptr<Handle> file, dcpl, primal;
 };
 
@@ -209,6 +215,18 @@ DatabaseWriter::DatabaseWriter(std::string path, int num_dofs, int num_snapshots
   m_impl->label = label.empty() ? m_impl->path : std::move(label);
   m_impl->num_dofs = num_dofs;
   m_impl->num_snapshots = num_snapshots;
+  // The space of the snapshots is reserved first: a disk that cannot hold them is
+  // refused here, before libhdf5 (which may crash closing a file it failed to write).
+  {
+    const int fd = ::open(m_impl->path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const off_t bytes = static_cast<off_t>(num_dofs) * num_snapshots * static_cast<off_t>(sizeof(double)) + (off_t{1} << 20);
+    const int err = fd < 0 ? errno : ::posix_fallocate(fd, 0, bytes);
+    if (fd >= 0) ::close(fd);
+    if (err != 0) {
+      std::remove(m_impl->path.c_str());
+      throw InputError("cannot write database '" + m_impl->label + "': " + std::strerror(err));
+    }
+  }
   hdf5::silence();
   try {
     Handle fcpl(H5Pcreate(H5P_FILE_CREATE), H5Pclose, "file creation properties");
@@ -236,12 +254,23 @@ DatabaseWriter::DatabaseWriter(std::string path, int num_dofs, int num_snapshots
   }
 }
 
-DatabaseWriter::~DatabaseWriter() = default;
+DatabaseWriter::~DatabaseWriter() {
+  // After a failed write (disk full) libhdf5 may crash flushing the file on close:
+  // the identifiers are left open (the process reports the error and the caller
+  // removes the file).
+  if (m_impl && m_impl->failed) {
+    (void)m_impl->primal.release();
+    (void)m_impl->dcpl.release();
+    (void)m_impl->file.release();
+  }
+}
 
 void DatabaseWriter::write_primal(int j, const Eigen::VectorXd& u) {
   std::lock_guard<std::mutex> lock(m_impl->mutex);
   if (!m_impl->primal || j < 0 || j >= m_impl->num_snapshots || u.size() != m_impl->num_dofs)
     throw std::invalid_argument("DatabaseWriter::write_primal: snapshot index or size out of range");
+  if (m_impl->failed) throw InputError("cannot write database '" + m_impl->label + "': an earlier write failed (disk full?)");
+  hdf5::silence();  // per thread in a thread-safe libhdf5: the workers write
   try {
     Handle space(H5Dget_space(m_impl->primal->id()), H5Sclose, "dataset /primal");
     const hsize_t start[2] = {static_cast<hsize_t>(j), 0}, count[2] = {1, static_cast<hsize_t>(u.size())};
@@ -251,6 +280,7 @@ void DatabaseWriter::write_primal(int j, const Eigen::VectorXd& u) {
       hdf5::check(H5Dwrite(m_impl->primal->id(), H5T_NATIVE_DOUBLE, memory.id(), space.id(), H5P_DEFAULT, u.data()),
                   "dataset /primal");
   } catch (const Hdf5Failure& e) {
+    m_impl->failed = true;
     throw InputError("cannot write database '" + m_impl->label + "': HDF5 failed on " + e.what() + " (disk full?)");
   }
 }
@@ -265,6 +295,7 @@ void DatabaseWriter::finish(const SnapshotDatabase& db) {
     m_impl->primal.reset();
     m_impl->file->close("file close");
   } catch (const Hdf5Failure& e) {
+    m_impl->failed = true;
     throw InputError("cannot write database '" + m_impl->label + "': HDF5 failed on " + e.what() + " (disk full?)");
   }
 }
