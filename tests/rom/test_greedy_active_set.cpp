@@ -389,7 +389,7 @@ BOOST_AUTO_TEST_CASE(a_query_the_dictionary_cannot_represent_is_inaccurate) {
   for (int i = 0; i <= 4; ++i) train.push_back(Eigen::VectorXd::Constant(1, 0.125 * i));
   rom::OfflineOptions offline;
   offline.threads = 2;
-  const rom::SnapshotDatabase db = rom::generate_snapshots(*ironing.problem, train, offline);
+  const rom::SnapshotDatabase db = rom::generate_snapshots(*ironing.problem, train, "train", static_cast<int>(train.size()), offline);
   const rom::ReducedModel model(*ironing.problem, db);
   for (const auto& [schedule, greedy_options] : schedules()) {
     BOOST_TEST_CONTEXT(schedule) {
