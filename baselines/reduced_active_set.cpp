@@ -1,5 +1,7 @@
 #include "baselines/reduced_active_set.hpp"
 
+#include "core/format.hpp"
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
@@ -26,7 +28,7 @@ ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOption
     else if (it->second == "cell")
       o.init = rom::WarmStart::Cell;
     else
-      throw InputError("option init = '" + it->second + "' unknown; expected empty, primal or cell");
+      throw InputError("option init = " + quoted(it->second, 200) + " unknown; expected empty, primal or cell");
   }
   o.tau = g.tau;
   o.tau_scaling = g.tau_scaling;
@@ -40,7 +42,7 @@ ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOption
     else if (it->second == "equality")
       o.inner_solve = InnerSolve::Equality;
     else
-      throw InputError("option inner_solve = '" + it->second + "' unknown; expected nonnegative or equality");
+      throw InputError("option inner_solve = " + quoted(it->second, 200) + " unknown; expected nonnegative or equality");
   }
   return o;
 }

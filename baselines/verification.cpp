@@ -10,6 +10,7 @@
 #include "baselines/cpg.hpp"
 #include "baselines/ipopt_qp.hpp"
 #include "baselines/reduced_active_set.hpp"
+#include "core/format.hpp"
 #include "core/atomic_file.hpp"
 #include "fom/parameter_space.hpp"
 #include "rom/greedy_active_set.hpp"
@@ -112,7 +113,7 @@ MethodVerification verify_method(const rom::OnlineSolver& solver, const rom::Onl
 /// twice and settings a method refuses.
 std::vector<std::unique_ptr<rom::OnlineSolver>> build_solvers(const rom::ReducedModel& model, const VerifyOptions& o) {
   if (o.reference != "ipopt" && o.reference != "fom")
-    throw InputError("reference solver '" + o.reference + "' unknown; expected ipopt or fom");
+    throw InputError("reference solver " + quoted(o.reference, 200) + " unknown; expected ipopt or fom");
   if (o.methods.empty()) throw InputError("verify: no online method given; expected at least one");
   std::vector<std::unique_ptr<rom::OnlineSolver>> solvers;
   for (size_t s = 0; s < o.methods.size(); ++s) {

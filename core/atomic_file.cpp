@@ -1,10 +1,13 @@
 #include "core/atomic_file.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -29,11 +32,73 @@ std::string base_of(const std::string& path) {
 
 std::string cannot_write(const std::string& path) { return "cannot write " + quoted(path, 200) + ": "; }
 
-void remove_all(const std::vector<std::string>& tmps) {
-  for (const std::string& t : tmps) std::remove(t.c_str());
+// --- temporaries removed on signals ------------------------------------------
+//
+// A fixed table of paths, so that the signal handler only reads memory that is
+// never freed and calls unlink() (async-signal-safe). A slot is claimed (0 → 2),
+// filled, then published (→ 1); the handler removes the published ones.
+constexpr int kSlots = 64;
+constexpr size_t kPathBytes = 4096;
+struct Slot {
+  std::atomic<int> state{0};
+  char path[kPathBytes];
+};
+Slot g_slots[kSlots];
+
+void register_temporary(const std::string& tmp) {
+  if (tmp.size() >= kPathBytes) return;
+  for (Slot& s : g_slots) {
+    int expected = 0;
+    if (!s.state.compare_exchange_strong(expected, 2)) continue;
+    std::memcpy(s.path, tmp.c_str(), tmp.size() + 1);
+    s.state.store(1);
+    return;
+  }
 }
 
+void unregister_temporary(const std::string& tmp) {
+  for (Slot& s : g_slots)
+    if (s.state.load() == 1 && tmp == s.path) {
+      s.state.store(0);
+      return;
+    }
+}
+
+extern "C" void remove_temporaries_and_end(int sig) {
+  for (Slot& s : g_slots)
+    if (s.state.load() == 1) ::unlink(s.path);
+  std::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+void remove_all(const std::vector<std::string>& tmps) {
+  for (const std::string& t : tmps) discard_temporary(t);
+}
+
+/// Blocks SIGINT, SIGTERM and SIGHUP while alive (the renames that publish a set
+/// of files complete before a signal is handled).
+class SignalsHeld {
+ public:
+  SignalsHeld() {
+    sigset_t set;
+    sigemptyset(&set);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set, sig);
+    pthread_sigmask(SIG_BLOCK, &set, &m_old);
+  }
+  ~SignalsHeld() { pthread_sigmask(SIG_SETMASK, &m_old, nullptr); }
+
+ private:
+  sigset_t m_old;
+};
+
 }  // namespace
+
+void remove_temporaries_on_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = remove_temporaries_and_end;
+  sigemptyset(&sa.sa_mask);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
+}
 
 void check_output_path(const std::string& path) {
   if (path.empty()) throw InputError("output file name is empty; expected a file name");
@@ -54,6 +119,52 @@ void check_output_path(const std::string& path) {
   if (::stat(folder.c_str(), &dir) != 0)
     throw InputError(cannot_write(path) + "folder " + quoted(folder, 200) + ": " + std::strerror(errno));
   if (!S_ISDIR(dir.st_mode)) throw InputError(cannot_write(path) + quoted(folder, 200) + " is not a folder");
+  // A read-only or permission-less folder is found now, not after the work.
+  const std::string probe = temporary_path_for(path);
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    const int err = errno;
+    unregister_temporary(probe);
+    throw InputError(cannot_write(path) + "cannot create a file in folder " + quoted(folder, 200) + ": " +
+                     std::strerror(err));
+  }
+  ::close(fd);
+  discard_temporary(probe);
+}
+
+void check_output_not_input(const std::string& output, const std::vector<std::string>& inputs) {
+  struct stat out {};
+  if (::stat(output.c_str(), &out) != 0) return;
+  for (const std::string& input : inputs) {
+    struct stat in {};
+    if (::stat(input.c_str(), &in) == 0 && in.st_dev == out.st_dev && in.st_ino == out.st_ino)
+      throw InputError(cannot_write(output) + "it is the input file " + quoted(input, 200) +
+                       ", which would be replaced; expected another output file");
+  }
+}
+
+FileLock::FileLock(const std::string& path, const std::function<void()>& on_wait) {
+  bool told = false;
+  for (;;) {
+    m_fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (m_fd < 0) throw InputError("cannot open " + quoted(path, 200) + " to lock it: " + std::strerror(errno));
+    if (::flock(m_fd, LOCK_EX | LOCK_NB) != 0) {
+      if (!told && on_wait) on_wait();
+      told = true;
+      while (::flock(m_fd, LOCK_EX) != 0 && errno == EINTR) {
+      }
+    }
+    // The holder before us may have replaced the file (rename): lock the new one.
+    struct stat locked {}, named {};
+    if (::fstat(m_fd, &locked) == 0 && ::stat(path.c_str(), &named) == 0 && locked.st_dev == named.st_dev &&
+        locked.st_ino == named.st_ino)
+      return;
+    ::close(m_fd);
+  }
+}
+
+FileLock::~FileLock() {
+  if (m_fd >= 0) ::close(m_fd);  // releases the lock
 }
 
 std::string temporary_path_for(const std::string& path) {
@@ -61,22 +172,30 @@ std::string temporary_path_for(const std::string& path) {
   // A hidden name built from at most 40 bytes of the target's name: a target
   // near the file-name limit still gets a valid temporary name.
   const std::string folder = folder_of(path);
-  return (folder == "/" ? "" : folder) + "/." + base_of(path).substr(0, 40) + ".tmp." + std::to_string(::getpid()) +
-         "." + std::to_string(counter++);
+  const std::string tmp = (folder == "/" ? "" : folder) + "/." + base_of(path).substr(0, 40) + ".tmp." +
+                          std::to_string(::getpid()) + "." + std::to_string(counter++);
+  register_temporary(tmp);
+  return tmp;
+}
+
+void discard_temporary(const std::string& tmp) {
+  std::remove(tmp.c_str());
+  unregister_temporary(tmp);
 }
 
 void commit_temporary(const std::string& tmp, const std::string& path) {
   try {
     check_output_path(path);
   } catch (...) {
-    std::remove(tmp.c_str());
+    discard_temporary(tmp);
     throw;
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     const int err = errno;
-    std::remove(tmp.c_str());
+    discard_temporary(tmp);
     throw InputError(cannot_write(path) + "renaming the completed temporary file failed: " + std::strerror(err));
   }
+  unregister_temporary(tmp);
 }
 
 void write_files_atomically(const std::vector<std::pair<std::string, FileWriter>>& files) {
@@ -84,13 +203,13 @@ void write_files_atomically(const std::vector<std::pair<std::string, FileWriter>
   std::vector<std::string> tmps;
   for (const auto& [path, writer] : files) {
     const std::string tmp = temporary_path_for(path);
+    tmps.push_back(tmp);
     std::ofstream out(tmp, std::ios::binary);
     if (!out) {
       const int err = errno;
       remove_all(tmps);
       throw InputError(cannot_write(path) + std::strerror(err));
     }
-    tmps.push_back(tmp);
     try {
       writer(out);
     } catch (...) {
@@ -103,10 +222,13 @@ void write_files_atomically(const std::vector<std::pair<std::string, FileWriter>
     if (!out) {
       const int err = errno;
       remove_all(tmps);
-      throw InputError(cannot_write(path) + "write failed" + (err ? std::string(": ") + std::strerror(err) : "") +
-                       " (disk full?)");
+      throw WriteFailure(cannot_write(path) + "write failed" + (err ? std::string(": ") + std::strerror(err) : "") +
+                         " (disk full?)");
     }
   }
+  // Every file is complete: publish them all, with the signals held so that an
+  // interrupt cannot leave part of the set published.
+  SignalsHeld held;
   for (size_t i = 0; i < files.size(); ++i) {
     try {
       commit_temporary(tmps[i], files[i].first);

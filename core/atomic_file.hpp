@@ -9,8 +9,17 @@
 /// Output targets are checked first: an existing target must be a regular file.
 /// A symbolic link, a folder, a device, a pipe or a socket given as output is
 /// refused (replacing it would destroy the link or the device node, not write
-/// into it), as is an empty name or a folder that does not exist.
+/// into it), as is an empty name, a folder that does not exist or one in which no
+/// file can be created. A target that is one of the command's input files (same
+/// device and inode, whatever the names) is refused as well.
+///
+/// Failures of the machine while writing (disk full, I/O error) throw WriteFailure,
+/// not InputError: the CLI reports them with exit code 1. The temporary files being
+/// written are removed when the process is ended by SIGINT, SIGTERM or SIGHUP
+/// (remove_temporaries_on_signals()), and a set of files is published only after
+/// all of it was written.
 #include <functional>
+#include <stdexcept>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -18,14 +27,53 @@
 
 namespace contactrom {
 
+/// \brief The machine could not write a complete output file (disk full, I/O
+/// error): not bad input. The temporary file is removed before it is thrown.
+class WriteFailure : public std::runtime_error {
+ public:
+  explicit WriteFailure(const std::string& message) : std::runtime_error(message) {}
+};
+
 /// \brief Writes the content of one file to a stream.
 using FileWriter = std::function<void(std::ostream&)>;
 
 /// \brief Throws InputError (one line, naming `path` and why) unless `path` can
-/// be written as an output file: non-empty, its folder exists, and it is either
+/// be written as an output file: non-empty, its folder exists and a file can be
+/// created in it (a temporary file is created and removed), and it is either
 /// absent or a regular file (not a symbolic link, folder, device, pipe or socket).
 /// Commands call it before any long computation.
 void check_output_path(const std::string& path);
+
+/// \brief Throws InputError if `output` is the same file as one of `inputs`
+/// (same device and inode: another name, a hard link or a relative path of the
+/// file count as the same); absent files are never the same.
+void check_output_not_input(const std::string& output, const std::vector<std::string>& inputs);
+
+/// \brief Installs handlers of SIGINT, SIGTERM and SIGHUP that remove the
+/// temporary files being written (write_file_atomically(), temporary_path_for())
+/// and then end the process by the same signal (its default action). Called by the
+/// command-line tool; a program embedding the library may call it (it replaces
+/// the program's handlers of those signals).
+void remove_temporaries_on_signals();
+
+/// \brief An exclusive lock on an existing file that is updated by read, modify
+/// and rename (`offline --append`): held from construction to destruction, so a
+/// second updater waits until the first has published its file, then reads that.
+/// The lock is taken on the file the path names *after* any rename by the holder
+/// before it (the path is opened again until the locked file is still the one the
+/// path names).
+class FileLock {
+ public:
+  /// \param on_wait called once if another process holds the lock (before waiting)
+  /// \throws InputError naming `path` if it cannot be opened.
+  explicit FileLock(const std::string& path, const std::function<void()>& on_wait = {});
+  ~FileLock();
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+
+ private:
+  int m_fd = -1;
+};
 
 /// \brief Calls `writer` on a stream to a temporary file next to `path`, then
 /// renames it to `path`. Throws InputError naming `path` and the system's reason
@@ -41,10 +89,15 @@ void write_files_atomically(const std::vector<std::pair<std::string, FileWriter>
 /// \brief Returns a unique temporary path next to `path` (same folder, so that
 /// rename() is atomic; a short hidden name, so that a long `path` does not
 /// exceed the file-name limit); for libraries such as HDF5 that write by name.
+/// The path is registered for removal on signals until commit_temporary() or
+/// discard_temporary().
 std::string temporary_path_for(const std::string& path);
 
 /// \brief Renames `tmp` to `path` after check_output_path(path); removes `tmp`
 /// and throws InputError naming `path` and the system's reason on failure.
 void commit_temporary(const std::string& tmp, const std::string& path);
+
+/// \brief Removes `tmp` (from the disk and from the files removed on signals).
+void discard_temporary(const std::string& tmp);
 
 }  // namespace contactrom

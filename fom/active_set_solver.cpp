@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "core/errors.hpp"
+#include "core/format.hpp"
 #include "core/stopwatch.hpp"
 #include "fom/pairing_fixed_point.hpp"
 #include "fom/rigid_bodies.hpp"
@@ -183,6 +184,7 @@ bool condense(const Problem& problem, const Param& mu, Condensation& out, const 
 }
 
 Eigen::MatrixXd unconstrained_load_responses(const Problem& problem, const Param& mu) {
+  check_rigid_motions_held(problem);
   Condensation cond;
   if (!condense(problem, mu, cond)) throw InputError(singular_stiffness_message(problem));
   return std::move(cond.z_load);
@@ -200,6 +202,9 @@ Eigen::VectorXd Condensation::surface_response(const Eigen::VectorXd& surface_fo
 
 ActiveSetSolver::ActiveSetSolver(const Problem& problem, ActiveSetOptions options)
     : m_problem(problem), m_options(options) {
+  // Before any factorisation: a rigid motion left free has no unique answer, and
+  // in floating point the factorisation may well succeed on it.
+  check_rigid_motions_held(problem);
   const auto t0 = std::chrono::steady_clock::now();
   if (!problem.stiffness_is_constant()) {
     // K(μ) changes with μ, its sparsity pattern does not: order the dofs once, here,
@@ -277,8 +282,25 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
     sol.message = "dual active-set QP failed: " + std::string(to_string(fp.solution.status));
   else if (fp.status != Status::Success)
     sol.message = pairing_no_convergence_message(fp, pairing_options());
+  certify_fom_solution(m_problem, sol, m_options.kkt_tolerance);
   sol.time_s = seconds_since(t0);
   return sol;
+}
+
+void certify_fom_solution(const Problem& problem, FomSolution& sol, double tolerance, bool complementarity) {
+  if (sol.u.size() != problem.num_dofs() || sol.lambda.size() != problem.contact().num_constraints()) return;
+  sol.kkt = kkt_residuals(problem, sol.mu, sol.u, sol.lambda);
+  const KktResiduals& k = sol.kkt;
+  const std::pair<const char*, double> checked[] = {{"stationarity", k.stationarity},
+                                                    {"penetration", k.penetration},
+                                                    {"negative-pressure", k.negative_pressure},
+                                                    {"complementarity", complementarity ? k.complementarity : 0.0}};
+  for (const auto& [name, value] : checked) {
+    if (value <= tolerance || sol.status != Status::Success) continue;  // NaN fails the test
+    sol.status = Status::NoConvergence;
+    sol.message = std::string("the solver converged, but the ") + name + " residual of its solution at the pairing" +
+                  " recomputed from it is " + format_number(value) + " > tolerance " + format_number(tolerance);
+  }
 }
 
 PairingFixedPointOptions ActiveSetSolver::pairing_options() const {

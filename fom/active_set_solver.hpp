@@ -29,6 +29,7 @@
 
 #include "fom/contact_model.hpp"
 #include "fom/dual_qp.hpp"
+#include "fom/kkt.hpp"
 #include "fom/pairing_fixed_point.hpp"
 #include "fom/problem.hpp"
 #include "fom/sparse_cholesky.hpp"
@@ -47,7 +48,24 @@ struct FomSolution {
   int active = 0;              ///< number of rows with λ > 0
   double time_s = 0.0;         ///< wall time of the query (factorisation reused)
   std::string message;         ///< reason when status != Success
+  /// KKT residuals of (u, λ) (fom::kkt_residuals(), pairing recomputed from u), as
+  /// certify_fom_solution() left them; all zero if no solution was computed.
+  KktResiduals kkt;
 };
+
+/// rief Largest relative KKT residual (fom/kkt.hpp) of a FOM solution reported as
+/// success: stationarity, penetration, negative pressure and (active-set solver)
+/// complementarity. Converged solves stay below 1e-10.
+constexpr double kFomKktTolerance = 1e-6;
+
+/// rief The FOM's promise on its status: computes `sol.kkt` with
+/// fom::kkt_residuals(), which re-pairs at `sol.u` as a user checking the answer
+/// would, and turns a Success whose stationarity, penetration or negative-pressure
+/// residual (and complementarity, when `complementarity`) is above `tolerance` or not
+/// a number into NoConvergence, with a message naming the residual. A solution
+/// without fields (failed solve) is left as it is.
+void certify_fom_solution(const Problem& problem, FomSolution& sol, double tolerance = kFomKktTolerance,
+                          bool complementarity = true);
 
 /// \brief Options of ActiveSetSolver (documented defaults).
 struct ActiveSetOptions {
@@ -63,6 +81,9 @@ struct ActiveSetOptions {
   /// rows. Default 0.05.
   double working_set_margin = 0.05;
   int anderson_depth = 10;          ///< Anderson acceleration depth of the pairing fixed point (0: plain), default 10
+  /// Largest relative KKT residual of a solution reported as success
+  /// (certify_fom_solution()); default kFomKktTolerance = 1e-6.
+  double kkt_tolerance = kFomKktTolerance;
   DualQpOptions qp;                 ///< options of the dual QP solve
 };
 

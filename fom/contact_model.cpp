@@ -9,6 +9,13 @@
 #include "core/errors.hpp"
 
 namespace contactrom::fom {
+namespace {
+/// Extension of a master chain beyond its end nodes, as a fraction of the end
+/// segment's length, within which a slave node still pairs with the chain's end
+/// (docs/theory.md, "Contact pairing"); as the extension zone of common
+/// node-to-surface codes, 10 %.
+constexpr double kChainEndExtension = 0.1;
+}  // namespace
 
 bool Pairing::same_as(const Pairing& other, double tol) const {
   if (segment.size() != other.segment.size() || eta.size() != other.eta.size()) return false;
@@ -222,8 +229,15 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
   int lowest = nseg, highest = -1;
   // Stores row k's closest segment in the pairing.
   auto pair_row = [&](int k, const Best& best) {
-    // A projection beyond either end of the master chain is no contact pair.
-    if (best.seg < 0 || (best.seg == 0 && best.raw < 0.0) || (best.seg == nm - 2 && best.raw > 1.0)) return;
+    // A projection beyond either end of the master chain is no contact pair, except
+    // within kChainEndExtension of the end segment's length: there the slave node is
+    // paired with the chain's end (ξ clamped, the end segment's normal), i.e. with
+    // the end segment extended. Flush ends (two blocks of equal width, a corner
+    // shared by both surfaces) put slave corner nodes exactly at a master end, where
+    // round-off alone would otherwise switch the pair on and off between iterations.
+    if (best.seg < 0 || (best.seg == 0 && best.raw < -kChainEndExtension) ||
+        (best.seg == nm - 2 && best.raw > 1.0 + kChainEndExtension))
+      return;
     p.segment[k] = best.seg;
     p.xi[k] = best.xi;
     lowest = std::min(lowest, best.seg);

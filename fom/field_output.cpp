@@ -142,6 +142,11 @@ void write_surface_csv(const std::string& path, const Problem& problem, const Ei
 void write_fields(const std::string& dir, const std::string& stem, const Problem& problem, const Param& mu,
                   const Eigen::VectorXd& u,
                   const Eigen::VectorXd& lambda) {
+  write_field_sets(dir, problem, {{stem, mu, &u, &lambda}});
+}
+
+void write_field_sets(const std::string& dir, const Problem& problem, const std::vector<FieldSet>& sets,
+                      const std::vector<std::pair<std::string, FileWriter>>& extra) {
   namespace fs = std::filesystem;
   if (dir.empty()) throw InputError("output folder name is empty; expected a folder");
   std::error_code ec;
@@ -155,10 +160,14 @@ void write_fields(const std::string& dir, const std::string& stem, const Problem
     if (ec) throw InputError("cannot create output folder " + quoted(dir, 200) + ": " + ec.message());
     created = true;
   }
-  const std::string base = dir + "/" + stem;
+  std::vector<std::pair<std::string, FileWriter>> files = extra;
+  for (const FieldSet& set : sets) {
+    const std::string base = dir + "/" + set.stem;
+    files.emplace_back(base + ".vtu", vtu_writer(problem, set.mu, *set.u, *set.lambda));
+    files.emplace_back(base + "_surface.csv", surface_csv_writer(problem, *set.u, *set.lambda));
+  }
   try {
-    write_files_atomically({{base + ".vtu", vtu_writer(problem, mu, u, lambda)},
-                            {base + "_surface.csv", surface_csv_writer(problem, u, lambda)}});
+    write_files_atomically(files);
   } catch (...) {
     if (created) fs::remove(dir, ec);  // only if still empty
     throw;

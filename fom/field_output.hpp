@@ -6,7 +6,10 @@
 /// u_x, u_y, u_z). Files are written atomically.
 #include <Eigen/Dense>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "core/atomic_file.hpp"
 #include "fom/problem.hpp"
 
 namespace contactrom::fom {
@@ -34,6 +37,21 @@ void write_surface_csv(const std::string& path, const Problem& problem, const Ei
 void write_fields(const std::string& dir, const std::string& stem, const Problem& problem, const Param& mu,
                   const Eigen::VectorXd& u,
                   const Eigen::VectorXd& lambda);
+
+/// \brief One solution to write as fields: `stem`.vtu and `stem`_surface.csv.
+struct FieldSet {
+  std::string stem;
+  Param mu;
+  const Eigen::VectorXd* u = nullptr;       ///< full displacement (must outlive the call)
+  const Eigen::VectorXd* lambda = nullptr;  ///< pressure per constraint row
+};
+
+/// \brief Writes the fields of every set in `dir`, and the `extra` files (path,
+/// writer), as one set: all complete before any is published; a failure leaves
+/// none of them (nor `dir`, if this call created it).
+/// \throws InputError naming the folder or file and the reason (WriteFailure on a full disk).
+void write_field_sets(const std::string& dir, const Problem& problem, const std::vector<FieldSet>& sets,
+                      const std::vector<std::pair<std::string, FileWriter>>& extra = {});
 
 /// \brief Creates `dir` (and parents) if needed; throws InputError naming it on failure.
 void ensure_directory(const std::string& dir);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "core/format.hpp"
 #include "core/errors.hpp"
 
 namespace contactrom {
@@ -125,7 +126,7 @@ fom::Param parse_problem_param(const fom::Problem& problem, const std::string& t
     throw InputError(std::string(e.what()) + " (" + problem.range_text() + ")");
   }
   if (static_cast<int>(items.size()) != problem.num_params())
-    throw InputError("problem '" + problem.name() + "' takes " + std::to_string(problem.num_params()) +
+    throw InputError("problem " + quoted(problem.name(), 200) + " takes " + std::to_string(problem.num_params()) +
                      " parameter value(s), but --param " + quoted(text) + " has " + std::to_string(items.size()) +
                      expected);
   fom::Param mu(problem.num_params());
@@ -139,7 +140,7 @@ fom::Param parse_problem_param(const fom::Problem& problem, const std::string& t
     }
     const Interval range{problem.param_lower()(i), problem.param_upper()(i), problem.parameters().lower_open[i] != 0, false};
     if (!range.contains(value))
-      throw InputError(what + " " + quoted(trim_blanks(items[i])) + " is outside the range of '" + problem.name() + "'" +
+      throw InputError(what + " " + quoted(trim_blanks(items[i])) + " is outside the range of " + quoted(problem.name(), 200) + "" +
                        expected);
     mu(i) = value;
   }

@@ -60,9 +60,14 @@ KktResiduals kkt_residuals(const Problem& problem, const Param& mu, const Eigen:
 
   KktResiduals k;
   const double scale = problem.displacement_scale();
-  // stableNorm: squares of entries below 1e-154 would underflow to zero.
-  const double terms = std::max({f_free.stableNorm(), ku_free.stableNorm(), ct_free.stableNorm()});
-  k.stationarity = terms > 0.0 ? r_free.stableNorm() / terms : 0.0;
+  // stableNorm: squares of entries below 1e-154 would underflow to zero. The
+  // denominator has a floor: below DBL_MIN/ε per entry (about 1e-292) the terms
+  // are subnormal and carry fewer than 53 bits, so a residual there measures the
+  // representation of the numbers, not the solution (a load d = 5e-324 has one bit).
+  const double resolvable = std::sqrt(static_cast<double>(n_free)) * std::numeric_limits<double>::min() /
+                       std::numeric_limits<double>::epsilon();
+  const double terms = std::max({f_free.stableNorm(), ku_free.stableNorm(), ct_free.stableNorm(), resolvable});
+  k.stationarity = r_free.stableNorm() / terms;
   k.penetration = std::max(0.0, cv.cwiseQuotient(contact.weights()).maxCoeff()) / scale;
   const double lmax = lambda.size() ? lambda.cwiseAbs().maxCoeff() : 0.0;
   k.negative_pressure = lmax > 0.0 ? std::max(0.0, -lambda.minCoeff()) / lmax : 0.0;

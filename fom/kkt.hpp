@@ -6,7 +6,9 @@
 /// deformed configuration and C(u), g(u) assembled. Residuals, all relative:
 ///  - stationarity: \f$ \|K u_0 - f + C^T\lambda\|_2 / \max(\|K u_0\|_2, \|f\|_2, \|C^T\lambda\|_2) \f$
 ///    on free dofs (\f$u_0\f$: u minus the lifting; a normwise backward error, at most 3,
-///    and meaningful also when the load vanishes),
+///    and meaningful also when the load vanishes; the denominator is at least
+///    \f$ \sqrt{n}\,\mathrm{DBL\_MIN}/\varepsilon \approx 10^{-292}\sqrt{n} \f$, below which
+///    numbers are subnormal and a residual measures their lost bits, not the solution),
 ///  - penetration: \f$ \max_s (C u - g)_s^+ / (w_s\, U) \f$ (gap per node in units
 ///    of the problem's displacement scale U),
 ///  - negative pressure: \f$ \max_s (-\lambda_s)^+ / \|\lambda\|_\infty \f$,

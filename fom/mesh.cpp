@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <gmsh.h>
 #include <poll.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -26,7 +27,9 @@
 #include <unordered_map>
 #include <utility>
 
+#include "core/format.hpp"
 #include "core/errors.hpp"
+#include "core/input_file.hpp"
 
 #ifndef CONTACTROM_DEFAULT_MESH_DIR
 #define CONTACTROM_DEFAULT_MESH_DIR "meshes"
@@ -121,7 +124,7 @@ std::string element_kind(int type) {
   } catch (...) {
     return "elements of gmsh type " + std::to_string(type);
   }
-  return "'" + name + "' elements";
+  return quoted(name, 200) + " elements";
 }
 
 struct PhysicalGroup {
@@ -190,23 +193,23 @@ std::string point_string(const Eigen::MatrixXd& x, int node) {
 void order_chain(const std::string& where, const std::string& name, const Eigen::MatrixXd& x,
                  const std::vector<std::array<int, 4>>& quads, std::vector<std::array<int, 2>> segs,
                  std::vector<std::array<int, 2>>& out_segments, std::vector<int>& out_nodes) {
-  if (segs.empty()) throw InputError(where + ": physical curve '" + name + "' has no line elements");
+  if (segs.empty()) throw InputError(where + ": physical curve " + quoted(name, 200) + " has no line elements");
   std::map<int, std::vector<int>> incident;  // node -> segment indices
   for (int s = 0; s < static_cast<int>(segs.size()); ++s) {
     if (segs[s][0] == segs[s][1])
-      throw InputError(where + ": physical curve '" + name + "' has a zero-length segment at " +
+      throw InputError(where + ": physical curve " + quoted(name, 200) + " has a zero-length segment at " +
                        point_string(x, segs[s][0]));
     for (int n : segs[s]) incident[n].push_back(s);
   }
   std::vector<int> ends;
   for (const auto& [node, list] : incident) {
     if (list.size() > 2)
-      throw InputError(where + ": physical curve '" + name + "' branches at " + point_string(x, node) +
+      throw InputError(where + ": physical curve " + quoted(name, 200) + " branches at " + point_string(x, node) +
                        "; expected a single chain of segments");
     if (list.size() == 1) ends.push_back(node);
   }
   if (!ends.empty() && ends.size() != 2)
-    throw InputError(where + ": physical curve '" + name + "' is not connected (" + std::to_string(ends.size() / 2) +
+    throw InputError(where + ": physical curve " + quoted(name, 200) + " is not connected (" + std::to_string(ends.size() / 2) +
                      " pieces); expected a single chain of segments");
   const bool closed = ends.empty();
 
@@ -244,7 +247,7 @@ void order_chain(const std::string& where, const std::string& name, const Eigen:
     if (orientation != 0) break;
   }
   if (orientation == 0)
-    throw InputError(where + ": physical curve '" + name + "' segment " + point_string(x, a) + "-" +
+    throw InputError(where + ": physical curve " + quoted(name, 200) + " segment " + point_string(x, a) + "-" +
                      point_string(x, b) + " is not an edge of any quad of a physical surface");
   if (orientation < 0) {
     if (closed)
@@ -311,14 +314,14 @@ Mesh read_current_model(const std::string& where) {
       auto [it, inserted] = entity_owner.emplace(e, g.name);
       if (!inserted)
         throw InputError(where + ": surface " + std::to_string(e) + " belongs to physical surfaces '" + it->second +
-                         "' and '" + g.name + "'; each element must belong to one body");
+                         "' and " + quoted(g.name, 200) + "; each element must belong to one body");
     }
     if (std::find(mesh.body_names.begin(), mesh.body_names.end(), g.name) != mesh.body_names.end())
-      throw InputError(where + ": two physical surfaces are named '" + g.name + "'");
+      throw InputError(where + ": two physical surfaces are named " + quoted(g.name, 200));
     auto tags = group_elements(2, g, kGmshQuad4, [&](int type) {
       throw InputError(where + ": surface elements must be 4-node quads, found " + element_kind(type));
     });
-    if (tags.empty()) throw InputError(where + ": physical surface '" + g.name + "' has no elements");
+    if (tags.empty()) throw InputError(where + ": physical surface " + quoted(g.name, 200) + " has no elements");
     mesh.body_names.push_back(g.name);
     body_quads.push_back(std::move(tags));
   }
@@ -345,16 +348,16 @@ Mesh read_current_model(const std::string& where) {
 
   for (const auto& g : curves) {
     if (mesh.segments.count(g.name))
-      throw InputError(where + ": two physical curves are named '" + g.name + "'");
+      throw InputError(where + ": two physical curves are named " + quoted(g.name, 200));
     const auto tags = group_elements(1, g, kGmshLine2, [&](int type) {
-      throw InputError(where + ": curve elements of '" + g.name + "' must be 2-node lines, found " +
+      throw InputError(where + ": curve elements of " + quoted(g.name, 200) + " must be 2-node lines, found " +
                        element_kind(type));
     });
     std::vector<std::array<int, 2>> segs;
     for (std::size_t e = 0; e + 1 < tags.size(); e += 2) {
       auto a = id_of.find(tags[e]), b = id_of.find(tags[e + 1]);
       if (a == id_of.end() || b == id_of.end())
-        throw InputError(where + ": physical curve '" + g.name + "' has nodes that belong to no physical surface");
+        throw InputError(where + ": physical curve " + quoted(g.name, 200) + " has nodes that belong to no physical surface");
       segs.push_back({a->second, b->second});
     }
     order_chain(where, g.name, mesh.nodes, mesh.quads, segs, mesh.segments[g.name], mesh.curve_nodes[g.name]);
@@ -362,7 +365,7 @@ Mesh read_current_model(const std::string& where) {
   // Physical points: a node group without segments (Dirichlet data on a point).
   for (const auto& g : physical_groups(0)) {
     if (mesh.curve_nodes.count(g.name))
-      throw InputError(where + ": the physical point '" + g.name + "' has the name of another group");
+      throw InputError(where + ": the physical point " + quoted(g.name, 200) + " has the name of another group");
     std::vector<int>& nodes = mesh.curve_nodes[g.name];
     mesh.segments[g.name];  // no segments
     for (int entity : g.entities) {
@@ -372,11 +375,11 @@ Mesh read_current_model(const std::string& where) {
       for (std::size_t t : tags) {
         auto it = id_of.find(t);
         if (it == id_of.end())
-          throw InputError(where + ": physical point '" + g.name + "' is not a node of a physical surface");
+          throw InputError(where + ": physical point " + quoted(g.name, 200) + " is not a node of a physical surface");
         nodes.push_back(it->second);
       }
     }
-    if (nodes.empty()) throw InputError(where + ": physical point '" + g.name + "' has no mesh node");
+    if (nodes.empty()) throw InputError(where + ": physical point " + quoted(g.name, 200) + " has no mesh node");
   }
   return mesh;
 }
@@ -611,7 +614,7 @@ const std::vector<int>& Mesh::group_nodes(const std::string& name) const {
   if (it != curve_nodes.end()) return it->second;
   std::string have;
   for (const auto& [n, list] : curve_nodes) have += (have.empty() ? "" : ", ") + n;
-  throw InputError("mesh has no physical group '" + name + "' (has: " + have + ")");
+  throw InputError("mesh has no physical group " + quoted(name, 200) + " (has: " + have + ")");
 }
 
 const std::vector<std::array<int, 2>>& Mesh::group_segments(const std::string& name) const {
@@ -619,7 +622,7 @@ const std::vector<std::array<int, 2>>& Mesh::group_segments(const std::string& n
   if (it != segments.end()) return it->second;
   std::string have;
   for (const auto& [n, list] : segments) have += (have.empty() ? "" : ", ") + n;
-  throw InputError("mesh has no physical group '" + name + "' (has: " + have + ")");
+  throw InputError("mesh has no physical group " + quoted(name, 200) + " (has: " + have + ")");
 }
 
 std::string Mesh::fingerprint() const {
@@ -641,6 +644,13 @@ std::string Mesh::fingerprint() const {
       fnv1a(h, static_cast<std::int32_t>(s[0]));
       fnv1a(h, static_cast<std::int32_t>(s[1]));
     }
+  }
+  // The node chains too: Dirichlet data and contact pairs read them, so a file
+  // whose chain was altered is another discretisation.
+  for (const auto& [name, chain] : curve_nodes) {
+    fnv1a(h, name);
+    fnv1a(h, static_cast<std::int64_t>(chain.size()));
+    for (int n : chain) fnv1a(h, static_cast<std::int32_t>(n));
   }
   if (dim == 3) {  // (2D meshes keep the fingerprint they had before 3D existed)
     fnv1a(h, static_cast<std::int32_t>(dim));
@@ -829,7 +839,7 @@ std::string refined_times(int refine) {
 
 /// Reads, meshes and refines the file with gmsh in this process (the child).
 Mesh mesh_with_gmsh(const std::string& path, const MeshOptions& options) {
-  const std::string where = "mesh '" + path + "'";
+  const std::string where = "mesh " + quoted(path, 200);
   GmshSession session;
   try {
     gmsh::open(path);
@@ -891,7 +901,12 @@ void write_all(int fd, const std::string& bytes) {
 /// The child: gmsh with default signal handling, no core file, stdout to /dev/null,
 /// and an exit handler that turns gmsh's exit() into a recognisable exit code
 /// before any handler inherited from the parent runs. Never returns.
-[[noreturn]] void run_child(int fd, const std::string& path, const MeshOptions& options) {
+[[noreturn]] void run_child(int fd, const std::string& path, const MeshOptions& options, pid_t parent) {
+  // The child ends with its parent, however the parent ends (SIGKILL included): a
+  // looping .geo must not keep a CPU busy after contactrom is gone. The parent may
+  // have died between fork() and prctl(); then getppid() has changed already.
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) ::_exit(1);
   for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
   const struct rlimit no_core = {0, 0};
   ::setrlimit(RLIMIT_CORE, &no_core);
@@ -903,7 +918,7 @@ void write_all(int fd, const std::string& bytes) {
   } catch (const std::exception& e) {
     message = std::string(1, kErrorFollows) + e.what();
   } catch (...) {
-    message = std::string(1, kErrorFollows) + "mesh '" + path + "': gmsh failed";
+    message = std::string(1, kErrorFollows) + "mesh " + quoted(path, 200) + ": gmsh failed";
   }
   write_all(fd, message);
   ::_exit(0);
@@ -923,10 +938,11 @@ std::string signal_name(int sig) {
 
 /// Forks, meshes in the child, and reads the child's answer within the time limit.
 Mesh mesh_in_child_process(const std::string& path, const MeshOptions& options) {
-  const std::string where = "mesh '" + path + "'";
+  const std::string where = "mesh " + quoted(path, 200);
   int fds[2];
   if (::pipe(fds) != 0) throw std::runtime_error(where + ": cannot create a pipe: " + std::strerror(errno));
   std::fflush(nullptr);  // nothing buffered may be written twice
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fds[0]), ::close(fds[1]);
@@ -934,7 +950,7 @@ Mesh mesh_in_child_process(const std::string& path, const MeshOptions& options) 
   }
   if (pid == 0) {
     ::close(fds[0]);
-    run_child(fds[1], path, options);
+    run_child(fds[1], path, options, parent);
   }
   ::close(fds[1]);
   std::string bytes;
@@ -980,6 +996,27 @@ Mesh mesh_in_child_process(const std::string& path, const MeshOptions& options) 
   throw InputError(where + ": gmsh ended with exit code " + std::to_string(code) + " while reading or meshing it");
 }
 
+/// Refuses a mesh file gmsh should not read: unreadable, named other than .geo or
+/// .msh, or a .msh that does not start as one. A .msh is data: gmsh parses anything
+/// it cannot read as a mesh as a .geo program (System commands included), so only
+/// a file that opens as the MSH format reaches gmsh.
+void check_mesh_file(const std::string& path) {
+  check_input_file(path, "mesh file", std::uintmax_t{4} << 30);  // a regular file of at most 4 GiB
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("mesh file " + quoted(path, 200) + " is not readable");
+  const std::string ext = lower_extension(path);
+  if (ext != ".geo" && ext != ".msh")
+    throw InputError("mesh file " + quoted(path, 200) + " has the extension '" + ext +
+                     "'; expected a gmsh mesh (.msh) or a gmsh geometry program (.geo)");
+  if (ext == ".msh") {
+    std::string first;
+    std::getline(in, first);
+    if (!first.empty() && first.back() == '\r') first.pop_back();
+    if (first != "$MeshFormat")
+      throw InputError("mesh file " + quoted(path, 200) + " does not start with the line $MeshFormat; expected a gmsh MSH file");
+  }
+}
+
 }  // namespace
 
 Mesh load_mesh(const std::string& path, const MeshOptions& options) {
@@ -993,9 +1030,7 @@ Mesh load_mesh(const std::string& path, const MeshOptions& options) {
     throw InputError("mesh time limit " + std::to_string(options.time_limit_s) +
                      " s invalid; expected a positive number of seconds");
 
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh file '" + path + "' not found");
-  if (!std::ifstream(path)) throw InputError("mesh file '" + path + "' is not readable");
+  check_mesh_file(path);
   return mesh_in_child_process(path, options);
 }
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "core/format.hpp"
 #include "core/errors.hpp"
 
 namespace contactrom::fom {
@@ -16,10 +17,11 @@ int ParameterSpace::index_of(const std::string& name) const {
 }
 
 void ParameterSpace::add(const std::string& name, double lo, double hi, bool open_lower) {
-  if (index_of(name) >= 0) throw InputError("parameter '" + name + "' is defined twice; expected distinct names");
-  if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi))
-    throw InputError("parameter '" + name + "' has range [" + format_number(lo) + ", " + format_number(hi) +
-                     "]; expected finite bounds with lo < hi");
+  if (index_of(name) >= 0) throw InputError("parameter " + quoted(name, 200) + " is defined twice; expected distinct names");
+  // The width must be finite too: sampling plans and grids step through it.
+  if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi) || !std::isfinite(hi - lo))
+    throw InputError("parameter " + quoted(name, 200) + " has range [" + format_number(lo) + ", " + format_number(hi) +
+                     "]; expected finite bounds with lo < hi and a finite width hi - lo");
   names.push_back(name);
   lower.conservativeResize(size());
   upper.conservativeResize(size());
@@ -39,7 +41,7 @@ bool ParameterSpace::contains(const Param& mu) const {
 
 void ParameterSpace::check(const Param& mu, const std::string& problem_name) const {
   if (mu.size() != size())
-    throw InputError("problem '" + problem_name + "' takes " + std::to_string(size()) + " parameter value(s) (" +
+    throw InputError("problem " + quoted(problem_name, 200) + " takes " + std::to_string(size()) + " parameter value(s) (" +
                      range_text() + "), got " + std::to_string(mu.size()));
   for (int i = 0; i < size(); ++i) {
     const bool below = lower_open[i] ? !(mu(i) > lower(i)) : !(mu(i) >= lower(i));
@@ -73,7 +75,7 @@ Param ParameterSpace::parse(const std::string& text, const std::string& problem_
     bool blank = true;
     for (char ch : item) blank = blank && std::isspace(static_cast<unsigned char>(ch));
     if (blank || stop == begin || *rest || !std::isfinite(v))
-      throw InputError("parameter value '" + item + "' in '" + text + "' is not a finite number; expected " +
+      throw InputError("parameter value " + quoted(item, 200) + " in " + quoted(text, 200) + " is not a finite number; expected " +
                        range_text());
     values.push_back(v);
     if (end == std::string::npos) break;
@@ -158,7 +160,7 @@ class AffineReader {
     while (!at_end() && (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_')) ++m_pos;
     const std::string name = m_text.substr(start, m_pos - start);
     const int i = m_space.index_of(name);
-    if (i < 0) fail("names the unknown parameter '" + name + "'");
+    if (i < 0) fail("names the unknown parameter " + quoted(name, 200));
     e.coefficients(i) += factor;
   }
   double number() {
@@ -184,7 +186,7 @@ class AffineReader {
   [[noreturn]] void fail(const std::string& what) const {
     std::string names;
     for (int i = 0; i < m_space.size(); ++i) names += (i ? ", " : "") + m_space.names[i];
-    throw InputError("expression '" + m_text + "' " + what + "; expected a number or an affine expression of the parameters (" +
+    throw InputError("expression " + quoted(m_text, 200) + " " + what + "; expected a number or an affine expression of the parameters (" +
                      (names.empty() ? "none defined" : names) + "), e.g. \"-d\" or \"0.5*d + 0.1\"");
   }
 

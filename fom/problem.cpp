@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "core/format.hpp"
+#include "fom/contact_checks.hpp"
 #include "fom/node_to_face_contact.hpp"
 
 namespace contactrom::fom {
@@ -73,7 +74,7 @@ class Builder {
       if (!listed)
         throw InputError(m_def.where({0, "bodies"}) + ": the mesh's " + kind + " '" + body +
                          "' has no [[bodies]] entry; expected every " + (m_mesh.dim == 3 ? "volume" : "surface") +
-                         " of '" + m_def.mesh + "' listed");
+                         " of " + quoted(m_def.mesh, 200) + " listed");
     }
   }
 
@@ -131,7 +132,7 @@ class Builder {
     for (const TractionSpec& t : m_def.traction) {
       group_nodes(t.group, t.where, "physical curve");
       if (m_mesh.group_segments(t.group).empty())
-        throw InputError(m_def.where(t.where) + ": '" + t.group + "' is a physical point; expected a physical curve");
+        throw InputError(m_def.where(t.where) + ": " + quoted(t.group, 200) + " is a physical point; expected a physical curve");
       for (const auto& seg : m_mesh.group_segments(t.group)) {
         const double half = 0.5 * (m_mesh.nodes.col(seg[1]) - m_mesh.nodes.col(seg[0])).norm();
         for (int node : seg)
@@ -255,7 +256,7 @@ class Builder {
   const std::vector<int>& group_nodes(const std::string& group, const SourceLocation& where, const char* kind) const {
     auto it = m_mesh.curve_nodes.find(group);
     if (it == m_mesh.curve_nodes.end())
-      throw InputError(m_def.where(where) + ": the mesh has no " + kind + " '" + group + "'; expected one of: " +
+      throw InputError(m_def.where(where) + ": the mesh has no " + kind + " " + quoted(group, 200) + "; expected one of: " +
                        joined_keys(m_mesh.curve_nodes));
     return it->second;
   }
@@ -383,6 +384,7 @@ std::unique_ptr<Problem> build_problem(ProblemDefinition definition, Mesh mesh) 
   }
   p->m_u_scale = scale;
   p->m_fingerprint = hash_text(def.text + "|" + m.fingerprint());
+  check_contact_pairs_face(*p);
   return p;
 }
 

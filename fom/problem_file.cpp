@@ -12,7 +12,9 @@
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "core/format.hpp"
 #include "core/errors.hpp"
+#include "core/input_file.hpp"
 
 #ifndef CONTACTROM_DEFAULT_PROBLEM_DIR
 #define CONTACTROM_DEFAULT_PROBLEM_DIR "problems"
@@ -59,7 +61,7 @@ class Reader {
       if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
         std::string list;
         for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-        fail(&v, prefix + key, "unknown key '" + key + "'; expected one of: " + list);
+        fail(&v, prefix + key, "unknown key " + quoted(key, 200) + "; expected one of: " + list);
       }
     }
   }
@@ -169,7 +171,7 @@ class Reader {
     m_def.name = string(*t, p, "name", true);
     for (char ch : m_def.name)
       if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.'))
-        fail(t->get("name"), p + "name", "'" + m_def.name + "' has the character '" + std::string(1, ch) +
+        fail(t->get("name"), p + "name", quoted(m_def.name, 200) + " has the character '" + std::string(1, ch) +
                                               "'; expected letters, digits, '_', '-' or '.' (it names output files)");
     const std::string mesh = string(*t, p, "mesh", true);
     const fs::path base = m_def.path.empty() ? fs::path(".") : fs::path(m_def.path).parent_path();
@@ -177,7 +179,7 @@ class Reader {
     const std::string formulation = string(*t, p, "formulation", false, "plane_strain");
     if (formulation != "plane_strain" && formulation != "plane_stress" && formulation != "3d")
       fail(t->get("formulation"), p + "formulation",
-           "'" + formulation + "' is unknown; expected \"plane_strain\", \"plane_stress\" or \"3d\"");
+           quoted(formulation, 200) + " is unknown; expected \"plane_strain\", \"plane_stress\" or \"3d\"");
     m_def.plane_stress = formulation == "plane_stress";
     m_def.dimension = formulation == "3d" ? 3 : 2;
     m_def.formulation_where = at(t->get("formulation") ? t->get("formulation") : t, p + "formulation");
@@ -204,13 +206,16 @@ class Reader {
       const std::string name = string(t, p, "name", true);
       if (!(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_') ||
           std::any_of(name.begin(), name.end(), [](char c) { return !(std::isalnum(static_cast<unsigned char>(c)) || c == '_'); }))
-        fail(t.get("name"), p + "name", "'" + name + "' is not a valid name; expected letters, digits and '_', not starting with a digit");
+        fail(t.get("name"), p + "name", quoted(name, 200) + " is not a valid name; expected letters, digits and '_', not starting with a digit");
       const toml::node* r = node(t, p, "range", true);
       if (!r->is_array() || r->as_array()->size() != 2) fail(r, p + "range", "expected [lo, hi]");
       const double lo = number(r->as_array()->get(0), p + "range[0]");
       const double hi = number(r->as_array()->get(1), p + "range[1]");
       if (!(lo < hi))
         fail(r, p + "range", "[" + format_number(lo) + ", " + format_number(hi) + "] is empty; expected lo < hi");
+      if (!std::isfinite(hi - lo))
+        fail(r, p + "range", "[" + format_number(lo) + ", " + format_number(hi) +
+                                 "] has a width hi - lo that overflows; expected a finite width");
       try {
         m_def.parameters.add(name, lo, hi, boolean(t, p, "lower_open", false));
       } catch (const InputError& e) {
@@ -240,7 +245,7 @@ class Reader {
           fail(nu, p + "poisson", "is " + format_number(b.poisson) + "; expected a Poisson ratio in (-1, 0.5)");
       }
       for (const BodySpec& other : m_def.bodies)
-        if (other.group == b.group) fail(&t, p + "group", "the body '" + b.group + "' is listed twice");
+        if (other.group == b.group) fail(&t, p + "group", "the body " + quoted(b.group, 200) + " is listed twice");
       m_def.bodies.push_back(std::move(b));
     }
   }
@@ -285,7 +290,7 @@ class Reader {
       c.slave = string(t, p, "slave", true);
       c.master = string(t, p, "master", true);
       c.where = at(&t, p + "slave");
-      if (c.slave == c.master) fail(&t, p + "master", "is the slave curve '" + c.slave + "' itself; expected another curve");
+      if (c.slave == c.master) fail(&t, p + "master", "is the slave curve " + quoted(c.slave, 200) + " itself; expected another curve");
       m_def.contact.push_back(std::move(c));
     }
   }
@@ -361,16 +366,8 @@ class Reader {
 };
 
 std::string read_text_file(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError("problem file '" + path + "' not found");
-  if (!fs::is_regular_file(path, ec)) throw InputError("problem file '" + path + "' is not a regular file");
-  const auto size = fs::file_size(path, ec);
-  if (ec || size > (16u << 20)) throw InputError("problem file '" + path + "' is larger than 16 MiB; expected a small TOML file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("problem file '" + path + "' cannot be read (permissions?)");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  // A small TOML file: at most 16 MiB.
+  return read_input_file(path, "problem file", std::uintmax_t{16} << 20);
 }
 
 }  // namespace
@@ -378,7 +375,7 @@ std::string read_text_file(const std::string& path) {
 std::string ProblemDefinition::where(const SourceLocation& at) const {
   std::string out = "problem file '" + (path.empty() ? name : path) + "'";
   if (at.line > 0) out += ", line " + std::to_string(at.line);
-  if (!at.key.empty()) out += ", key '" + at.key + "'";
+  if (!at.key.empty()) out += ", key " + quoted(at.key, 200);
   return out;
 }
 
@@ -392,7 +389,7 @@ ProblemDefinition parse_problem_text(const std::string& text, const std::string&
   } catch (const toml::parse_error& e) {
     std::string what(e.description());
     std::replace(what.begin(), what.end(), '\n', ' ');
-    throw InputError("problem file '" + path + "', line " + std::to_string(e.source().begin.line) +
+    throw InputError("problem file " + quoted(path, 200) + ", line " + std::to_string(e.source().begin.line) +
                      ": TOML syntax error: " + what);
   }
   Reader(def).read(root);
@@ -417,7 +414,7 @@ std::string find_problem_file(const std::string& name_or_path) {
                        (name_or_path.size() > 5 && name_or_path.substr(name_or_path.size() - 5) == ".toml");
   if (is_path) {
     std::error_code ec;
-    if (!fs::exists(name_or_path, ec)) throw InputError("problem file '" + name_or_path + "' not found");
+    if (!fs::exists(name_or_path, ec)) throw InputError("problem file " + quoted(name_or_path, 200) + " not found");
     return name_or_path;
   }
   const std::string path = problem_directory() + "/" + name_or_path + ".toml";
@@ -425,7 +422,7 @@ std::string find_problem_file(const std::string& name_or_path) {
   if (name_or_path.empty() || !fs::exists(path, ec)) {
     std::string list;
     for (const auto& n : shipped_problem_names()) list += (list.empty() ? "" : ", ") + n;
-    throw InputError("unknown problem '" + name_or_path + "'; expected a problem file path or one of: " + list);
+    throw InputError("unknown problem " + quoted(name_or_path, 200) + "; expected a problem file path or one of: " + list);
   }
   return path;
 }

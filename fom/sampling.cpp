@@ -5,6 +5,7 @@
 #include <numeric>
 #include <random>
 
+#include "core/format.hpp"
 #include "core/errors.hpp"
 
 namespace contactrom::fom {
@@ -12,15 +13,24 @@ namespace {
 
 using Axis = std::vector<double>;
 
+/// The point k of n equal steps from lo to hi: exactly lo at k = 0 and hi at k = n,
+/// and never outside [lo, hi] in between (lo + (hi − lo)·k/n alone can step past a
+/// bound: 0.1·6/6 = 0.10000000000000002).
+double grid_point(double lo, double hi, double k, double n) {
+  if (k <= 0.0) return lo;
+  if (k >= n) return hi;
+  return std::clamp(lo + (hi - lo) * k / n, lo, hi);
+}
+
 Axis uniform_axis(const ParameterSpace& s, int i, int n) {
   const double lo = s.lower(i), hi = s.upper(i);
   Axis out;
   if (s.lower_open[i]) {
-    for (int k = 1; k <= n; ++k) out.push_back(lo + (hi - lo) * k / n);
+    for (int k = 1; k <= n; ++k) out.push_back(grid_point(lo, hi, k, n));
   } else if (n == 1) {
     out.push_back(lo);
   } else {
-    for (int k = 0; k < n; ++k) out.push_back(lo + (hi - lo) * k / (n - 1));
+    for (int k = 0; k < n; ++k) out.push_back(grid_point(lo, hi, k, n - 1));
   }
   return out;
 }
@@ -29,9 +39,9 @@ Axis midpoint_axis(const ParameterSpace& s, int i, int m) {
   const double lo = s.lower(i), hi = s.upper(i);
   Axis out;
   if (s.lower_open[i]) {
-    for (int k = 1; k < m; ++k) out.push_back(lo + (hi - lo) * (k + 0.5) / m);
+    for (int k = 1; k < m; ++k) out.push_back(grid_point(lo, hi, k + 0.5, m));
   } else {
-    for (int k = 0; k + 1 < m; ++k) out.push_back(lo + (hi - lo) * (k + 0.5) / (m - 1));
+    for (int k = 0; k + 1 < m; ++k) out.push_back(grid_point(lo, hi, k + 0.5, m - 1));
   }
   return out;
 }
@@ -41,7 +51,7 @@ std::vector<std::pair<long, double>> nested_axis(const ParameterSpace& s, int i,
   const long n = 1L << level;
   std::vector<std::pair<long, double>> out;
   for (long k = s.lower_open[i] ? 1 : 0; k <= n; ++k)
-    out.emplace_back(k, s.lower(i) + (s.upper(i) - s.lower(i)) * static_cast<double>(k) / static_cast<double>(n));
+    out.emplace_back(k, grid_point(s.lower(i), s.upper(i), static_cast<double>(k), static_cast<double>(n)));
   return out;
 }
 
@@ -92,7 +102,7 @@ void check_level(int level) {
 int resolve_training_size(const SamplingPlan& plan, const std::string& problem_name, int train, int level,
                           bool allow_default) {
   const std::string sel = plan.selector();
-  const std::string intro = "problem '" + problem_name + "' ";
+  const std::string intro = "problem " + quoted(problem_name, 200) + " ";
   if (sel == "list") {
     if (train || level)
       throw InputError(intro + "trains on its " + std::to_string(plan.points.size()) +
@@ -134,7 +144,7 @@ SamplingPlan::Kind sampling_kind_from_name(const std::string& name, bool validat
   if (name == "list") return K::List;
   if (validation && name == "midpoints") return K::Midpoints;
   if (validation && name == "next_level") return K::NextLevel;
-  throw InputError("sampling '" + name + "' is unknown; expected one of: " +
+  throw InputError("sampling " + quoted(name, 200) + " is unknown; expected one of: " +
                    (validation ? "midpoints, next_level, uniform, nested, random, list" : "uniform, nested, random, list"));
 }
 
@@ -194,7 +204,7 @@ std::vector<Param> SamplingPlan::points_for(const ParameterSpace& space, int n) 
         for (int k = 0; k < base; ++k) {
           double t = (strata[static_cast<size_t>(k)] + unit(rng)) / base;
           if (space.lower_open[i] && t == 0.0) t = 0.5 / base;
-          out[static_cast<size_t>(k)](i) = space.lower(i) + (space.upper(i) - space.lower(i)) * t;
+          out[static_cast<size_t>(k)](i) = grid_point(space.lower(i), space.upper(i), t, 1.0);
         }
       }
       return out;

@@ -1,6 +1,7 @@
 // Python bindings of the full-order side: Problem (parameters, operators K(μ),
 // C(u), g(u)), FullOrderSolver and its results, KKT residuals and verification.
 #include "baselines/kkt_verifier.hpp"
+#include "core/format.hpp"
 #include "core/errors.hpp"
 #include "python/bindings.hpp"
 #include "rom/offline.hpp"
@@ -19,10 +20,13 @@ struct ConstraintAt {
   Eigen::VectorXd g;
 };
 
+/// u: one finite value per dof of `problem`.
+void check_u(const fom::Problem& problem, const Eigen::VectorXd& u) {
+  check_vector(u, "u", problem.num_dofs(), "the dofs of " + quoted(problem.name(), 200));
+}
+
 ConstraintAt constraint_at(const fom::Problem& problem, const Eigen::VectorXd& u) {
-  if (u.size() != problem.num_dofs())
-    throw InputError("u has " + std::to_string(u.size()) + " entries; expected " +
-                     std::to_string(problem.num_dofs()) + " (the dofs of '" + problem.name() + "')");
+  check_u(problem, u);
   const fom::ContactModel& contact = problem.contact();
   const Eigen::VectorXd us = contact.restrict_to_surface(u);
   fom::ConstraintMatrix cs;
@@ -39,23 +43,18 @@ ConstraintAt constraint_at(const fom::Problem& problem, const Eigen::VectorXd& u
 }
 
 void check_sizes(const fom::Problem& problem, const Eigen::VectorXd& u, const Eigen::VectorXd& lambda) {
-  if (u.size() != problem.num_dofs())
-    throw InputError("u has " + std::to_string(u.size()) + " entries; expected " +
-                     std::to_string(problem.num_dofs()) + " (the dofs of '" + problem.name() + "')");
-  if (lambda.size() != problem.contact().num_constraints())
-    throw InputError("lam has " + std::to_string(lambda.size()) + " entries; expected " +
-                     std::to_string(problem.contact().num_constraints()) + " (the contact rows of '" +
-                     problem.name() + "')");
+  check_u(problem, u);
+  check_vector(lambda, "lam", problem.contact().num_constraints(), "the contact rows of " + quoted(problem.name(), 200));
 }
 
 FomResult finish(const fom::Problem& problem, fom::FomSolution solution) {
   // A failed solve may carry no field at all; its status and message say why.
   if (solution.u.size() != problem.num_dofs() || solution.lambda.size() != problem.contact().num_constraints())
-    throw std::runtime_error("the FOM solver returned no solution for problem '" + problem.name() + "' (status " +
+    throw std::runtime_error("the FOM solver returned no solution for problem " + quoted(problem.name(), 200) + " (status " +
                              to_string(solution.status) +
                              (solution.message.empty() ? "" : ": " + solution.message) + ")");
   FomResult r;
-  r.kkt = fom::kkt_residuals(problem, solution.mu, solution.u, solution.lambda);
+  r.kkt = solution.kkt;  // the residuals its status was certified with
   r.contact_force = fom::contact_force(problem, solution.lambda);
   r.solution = std::move(solution);
   return r;
@@ -81,10 +80,10 @@ py::dict report_dict(const baselines::VerificationReport& r, const fom::Referenc
   return d;
 }
 
-std::shared_ptr<fom::Problem> make(const std::string& name_or_path, int refine) {
+std::shared_ptr<fom::Problem> make(py::handle name_or_path, int refine) {
   fom::ProblemOptions options;
   options.refine = refine;
-  return fom::make_problem(name_or_path, options);
+  return fom::make_problem(path_arg(name_or_path), options);
 }
 
 }  // namespace
@@ -160,14 +159,16 @@ with u = u_lift(mu) + u0 on all dofs (Dirichlet dofs kept).)doc");
           "g", [](const fom::Problem& p, const Eigen::VectorXd& u) { return constraint_at(p, u).g; }, py::arg("u"),
           "Gap vector g(u) (n_c) of the same linearisation: C(u) u - g(u) <= 0.")
       .def(
-          "normal_gaps", [](const fom::Problem& p, const Eigen::VectorXd& u) { return fom::normal_gaps(p, u); },
+          "normal_gaps",
+          [](const fom::Problem& p, const Eigen::VectorXd& u) {
+            check_u(p, u);
+            return fom::normal_gaps(p, u);
+          },
           py::arg("u"), "Gap of every contact row in length units (unpaired rows: inf).")
       .def(
           "contact_force",
           [](const fom::Problem& p, const Eigen::VectorXd& lam) {
-            if (lam.size() != p.contact().num_constraints())
-              throw InputError("lam has " + std::to_string(lam.size()) + " entries; expected " +
-                               std::to_string(p.contact().num_constraints()));
+            check_vector(lam, "lam", p.contact().num_constraints(), "the contact rows of " + quoted(p.name(), 200));
             return fom::contact_force(p, lam);
           },
           py::arg("lam"), "Total contact force sum_s w_s lam_s (per unit thickness).")
@@ -180,7 +181,7 @@ with u = u_lift(mu) + u0 on all dofs (Dirichlet dofs kept).)doc");
           },
           py::arg("mu"), py::arg("u"), py::arg("lam"), "The four relative KKT residuals of (u, lam) at mu, as a dict.")
       .def("__repr__", [](const fom::Problem& p) {
-        return "<contactrom.Problem '" + p.name() + "': " + p.range_text() + ", " + std::to_string(p.num_dofs()) +
+        return "<contactrom.Problem " + quoted(p.name(), 200) + ": " + p.range_text() + ", " + std::to_string(p.num_dofs()) +
                " dofs, " + std::to_string(p.contact().num_constraints()) + " contact rows>";
       });
   m.def("problem", &make, py::arg("name"), py::arg("refine") = 0,
@@ -213,7 +214,7 @@ The FOM solver of a problem: the active-set solver (default; K factorised once
 here when it does not depend on mu) or Ipopt (solver="ipopt").)doc")
       .def(py::init([](std::shared_ptr<fom::Problem> problem, const std::string& solver) {
              if (solver != "active-set" && solver != "ipopt")
-               throw InputError("solver '" + solver + "' unknown; expected active-set or ipopt");
+               throw InputError("solver " + quoted(solver, 200) + " unknown; expected active-set or ipopt");
              auto s = std::make_unique<FullOrderSolver>();
              s->problem = problem;
              s->kind = solver;

@@ -4,6 +4,7 @@
 #include <Python.h>
 #include <variant>
 
+#include "core/format.hpp"
 #include "core/errors.hpp"
 #include "python/bindings.hpp"
 #include "rom/offline.hpp"
@@ -15,7 +16,7 @@ namespace {
 rom::LiftingKind lifting_kind(const std::string& text) {
   if (text == "harmonic") return rom::LiftingKind::Harmonic;
   if (text == "dirichlet") return rom::LiftingKind::Dirichlet;
-  throw InputError("lifting '" + text + "' unknown; expected harmonic or dirichlet");
+  throw InputError("lifting " + quoted(text, 200) + " unknown; expected harmonic or dirichlet");
 }
 
 std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, double delta, const std::string& method,
@@ -47,7 +48,8 @@ std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, doub
   return r;
 }
 
-std::unique_ptr<ReducedModel> load_reduced_model(const std::string& path) {
+std::unique_ptr<ReducedModel> load_reduced_model(py::handle path_like) {
+  const std::string path = path_arg(path_like);
   auto r = std::make_unique<ReducedModel>();
   py::gil_scoped_release release;
   r->rom = std::make_shared<rom::OnlineModel>(rom::OnlineModel::load(path));
@@ -136,19 +138,21 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
           "The validation parameters of the database's training set (those `contactrom online` evaluates).")
       .def(
           "save",
-          [](const Database& d, const std::string& path) {
+          [](const Database& d, py::handle path_like) {
+            const std::string path = path_arg(path_like);
             py::gil_scoped_release release;
             rom::write_database(path, *d.db);
           },
           py::arg("path"), "Writes the HDF5 file (atomically), readable by the CLI and load_database.")
       .def("__repr__", [](const Database& d) {
-        return "<contactrom.SnapshotDatabase '" + d.db->problem + "': " + std::to_string(d.db->num_snapshots()) +
+        return "<contactrom.SnapshotDatabase " + quoted(d.db->problem, 200) + ": " + std::to_string(d.db->num_snapshots()) +
                " snapshots>";
       });
 
   m.def(
       "load_database",
-      [](const std::string& path) {
+      [](py::handle path_like) {
+        const std::string path = path_arg(path_like);
         py::gil_scoped_release release;
         auto db = std::make_shared<rom::SnapshotDatabase>(rom::read_database(path));
         Database d;
@@ -225,7 +229,8 @@ object owns the problem (and the database) it needs.)doc")
                   "Reads a reduced-model file (`contactrom reduce` or ReducedModel.save): no FOM, no meshing.")
       .def(
           "save",
-          [](const ReducedModel& r, const std::string& path) {
+          [](const ReducedModel& r, py::handle path_like) {
+            const std::string path = path_arg(path_like);
             py::gil_scoped_release release;
             r.rom->save(path);
           },

@@ -70,6 +70,13 @@ struct ReducedModel {
 /// value out of range.
 fom::Param to_param(const fom::Problem& problem, py::handle value);
 
+/// \brief A path argument: a str, bytes or any os.PathLike (os.fsdecode).
+std::string path_arg(py::handle value);
+
+/// \brief Throws InputError unless `v` has `size` entries, all finite, naming
+/// `name` and what was expected (`what`, e.g. "the dofs of 'hertz'").
+void check_vector(const Eigen::VectorXd& v, const char* name, Eigen::Index size, const std::string& what);
+
 /// \brief A list of parameters (one per row of a 2-D array, or a 1-D array / list
 /// of numbers for a one-parameter problem), each checked by to_param.
 std::vector<fom::Param> to_params(const fom::Problem& problem, py::handle values);

@@ -3,6 +3,7 @@
 // The pure-Python package `contactrom` (python/contactrom/) re-exports it.
 #include <cmath>
 
+#include "core/format.hpp"
 #include "core/errors.hpp"
 #include "core/version.hpp"
 #include "fom/input_values.hpp"
@@ -21,16 +22,24 @@ fom::Param checked_param(const fom::Problem& problem, const double* values, py::
 }  // namespace
 
 fom::Param to_param(const fom::Problem& problem, py::handle value) {
+  const auto refuse = [&] {
+    return InputError("a parameter of " + quoted(problem.name(), 200) + " is a number or a sequence of " +
+                      std::to_string(problem.num_params()) + " numbers (" + problem.range_text() + "), not " +
+                      quoted(py::str(py::repr(value)).cast<std::string>(), 80));
+  };
+  // None and text are not numbers (numpy would turn them into nan, or read the text).
+  if (value.is_none() || py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value)) throw refuse();
   if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
-    const double v = value.cast<double>();
+    const double v = PyFloat_AsDouble(value.ptr());  // an int beyond the doubles: OverflowError
+    if (v == -1.0 && PyErr_Occurred()) {
+      PyErr_Clear();
+      throw InputError("parameter value " + quoted(py::str(value).cast<std::string>(), 80) +
+                       " is not a finite number; expected " + problem.range_text());
+    }
     return checked_param(problem, &v, 1);
   }
-  const auto refuse = [&] {
-    return InputError("a parameter of '" + problem.name() + "' is a number or a sequence of " +
-                      std::to_string(problem.num_params()) + " numbers (" + problem.range_text() + ")");
-  };
-  if (py::isinstance<py::str>(value)) throw refuse();  // numpy would read the text
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!a) PyErr_Clear();
   if (a && a.ndim() == 0) return checked_param(problem, a.data(), 1);  // numpy scalars
   if (!a || a.ndim() != 1) throw refuse();
   return checked_param(problem, a.data(), a.size());
@@ -40,13 +49,27 @@ std::vector<fom::Param> to_params(const fom::Problem& problem, py::handle values
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
   const bool one = problem.num_params() == 1;
   if (!a || a.ndim() < 1 || a.ndim() > 2 || (a.ndim() == 1 && !one))
-    throw InputError("parameters of '" + problem.name() + "' are an array of shape (n, " +
+    throw InputError("parameters of " + quoted(problem.name(), 200) + " are an array of shape (n, " +
                      std::to_string(problem.num_params()) + ")" + (one ? " or (n,)" : "") + " (" +
                      problem.range_text() + ")");
   const py::ssize_t width = a.ndim() == 1 ? 1 : a.shape(1);
   std::vector<fom::Param> out;
   for (py::ssize_t i = 0; i < a.shape(0); ++i) out.push_back(checked_param(problem, a.data() + i * width, width));
   return out;
+}
+
+std::string path_arg(py::handle value) {
+  return py::module_::import("os").attr("fsdecode")(value).cast<std::string>();
+}
+
+void check_vector(const Eigen::VectorXd& v, const char* name, Eigen::Index size, const std::string& what) {
+  if (v.size() != size)
+    throw InputError(std::string(name) + " has " + std::to_string(v.size()) + " entries; expected " +
+                     std::to_string(size) + " (" + what + ")");
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v(i)))
+      throw InputError(std::string(name) + "[" + std::to_string(i) + "] is " + fom::format_number(v(i)) +
+                       "; expected finite numbers");
 }
 
 py::array_t<double> params_array(const std::vector<fom::Param>& params, int num_params) {

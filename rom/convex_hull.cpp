@@ -1,5 +1,7 @@
 #include "rom/convex_hull.hpp"
 
+#include "core/format.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -287,6 +289,9 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
   // them, d_p = u_j − u_lift(μ_j) (Dirichlet lifting, so that u = u_lift(μ) + D_p α
   // is a convex combination of the snapshots up to the Dirichlet data): the reduced
   // model measures its snapshots from its own offset u_off, which is undone here.
+  if (!model.has_primal_snapshots())
+    throw InputError("convex-hull combines the primal training snapshots, which this reduced model of '" +
+                     problem.name() + "' does not keep (build it with keep_primal_snapshots = true)");
   MatrixXd dp = model.primal_snapshots();
   const MatrixXd& dd = model.dictionary();
   const Index m = dp.cols();
@@ -308,7 +313,7 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
   Pod svd(PodOptions{delta, 0});
   svd.compute(dp);
   if (svd.info() != Status::Success)
-    throw InputError("SVD of the primal dictionary of '" + problem.name() + "' failed (" + to_string(svd.info()) + ")");
+    throw InputError("SVD of the primal dictionary of " + quoted(problem.name(), 200) + " failed (" + to_string(svd.info()) + ")");
   if (options.basis == ProjectionBasis::Svd) {
     m_b = svd.basis();
   } else {
@@ -325,7 +330,7 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
     m_b = orth.basis();
   }
   if (m_b.cols() == 0)
-    throw InputError("the primal dictionary of '" + problem.name() + "' is zero: no projection basis");
+    throw InputError("the primal dictionary of " + quoted(problem.name(), 200) + " is zero: no projection basis");
   const std::vector<char>& dirichlet = problem.is_dirichlet();
   for (Index i = 0; i < m_b.rows(); ++i)
     if (dirichlet[static_cast<std::size_t>(i)]) m_b.row(i).setZero();
@@ -488,7 +493,7 @@ ConvexHullOptions convex_hull_options(const OnlineSolverOptions& options) {
       else if (value == "random")
         o.basis = ProjectionBasis::Random;
       else
-        throw InputError("convex-hull basis '" + value + "' unknown; expected svd or random");
+        throw InputError("convex-hull basis " + quoted(value, 200) + " unknown; expected svd or random");
     } else if (key == "basis_delta") {
       o.basis_delta = parse_double(key, value);
     } else if (key == "rank_l") {
@@ -507,7 +512,7 @@ ConvexHullOptions convex_hull_options(const OnlineSolverOptions& options) {
       else if (value == "0" || value == "false")
         o.polish = false;
       else
-        throw InputError("convex-hull polish = '" + value + "' invalid; expected 0, 1, true or false");
+        throw InputError("convex-hull polish = " + quoted(value, 200) + " invalid; expected 0, 1, true or false");
     } else if (key == "max_pairing_iterations") {
       o.max_pairing_iterations = static_cast<int>(std::clamp(parse_integer(key, value), -1LL, 1000000LL));
     } else if (key == "selection_iterations") {

@@ -1,6 +1,7 @@
 #include "rom/database_merge.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "core/format.hpp"
 
@@ -11,7 +12,7 @@ namespace {
 void check_compatible(const SnapshotDatabase& a, const std::string& name_a, const SnapshotDatabase& b,
                       const std::string& name_b) {
   auto differ = [&](const std::string& what, const std::string& va, const std::string& vb) {
-    throw InputError("cannot merge '" + name_b + "' into '" + name_a + "': " + what + " " + vb + " differs from " +
+    throw InputError("cannot merge " + quoted(name_b, 200) + " into " + quoted(name_a, 200) + ": " + what + " " + vb + " differs from " +
                      va + "; expected databases of the same problem and training set");
   };
   if (a.problem != b.problem) differ("problem", a.problem, b.problem);
@@ -38,7 +39,10 @@ SnapshotDatabase reordered(const SnapshotDatabase& db, const std::vector<int>& o
   for (size_t j = 0; j < order.size(); ++j) {
     const int k = order[j];
     out.parameters.col(j) = db.parameters.col(k);
-    out.primal.col(j) = db.primal.col(k);
+    if (db.primal_in_memory())
+      out.primal.col(j) = db.primal.col(k);
+    else
+      out.primal_refs[j] = db.primal_refs[k];
     out.dual.col(j) = db.dual.col(k);
     out.status[j] = db.status[k];
     out.iterations[j] = db.iterations[k];
@@ -64,9 +68,16 @@ SnapshotDatabase merge_databases(const std::vector<SnapshotDatabase>& databases,
   int n = 0;
   for (const auto& db : databases) n += db.num_snapshots();
 
+  // Snapshots on disk stay there: the merged database refers to their files.
+  const bool on_disk = !databases[0].primal_in_memory();
+  for (const auto& db : databases)
+    if (db.primal_in_memory() == on_disk)
+      throw std::invalid_argument("merge_databases: databases with primal snapshots in memory and on disk");
   SnapshotDatabase out = databases[0];
   out.parameters.resize(databases[0].parameters.rows(), n);
-  out.primal.resize(databases[0].num_dofs(), n);
+  out.primal.resize(databases[0].num_dofs(), on_disk ? 0 : n);
+  out.primal_files.clear();
+  out.primal_refs.clear();
   out.dual.resize(databases[0].num_constraints(), n);
   out.status.clear();
   out.iterations.clear();
@@ -83,10 +94,14 @@ SnapshotDatabase merge_databases(const std::vector<SnapshotDatabase>& databases,
           throw InputError("cannot merge '" + names[d] + "': its snapshot " + std::to_string(k) +
                            " has the parameter of an earlier snapshot; expected disjoint parts");
       out.parameters.col(j) = db.parameters.col(k);
-      out.primal.col(j) = db.primal.col(k);
+      if (on_disk)
+        out.primal_refs.push_back({db.primal_refs[k].file + static_cast<int>(out.primal_files.size()), db.primal_refs[k].row});
+      else
+        out.primal.col(j) = db.primal.col(k);
       out.dual.col(j) = db.dual.col(k);
       ++j;
     }
+    out.primal_files.insert(out.primal_files.end(), db.primal_files.begin(), db.primal_files.end());
     out.status.insert(out.status.end(), db.status.begin(), db.status.end());
     out.iterations.insert(out.iterations.end(), db.iterations.begin(), db.iterations.end());
     out.pairing_iterations.insert(out.pairing_iterations.end(), db.pairing_iterations.begin(),
@@ -103,13 +118,13 @@ void check_appendable(const SnapshotDatabase& db, const std::string& path, const
                       const std::string& training_kind, int training_size) {
   check_database_problem(db, problem, path);
   if (db.training_kind != training_kind || db.training_size != training_size)
-    throw InputError("cannot append to '" + path + "': its training set " + db.training_kind + " " +
+    throw InputError("cannot append to " + quoted(path, 200) + ": its training set " + db.training_kind + " " +
                      std::to_string(db.training_size) + " differs from " + training_kind + " " +
                      std::to_string(training_size) + "; expected the same --train or --level");
   const std::vector<fom::Param> training = fom::training_set(problem, training_size);
   for (int j = 0; j < db.num_snapshots(); ++j)
     if (index_of(training, db.parameter(j)) < 0)
-      throw InputError("cannot append to '" + path + "': its snapshot " + std::to_string(j) +
+      throw InputError("cannot append to " + quoted(path, 200) + ": its snapshot " + std::to_string(j) +
                        " is not at a parameter of its training set; expected a database written by contactrom offline");
 }
 
@@ -123,21 +138,31 @@ std::vector<fom::Param> parameters_not_in(const SnapshotDatabase& db, const std:
   return missing;
 }
 
-SnapshotDatabase append_snapshots(const SnapshotDatabase& db, const std::string& name, const SnapshotDatabase& added,
-                                  const std::vector<fom::Param>& training) {
-  const SnapshotDatabase merged = merge_databases({db, added}, {name, "the new snapshots"});
-  // Columns sorted by their position in the training set.
-  std::vector<std::pair<int, int>> position(merged.num_snapshots());
-  for (int j = 0; j < merged.num_snapshots(); ++j) {
-    position[j] = {index_of(training, merged.parameter(j)), j};
+SnapshotDatabase sorted_by_training(const SnapshotDatabase& db, const std::string& name,
+                                    const std::vector<fom::Param>& training) {
+  std::vector<std::pair<int, int>> position(db.num_snapshots());
+  for (int j = 0; j < db.num_snapshots(); ++j) {
+    position[j] = {index_of(training, db.parameter(j)), j};
     if (position[j].first < 0)
-      throw InputError("cannot append to '" + name + "': snapshot " + std::to_string(j) +
+      throw InputError("cannot sort the snapshots of " + quoted(name, 200) + ": snapshot " + std::to_string(j) +
                        " is not at a parameter of the training set");
   }
   std::sort(position.begin(), position.end());
   std::vector<int> order;
   for (const auto& p : position) order.push_back(p.second);
-  return reordered(merged, order);
+  return reordered(db, order);
+}
+
+SnapshotDatabase merge_in_training_order(const std::vector<SnapshotDatabase>& databases,
+                                         const std::vector<std::string>& names) {
+  const SnapshotDatabase merged = merge_databases(databases, names);
+  const auto problem = rebuild_database_problem(databases[0], names[0]);
+  return sorted_by_training(merged, names[0], fom::training_set(*problem, merged.training_size));
+}
+
+SnapshotDatabase append_snapshots(const SnapshotDatabase& db, const std::string& name, const SnapshotDatabase& added,
+                                  const std::vector<fom::Param>& training) {
+  return sorted_by_training(merge_databases({db, added}, {name, "the new snapshots"}), name, training);
 }
 
 }  // namespace contactrom::rom

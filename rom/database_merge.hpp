@@ -23,12 +23,28 @@ namespace contactrom::rom {
 std::pair<int, int> part_range(int n, int k, int parts);
 
 /// \brief Concatenates the snapshots of `databases` in the given order (timing
-/// fields: setup and wall times summed, threads the largest).
+/// fields: setup and wall times summed, threads the largest). Databases whose primal
+/// snapshots are on disk (read_database(path, false), streamed offline runs) are
+/// merged by reference: the result refers to their files, and write_database()
+/// copies the snapshots one at a time (all inputs alike: in memory or on disk).
 /// \param names file names of the databases, for error messages (same size)
 /// \throws InputError naming the two files if they differ in problem, mesh
 ///   fingerprint, parameter names, training options (kind and size), numbers of dofs
 ///   or constraints, or if a parameter appears twice.
 SnapshotDatabase merge_databases(const std::vector<SnapshotDatabase>& databases, const std::vector<std::string>& names);
+
+/// \brief merge_databases(), then the snapshots sorted into the order of their
+/// training set (the problem rebuilt from the first database), so that the parts of
+/// `offline --part k/K` given in any order make the database of the whole run.
+/// \throws InputError as merge_databases and sorted_by_training.
+SnapshotDatabase merge_in_training_order(const std::vector<SnapshotDatabase>& databases,
+                                         const std::vector<std::string>& names);
+
+/// \brief `db` with its snapshots sorted into the order of `training`.
+/// \param name the file `db` was read from, for error messages
+/// \throws InputError if a snapshot's parameter is not in `training`.
+SnapshotDatabase sorted_by_training(const SnapshotDatabase& db, const std::string& name,
+                                    const std::vector<fom::Param>& training);
 
 /// \brief Checks, before any snapshot is computed, that snapshots of `problem` for
 /// the training set (`training_kind`, `training_size`) can be appended to `db`

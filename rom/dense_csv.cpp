@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/format.hpp"
+#include "core/input_file.hpp"
 #include "fom/input_values.hpp"
 
 namespace contactrom::rom {
@@ -95,9 +97,15 @@ Eigen::MatrixXd read_dense_csv(std::istream& in, const std::string& name) {
   return matrix;
 }
 
+namespace {
+/// Largest CSV file read (1 GiB): the values of a dictionary of 10^8 entries.
+constexpr std::uintmax_t kMaxCsvBytes = std::uintmax_t{1} << 30;
+}  // namespace
+
 Eigen::MatrixXd read_dense_csv(const std::string& path) {
+  check_input_file(path, "CSV file", kMaxCsvBytes);
   std::ifstream in(path);
-  if (!in) throw InputError("cannot open '" + path + "': no such file or not readable");
+  if (!in) throw InputError("cannot open " + quoted(path, 200) + ": no such file or not readable");
   return read_dense_csv(in, path);
 }
 

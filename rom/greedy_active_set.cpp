@@ -842,8 +842,9 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds
 }
 
 double GreedyActiveSet::surface_step(const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x) const {
-  thread_local Eigen::VectorXd change;
-  change.noalias() = m_model.surface_basis() * (u_hat - x);
+  thread_local Eigen::VectorXd diff, change;  // storage reused: the iterations allocate nothing
+  diff = u_hat - x;
+  change.noalias() = m_model.surface_basis() * diff;
   return (change.size() > 0 ? change.cwiseAbs().maxCoeff() : 0.0) / m_model.problem().displacement_scale();
 }
 

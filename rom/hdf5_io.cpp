@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 
+#include "core/format.hpp"
 #include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 
@@ -14,6 +15,32 @@ namespace {
 
 std::string attribute_what(const char* name) { return std::string("attribute ") + name; }
 std::string dataset_what(const char* name) { return std::string("dataset /") + name; }
+
+/// Bob Jenkins' lookup3 hash (hashlittle, public domain), with which HDF5
+/// checksums its metadata (initial value 0).
+std::uint32_t lookup3(const unsigned char* k, size_t length) {
+  auto rot = [](std::uint32_t x, int r) { return (x << r) | (x >> (32 - r)); };
+  auto word = [](const unsigned char* p, size_t n) {
+    std::uint32_t w = 0;
+    for (size_t i = 0; i < n && i < 4; ++i) w |= static_cast<std::uint32_t>(p[i]) << (8 * i);
+    return w;
+  };
+  std::uint32_t a = 0xdeadbeef + static_cast<std::uint32_t>(length), b = a, c = a;
+  while (length > 12) {
+    a += word(k, 4), b += word(k + 4, 4), c += word(k + 8, 4);
+    a -= c, a ^= rot(c, 4), c += b, b -= a, b ^= rot(a, 6), a += c;
+    c -= b, c ^= rot(b, 8), b += a, a -= c, a ^= rot(c, 16), c += b;
+    b -= a, b ^= rot(a, 19), a += c, c -= b, c ^= rot(b, 4), b += a;
+    length -= 12, k += 12;
+  }
+  if (length == 0) return c;
+  a += word(k, length), b += length > 4 ? word(k + 4, length - 4) : 0, c += length > 8 ? word(k + 8, length - 8) : 0;
+  c ^= b, c -= rot(b, 14), a ^= c, a -= rot(c, 11), b ^= a, b -= rot(a, 25);
+  c ^= b, c -= rot(b, 16), a ^= c, a -= rot(c, 4), b ^= a, b -= rot(a, 14);
+  c ^= b, c -= rot(b, 24);
+  return c;
+}
+
 
 /// Number of elements of an attribute's dataspace (scalar: 1).
 hssize_t attribute_elements(hid_t attr, const std::string& what) {
@@ -37,13 +64,60 @@ T read_numeric_attribute(hid_t loc, const char* name, H5T_class_t cls, hid_t mem
   return value;
 }
 
+
+/// Stores the checksum of the `bytes` just written to `set`.
+void write_checksum(hid_t set, const void* bytes, size_t size, const std::string& what) {
+  const std::uint32_t sum = data_checksum(bytes, size);
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, what);
+  Handle attr(H5Acreate2(set, kChecksumAttribute, H5T_STD_U32LE, space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
+  check(H5Awrite(attr.id(), H5T_NATIVE_UINT32, &sum), what);
+}
+
+/// Refuses data whose checksum differs from the stored one (or that has none).
+void verify_checksum(hid_t set, const void* bytes, size_t size, const std::string& what) {
+  if (H5Aexists(set, kChecksumAttribute) <= 0)
+    throw Refused(what + " has no checksum attribute " + kChecksumAttribute + " (expected a file written by contactrom)");
+  const std::uint32_t stored = read_numeric_attribute<std::uint32_t>(set, kChecksumAttribute, H5T_INTEGER, H5T_NATIVE_UINT32,
+                                                                     "an unsigned 32-bit integer");
+  if (data_checksum(bytes, size) != stored)
+    throw Refused(what + " fails its checksum: the file is damaged");
+}
+
+/// Opens dataset `name`, refusing links to other files (external, or soft links
+/// anywhere on the path) and data stored outside the file (external or virtual
+/// storage): a file contactrom reads must not read any other file.
+hid_t open_local_dataset(hid_t loc, const char* name, const std::string& what) {
+  const std::string path = name;
+  for (size_t end = path.find('/', 1);; end = path.find('/', end + 1)) {
+    const std::string prefix = path.substr(0, end);
+    if (H5Lexists(loc, prefix.c_str(), H5P_DEFAULT) > 0) {
+      H5L_info_t info{};
+      if (H5Lget_info(loc, prefix.c_str(), &info, H5P_DEFAULT) < 0) throw Failure(what);
+      if (info.type != H5L_TYPE_HARD)
+        throw Refused(what + " is reached through a " + (info.type == H5L_TYPE_EXTERNAL ? "link to another file" : "soft link") +
+                      " (/" + prefix + "); expected the data in the file itself");
+    }
+    if (end == std::string::npos) break;
+  }
+  const hid_t set = H5Dopen2(loc, name, H5P_DEFAULT);
+  if (set < 0) return set;
+  const hid_t dcpl = H5Dget_create_plist(set);
+  const bool outside = dcpl < 0 || H5Pget_external_count(dcpl) > 0 || H5Pget_layout(dcpl) == H5D_VIRTUAL;
+  if (dcpl >= 0) H5Pclose(dcpl);
+  if (outside) {
+    H5Dclose(set);
+    throw Refused(what + " stores its data outside the file (external or virtual storage); expected the data in the file");
+  }
+  return set;
+}
+
 /// Reads a rank-1/2 dataset of class `cls` into `out` after checking its
 /// declared size against the file's size.
 template <typename T>
 void read_numeric_dataset(hid_t file, const char* name, H5T_class_t cls, hid_t mem_type, const char* expected,
                           std::vector<T>& out, hsize_t& rows, hsize_t& cols) {
   const std::string what = dataset_what(name);
-  Handle set(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, what);
+  Handle set(open_local_dataset(file, name, what), H5Dclose, what);
   Handle type(H5Dget_type(set.id()), H5Tclose, what);
   if (H5Tget_class(type.id()) != cls) throw Refused(what + " does not hold " + expected);
   const size_t element = H5Tget_size(type.id());
@@ -64,6 +138,7 @@ void read_numeric_dataset(hid_t file, const char* name, H5T_class_t cls, hid_t m
   }
   out.assign(static_cast<size_t>(rows * cols), T{});
   if (!out.empty()) check(H5Dread(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), what);
+  verify_checksum(set.id(), out.data(), out.size() * sizeof(T), what);
 }
 
 }  // namespace
@@ -144,6 +219,10 @@ double read_double_attribute(hid_t loc, const char* name) {
   return read_numeric_attribute<double>(loc, name, H5T_FLOAT, H5T_NATIVE_DOUBLE, "floating-point number");
 }
 
+std::uint32_t data_checksum(const void* bytes, std::size_t size) {
+  return lookup3(static_cast<const unsigned char*>(bytes), size);
+}
+
 std::uint64_t file_size(hid_t file) {
   hsize_t size = 0;
   check(H5Fget_filesize(file, &size), "the file size");
@@ -152,7 +231,7 @@ std::uint64_t file_size(hid_t file) {
 
 std::vector<hsize_t> dataset_shape(hid_t file, const char* name) {
   const std::string what = dataset_what(name);
-  Handle set(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, what);
+  Handle set(open_local_dataset(file, name, what), H5Dclose, what);
   Handle space(H5Dget_space(set.id()), H5Sclose, what);
   const int rank = H5Sget_simple_extent_ndims(space.id());
   if (rank < 1 || rank > 2) throw Refused(what + " has rank " + std::to_string(rank) + ", expected 1 or 2");
@@ -177,6 +256,7 @@ void write_dataset(hid_t file, hid_t dcpl, const char* name, hid_t file_type, hi
   Handle set(H5Dcreate2(file, name, file_type, space.id(), H5P_DEFAULT, dcpl, H5P_DEFAULT), H5Dclose, what);
   const hsize_t count = rank == 2 ? rows * cols : rows;
   if (count > 0) check(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), what);
+  write_checksum(set.id(), data, static_cast<size_t>(count) * H5Tget_size(mem_type), what);
 }
 
 hid_t create_memory_file(const std::string& label, hid_t fcpl) {
@@ -188,35 +268,6 @@ hid_t create_memory_file(const std::string& label, hid_t fcpl) {
   check(H5Pset_libver_bounds(fapl.id(), H5F_LIBVER_V18, H5F_LIBVER_V18), "file access properties");
   return H5Fcreate(label.c_str(), H5F_ACC_TRUNC, fcpl, fapl.id());
 }
-
-namespace {
-
-/// Bob Jenkins' lookup3 hash (hashlittle, public domain), with which HDF5
-/// checksums its metadata (initial value 0).
-std::uint32_t lookup3(const unsigned char* k, size_t length) {
-  auto rot = [](std::uint32_t x, int r) { return (x << r) | (x >> (32 - r)); };
-  auto word = [](const unsigned char* p, size_t n) {
-    std::uint32_t w = 0;
-    for (size_t i = 0; i < n && i < 4; ++i) w |= static_cast<std::uint32_t>(p[i]) << (8 * i);
-    return w;
-  };
-  std::uint32_t a = 0xdeadbeef + static_cast<std::uint32_t>(length), b = a, c = a;
-  while (length > 12) {
-    a += word(k, 4), b += word(k + 4, 4), c += word(k + 8, 4);
-    a -= c, a ^= rot(c, 4), c += b, b -= a, b ^= rot(a, 6), a += c;
-    c -= b, c ^= rot(b, 8), b += a, a -= c, a ^= rot(c, 16), c += b;
-    b -= a, b ^= rot(a, 19), a += c, c -= b, c ^= rot(b, 4), b += a;
-    length -= 12, k += 12;
-  }
-  if (length == 0) return c;
-  a += word(k, length), b += length > 4 ? word(k + 4, length - 4) : 0, c += length > 8 ? word(k + 8, length - 8) : 0;
-  c ^= b, c -= rot(b, 14), a ^= c, a -= rot(c, 11), b ^= a, b -= rot(a, 25);
-  c ^= b, c -= rot(b, 16), a ^= c, a -= rot(c, 4), b ^= a, b -= rot(a, 14);
-  c ^= b, c -= rot(b, 24);
-  return c;
-}
-
-}  // namespace
 
 std::string file_image(hid_t file) {
   check(H5Fflush(file, H5F_SCOPE_GLOBAL), "file flush");
@@ -262,11 +313,12 @@ void write_string_list(hid_t loc, hid_t dcpl, const char* name, const std::vecto
   std::string buf(width * items.size(), '\0');
   for (size_t i = 0; i < items.size(); ++i) buf.replace(i * width, items[i].size(), items[i]);
   if (!items.empty()) check(H5Dwrite(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()), what);
+  write_checksum(set.id(), buf.data(), buf.size(), what);
 }
 
 std::vector<std::string> read_string_list(hid_t loc, const char* name, std::uint64_t max_bytes) {
   const std::string what = dataset_what(name);
-  Handle set(H5Dopen2(loc, name, H5P_DEFAULT), H5Dclose, what);
+  Handle set(open_local_dataset(loc, name, what), H5Dclose, what);
   Handle type(H5Dget_type(set.id()), H5Tclose, what);
   if (H5Tget_class(type.id()) != H5T_STRING || H5Tis_variable_str(type.id()) != 0)
     throw Refused(what + " is not a list of fixed-length strings");
@@ -279,6 +331,7 @@ std::vector<std::string> read_string_list(hid_t loc, const char* name, std::uint
     throw Refused(what + " declares more bytes than the file holds");
   std::string buf(width * n, '\0');
   if (n > 0) check(H5Dread(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()), what);
+  verify_checksum(set.id(), buf.data(), buf.size(), what);
   std::vector<std::string> out;
   for (hsize_t i = 0; i < n; ++i) {
     std::string item = buf.substr(i * width, width);
@@ -326,20 +379,25 @@ int superblock_version(const std::string& path) {
 hid_t open_file(const std::string& path, const std::string& label, const std::string& expected_writer) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(label + " '" + path + "' not found");
-  if (fs::is_directory(path, ec)) throw InputError(label + " '" + path + "' is a directory, expected an HDF5 file");
+  if (!fs::exists(path, ec)) throw InputError(label + " " + quoted(path, 200) + " not found");
+  if (fs::is_directory(path, ec)) throw InputError(label + " " + quoted(path, 200) + " is a directory, expected an HDF5 file");
   silence();
   const int version = superblock_version(path);
   if (version < 0)
-    throw InputError(label + " '" + path + "' is not an HDF5 file (expected one written by " + expected_writer + ")");
+    throw InputError(label + " " + quoted(path, 200) + " is not an HDF5 file (expected one written by " + expected_writer + ")");
   // Without checksums (superblock versions 0 and 1) a damaged file reaches
   // libhdf5's parsers unchecked; contactrom writes version 2.
   if (version < 2)
-    throw InputError(label + " '" + path + "' has HDF5 superblock version " + std::to_string(version) +
+    throw InputError(label + " " + quoted(path, 200) + " has HDF5 superblock version " + std::to_string(version) +
                      " (no metadata checksums), expected 2 or later as written by " + expected_writer +
                      "; write it again with " + expected_writer);
-  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (file < 0) throw InputError(label + " '" + path + "' is truncated or corrupt (HDF5 cannot open it)");
+  // Without HDF5's own file lock (flock): files are published whole by rename, so a
+  // reader never sees one being written, and `offline --append` holds its own lock
+  // on the database (core/atomic_file.hpp FileLock), which HDF5's would conflict with.
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "file access properties");
+  check(H5Pset_file_locking(fapl.id(), false, true), "file access properties");
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.id());
+  if (file < 0) throw InputError(label + " " + quoted(path, 200) + " is truncated or corrupt (HDF5 cannot open it)");
   return file;
 }
 

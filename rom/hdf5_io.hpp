@@ -68,6 +68,15 @@ void check(herr_t rc, const std::string& what);
 /// \brief Largest string attribute read or written (bytes); longer is refused.
 inline constexpr std::size_t kMaxStringAttribute = std::size_t{1} << 24;
 
+/// \brief Name of the attribute holding the checksum of a dataset's data: every
+/// dataset write_dataset() and write_string_list() create carries it, and the
+/// readers refuse data that fails it (docs/database_format.md, "Data checksums").
+inline constexpr const char* kChecksumAttribute = "checksum_lookup3";
+
+/// \brief The checksum of a dataset's data bytes: Bob Jenkins' lookup3 (hashlittle,
+/// initial value 0), the hash HDF5 uses for its metadata.
+std::uint32_t data_checksum(const void* bytes, std::size_t size);
+
 /// \brief Writes a scalar fixed-length UTF-8 string attribute (h5py returns it as bytes
 /// or str depending on its version; its length is the string's, at least 1).
 void write_string_attribute(hid_t loc, const char* name, const std::string& value);

@@ -1,6 +1,7 @@
 #include "rom/offline.hpp"
 
 #include <algorithm>
+#include <memory>
 
 namespace contactrom::rom {
 
@@ -19,7 +20,10 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
   db.training_size = training_size;
   db.parameters.resize(problem.num_params(), n);
   for (int j = 0; j < n; ++j) db.parameters.col(j) = params[j];
-  db.primal = Eigen::MatrixXd::Zero(nd, n);
+  const bool streamed = !options.stream_to.empty();
+  db.primal = Eigen::MatrixXd::Zero(nd, streamed ? 0 : n);
+  std::unique_ptr<DatabaseWriter> writer;
+  if (streamed) writer = std::make_unique<DatabaseWriter>(options.stream_to, nd, n, options.stream_label);
   db.dual = Eigen::MatrixXd::Zero(nc, n);
   db.status.assign(n, Status::Success);
   db.iterations.assign(n, 0);
@@ -40,19 +44,28 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
         db.iterations[j] = sol.iterations;
         db.pairing_iterations[j] = sol.pairing_iterations;
         db.time_s[j] = sol.time_s;
+        // Primal snapshot u − u_lift(μ), exactly zero on Dirichlet dofs (the
+        // lifting carries the Dirichlet values; rounding differences between the
+        // solver's and the problem's lifting sums are removed here).
+        Eigen::VectorXd col = Eigen::VectorXd::Zero(nd);
         if (sol.u.size() == nd) {
-          // Primal snapshot u − u_lift(μ), exactly zero on Dirichlet dofs (the
-          // lifting carries the Dirichlet values; rounding differences between the
-          // solver's and the problem's lifting sums are removed here).
-          auto col = db.primal.col(j);
           col = sol.u - problem.lifting(params[j]);
           for (int i = 0; i < nd; ++i)
             if (dirichlet[i]) col(i) = 0.0;
         }
+        if (writer)
+          writer->write_primal(j, col);
+        else
+          db.primal.col(j) = col;
         if (sol.lambda.size() == nc) db.dual.col(j) = sol.lambda;
       },
       options.progress);
   db.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (writer) {
+    writer->finish(db);
+    db.primal_files = {options.stream_to};
+    for (int j = 0; j < n; ++j) db.primal_refs.push_back({0, j});
+  }
   return db;
 }
 

@@ -13,7 +13,9 @@
 /// all worker threads; every parameter is solved from scratch (no warm start from
 /// a neighbouring parameter) and its snapshot is written into the column
 /// preassigned to it, so the arrays are bit-identical whatever the thread count
-/// and scheduling. Only the timing fields differ between runs.
+/// and scheduling. Only the timing fields differ between runs. With
+/// OfflineOptions::stream_to each primal snapshot goes to the file as soon as it is
+/// computed (rom::DatabaseWriter), with the same arrays.
 #include <chrono>
 #include <functional>
 #include <iosfwd>
@@ -35,6 +37,14 @@ struct OfflineOptions {
   /// Label written as the `created_by` attribute. Default "contactrom " + version().
   std::string created_by = "contactrom " + version();
   ProgressCallback progress;  ///< called after every snapshot (optional)
+  /// Stream the primal snapshots, as they are computed, into a database file at this
+  /// path (rom::DatabaseWriter; the caller renames or merges it, and removes it on
+  /// failure) instead of holding them in memory: the returned database then refers
+  /// to that file (primal_files) and the run's memory does not grow with the number
+  /// of snapshots (the pressures, n_c per snapshot, stay in memory). Default "" (in memory).
+  std::string stream_to;
+  /// The database named in error messages about `stream_to` (default: stream_to itself).
+  std::string stream_label;
 };
 
 /// \brief Computes the FOM snapshots of `problem` at `params` (in parallel; see the

@@ -23,13 +23,14 @@ std::string broadcast_message(const std::string& message, int root) {
   return text;
 }
 
-/// Local snapshots packed one after the other: primal, dual, then the scalars.
-std::vector<double> pack(const SnapshotDatabase& db) {
-  const int nd = db.num_dofs(), nc = db.num_constraints(), stride = nd + nc + kScalarsPerSnapshot;
+/// Local snapshots packed one after the other: primal (unless streamed to a file:
+/// nd = 0), dual, then the scalars.
+std::vector<double> pack(const SnapshotDatabase& db, int nd) {
+  const int nc = db.num_constraints(), stride = nd + nc + kScalarsPerSnapshot;
   std::vector<double> buffer(static_cast<size_t>(stride) * db.num_snapshots());
   for (int k = 0; k < db.num_snapshots(); ++k) {
     double* p = buffer.data() + static_cast<size_t>(stride) * k;
-    Eigen::Map<Eigen::VectorXd>(p, nd) = db.primal.col(k);
+    if (nd > 0) Eigen::Map<Eigen::VectorXd>(p, nd) = db.primal.col(k);
     Eigen::Map<Eigen::VectorXd>(p + nd, nc) = db.dual.col(k);
     p[nd + nc] = static_cast<double>(static_cast<int>(db.status[k]));
     p[nd + nc + 1] = db.iterations[k];
@@ -37,6 +38,22 @@ std::vector<double> pack(const SnapshotDatabase& db) {
     p[nd + nc + 3] = db.time_s[k];
   }
   return buffer;
+}
+
+/// Every rank's `path`, on rank 0 (in rank order; empty elsewhere).
+std::vector<std::string> gather_paths(const std::string& path, int rank, int size) {
+  int length = static_cast<int>(path.size()), longest = 0;
+  MPI_Allreduce(&length, &longest, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  std::string mine = path;
+  mine.resize(static_cast<size_t>(longest), '\0');
+  std::string all(rank == 0 ? static_cast<size_t>(longest) * size : 0, '\0');
+  MPI_Gather(mine.data(), longest, MPI_CHAR, all.data(), longest, MPI_CHAR, 0, MPI_COMM_WORLD);
+  std::vector<std::string> out;
+  for (int r = 0; rank == 0 && r < size; ++r) {
+    std::string p = all.substr(static_cast<size_t>(r) * longest, static_cast<size_t>(longest));
+    out.push_back(p.substr(0, p.find('\0')));
+  }
+  return out;
 }
 
 /// Number of parameters rank r computes under the cyclic assignment.
@@ -122,9 +139,13 @@ SnapshotDatabase generate_snapshots_distributed(const fom::Problem& problem, con
     throw RankFailure("rank " + std::to_string(first_failed) + " of " + std::to_string(size) +
                       " failed: " + broadcast_message(error, first_failed));
 
-  const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
+  // Streamed runs gather everything but the primal snapshots, which stay in each
+  // rank's file (the database refers to them; the caller writes it and removes them).
+  const bool streamed = !options.stream_to.empty();
+  const int nd = streamed ? 0 : problem.num_dofs(), nc = problem.contact().num_constraints();
   const int stride = nd + nc + kScalarsPerSnapshot;
-  const std::vector<double> buffer = pack(local);
+  const std::vector<double> buffer = pack(local, nd);
+  const std::vector<std::string> files = streamed ? gather_paths(options.stream_to, rank, size) : std::vector<std::string>{};
   std::vector<int> counts(size), displs(size);
   for (int r = 0, offset = 0; r < size; ++r) {
     counts[r] = share(n, r, size) * stride;
@@ -141,7 +162,9 @@ SnapshotDatabase generate_snapshots_distributed(const fom::Problem& problem, con
   // Rank r's k-th snapshot is parameter j = r + k·size.
   SnapshotDatabase db = local;  // metadata (problem, fingerprint, names, ...) of rank 0
   db.parameters.resize(problem.num_params(), n);
-  db.primal.resize(nd, n);
+  db.primal.resize(problem.num_dofs(), streamed ? 0 : n);
+  db.primal_files = files;
+  db.primal_refs.assign(streamed ? n : 0, {});
   db.dual.resize(nc, n);
   db.status.assign(n, Status::Success);
   db.iterations.assign(n, 0);
@@ -152,7 +175,10 @@ SnapshotDatabase generate_snapshots_distributed(const fom::Problem& problem, con
       const int j = r + k * size;
       const double* p = all.data() + displs[r] + static_cast<size_t>(stride) * k;
       db.parameters.col(j) = params[j];
-      db.primal.col(j) = Eigen::Map<const Eigen::VectorXd>(p, nd);
+      if (streamed)
+        db.primal_refs[j] = {r, k};
+      else
+        db.primal.col(j) = Eigen::Map<const Eigen::VectorXd>(p, nd);
       db.dual.col(j) = Eigen::Map<const Eigen::VectorXd>(p + nd, nc);
       db.status[j] = static_cast<Status>(static_cast<int>(p[nd + nc]));
       db.iterations[j] = static_cast<int>(p[nd + nc + 1]);

@@ -12,7 +12,12 @@
 /// the parameter range (the cost of a FOM query grows with the contact zone). The
 /// snapshots are gathered on rank 0 into the columns of the serial order: each
 /// snapshot is computed from scratch exactly as in a serial run, so the database's
-/// arrays are bit-identical to the serial ones; only timing fields differ.
+/// arrays are bit-identical to the serial ones; only timing fields differ. With
+/// OfflineOptions::stream_to (a path of each rank's own), each rank streams its
+/// primal snapshots into that file and only the pressures and outcomes are gathered:
+/// rank 0's database refers to the ranks' files (SnapshotDatabase::primal_files, which
+/// must be visible to rank 0: one machine or a shared file system), and
+/// write_database() copies them into the database one snapshot at a time.
 #include <string>
 #include <vector>
 

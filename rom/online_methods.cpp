@@ -70,7 +70,8 @@ std::vector<OptionSpec> greedy_specs(bool with_schedule) {
                        "per rebuild, Alg. 1 with safeguards), paper (Alg. 1 exactly) or nested",
                        {"fixed-point", "interleaved", "paper", "nested"}));
   o.push_back(integer("anderson_depth", "5", "nested schedule: Anderson depth of the rebuild point (0: plain)", 0, 1e6));
-  o.push_back(number("surface_step", "1e-3",
+  if (with_schedule)
+    o.push_back(number("surface_step", "1e-3",
                      "fixed-point schedule: largest move of the contact surface (units of U) between the operators' "
                      "point and the answer",
                      Interval::greater_than(0)));
@@ -173,7 +174,7 @@ std::string known_keys(const OnlineMethod& m) {
 
 void check_key(const OnlineMethod& m, const std::string& key) {
   if (!find_spec(m, key))
-    throw InputError("online method '" + m.name + "' has no option " + quoted(key) + "; it knows: " + known_keys(m));
+    throw InputError("online method " + quoted(m.name, 200) + " has no option " + quoted(key) + "; it knows: " + known_keys(m));
 }
 
 }  // namespace
@@ -199,7 +200,7 @@ std::vector<OnlineMethod> rom_online_methods() {
           {"greedy-nested", "greedy active set, contact operators rebuilt on a nested schedule", greedy_specs(false),
            nested},
           {"convex-hull", "convex-hull approximation: nnFOCUSS on the monolithic dictionary (paper app. B)",
-           convex_hull_specs(), make_convex_hull_solver}};
+           convex_hull_specs(), make_convex_hull_solver, false, /*needs_primal_snapshots=*/true}};
 }
 
 void register_online_method(OnlineMethod method) {
@@ -223,6 +224,7 @@ void register_online_solver(const std::string& name, OnlineSolverFactory factory
   m.name = name;
   m.summary = "registered at run time";
   m.open_options = true;
+  m.needs_primal_snapshots = true;  // unknown: keep everything the method could read
   m.factory = std::move(factory);
   register_online_method(std::move(m));
 }
@@ -254,6 +256,10 @@ OnlineMethod online_method(const std::string& name) {
   throw InputError("unknown online method " + quoted(name) + "; expected one of: " + join(online_solver_names(), ", "));
 }
 
+bool online_method_needs_primal_snapshots(const std::string& name) {
+  return online_method(name).needs_primal_snapshots;
+}
+
 std::string describe_option_type(const OptionSpec& spec) {
   switch (spec.type) {
     case OptionType::Number: return spec.range.text();
@@ -273,7 +279,7 @@ std::string describe_option_type(const OptionSpec& spec) {
 }
 
 void validate_option_value(const std::string& method, const OptionSpec& spec, const std::string& value) {
-  const std::string what = "online method '" + method + "' option " + spec.key;
+  const std::string what = "online method " + quoted(method, 200) + " option " + spec.key;
   switch (spec.type) {
     case OptionType::Number:
       (void)parse_number(value, what, spec.range);
@@ -299,7 +305,7 @@ void validate_online_options(const std::string& method, const OnlineSolverOption
   if (m.open_options) return;  // the factory checks its own settings
   for (const auto& [key, value] : options.extra) {
     if (is_shared(key))
-      throw InputError("online method '" + method + "' option " + key +
+      throw InputError("online method " + quoted(method, 200) + " option " + key +
                        " is a field of OnlineSolverOptions; set the field (or use options_from_map)");
     check_key(m, key);
     validate_option_value(method, *find_spec(m, key), value);
@@ -356,7 +362,7 @@ void check_extra_options(const OnlineSolverOptions& options, const std::string& 
                          const std::vector<std::string>& known) {
   for (const auto& entry : options.extra) {
     if (std::find(known.begin(), known.end(), entry.first) != known.end()) continue;
-    throw InputError("online method '" + method + "' has no option '" + entry.first + "'; it knows: " +
+    throw InputError("online method " + quoted(method, 200) + " has no option " + quoted(entry.first, 200) + "; it knows: " +
                      (known.empty() ? "none" : join(known, ", ")));
   }
 }

@@ -92,6 +92,10 @@ struct OnlineMethod {
   /// Options not declared (a method added with register_online_solver()): every
   /// key of OnlineSolverOptions::extra is passed to the factory, which checks it.
   bool open_options = false;
+  /// Whether the method combines the primal training snapshots themselves
+  /// (ReducedModel::primal_snapshots(), n × m): a reduced-model file then stores
+  /// them. Methods added with register_online_solver() are assumed to.
+  bool needs_primal_snapshots = false;
 };
 
 /// \brief Registers (or replaces) a method with its option declarations.
@@ -104,6 +108,10 @@ std::vector<OnlineMethod> online_methods();
 /// \throws InputError naming the known methods (or the library that provides a
 /// built-in method this program does not link).
 OnlineMethod online_method(const std::string& name);
+
+/// \brief Whether method `name` needs the primal training snapshots
+/// (OnlineMethod::needs_primal_snapshots). \throws InputError as online_method().
+bool online_method_needs_primal_snapshots(const std::string& name);
 
 /// \brief The methods built into contactrom::rom (`greedy`, `greedy-nested`,
 /// `convex-hull`); the registry starts with them.

@@ -251,7 +251,7 @@ std::unique_ptr<fom::Problem> rebuild_problem(const ProblemRecord& r, const std:
     problem = fom::build_problem(std::move(def), *r.mesh);
   }
   if (problem->name() != r.name)
-    throw InputError(label + " names problem '" + r.name + "' but its problem file defines '" + problem->name() + "'");
+    throw InputError(label + " names problem " + quoted(r.name, 200) + " but its problem file defines " + quoted(problem->name(), 200));
   if (problem->fingerprint() != r.fingerprint)
     throw InputError(label + " was built for mesh fingerprint " + r.fingerprint + " but the stored problem gives " +
                      problem->fingerprint() + "; rebuild it with this contactrom");

@@ -1,5 +1,7 @@
 #include "rom/reduced_model.hpp"
 
+#include "core/format.hpp"
+
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <chrono>
@@ -23,56 +25,98 @@ std::vector<Eigen::VectorXd> harmonic_offsets(const fom::Problem& problem) {
 
 }  // namespace
 
+std::vector<int> reduced_model_columns(const SnapshotDatabase& db, const ReducedModelOptions& options) {
+  std::vector<int> out;
+  for (int j = 0; j < db.num_snapshots(); ++j)
+    if (options.include_failed_snapshots || db.status[j] == Status::Success) out.push_back(j);
+  return out;
+}
+
+std::vector<Eigen::VectorXd> reduced_model_offsets(const fom::Problem& problem, LiftingKind lifting) {
+  return lifting == LiftingKind::Harmonic ? harmonic_offsets(problem) : problem.lifting_terms();
+}
+
+ReducedSnapshots::ReducedSnapshots(const fom::Problem& problem, const SnapshotDatabase& db, std::vector<int> columns,
+                                   const std::vector<Eigen::VectorXd>& offset_terms)
+    : m_stored(primal_blocks(db, columns)) {
+  // The database stores u − u_lift; the reduced displacement is measured from the
+  // offset: u − u_off = (u − u_lift) − Σ_k φ_k (L̃_k − L_k).
+  const int nt = problem.num_load_terms();
+  for (int k = 0; k < nt; ++k) {
+    Eigen::VectorXd d = offset_terms[k] - problem.lifting_terms()[k];
+    if (d.cwiseAbs().maxCoeff() > 0.0) m_shift.emplace_back(k, std::move(d));
+  }
+  m_coefficients.resize(nt, static_cast<Eigen::Index>(columns.size()));
+  for (size_t c = 0; c < columns.size(); ++c)
+    m_coefficients.col(static_cast<Eigen::Index>(c)) = problem.load_coefficients(db.parameter(columns[c]));
+}
+
+void ReducedSnapshots::read_rows(Eigen::Index first, Eigen::Index count, Eigen::MatrixXd& out) const {
+  m_stored->read_rows(first, count, out);
+  for (Eigen::Index c = 0; c < out.cols(); ++c)
+    for (const auto& [k, d] : m_shift) out.col(c) -= m_coefficients(k, c) * d.segment(first, count);
+}
+
+void share_reduced_model_pod(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options) {
+  const ReducedSnapshots snapshots(problem, db, reduced_model_columns(db, options),
+                                   reduced_model_offsets(problem, options.lifting));
+  PodOptions pod_options = options.pod;
+  pod_options.delta = options.delta;
+  Pod(pod_options).compute(snapshots);
+}
+
 ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options)
     : m_problem(problem), m_options(options) {
   const auto t0 = std::chrono::steady_clock::now();
   const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
   if (db.num_dofs() != nd || db.num_constraints() != nc)
-    throw InputError("database of problem '" + db.problem + "' has " + std::to_string(db.num_dofs()) + " dofs and " +
+    throw InputError("database of problem " + quoted(db.problem, 200) + " has " + std::to_string(db.num_dofs()) + " dofs and " +
                      std::to_string(db.num_constraints()) + " contact rows, but " + problem.name() + " has " +
                      std::to_string(nd) + " and " + std::to_string(nc));
   if (!(options.delta >= 0.0))
     throw InputError("POD tolerance delta = " + std::to_string(options.delta) + " invalid; expected >= 0");
 
-  for (int j = 0; j < db.num_snapshots(); ++j)
-    if (options.include_failed_snapshots || db.status[j] == Status::Success) m_dict_snapshots.push_back(j);
+  m_dict_snapshots = reduced_model_columns(db, options);
   if (m_dict_snapshots.empty())
-    throw InputError("database of problem '" + db.problem + "' holds no successful snapshot");
+    throw InputError("database of problem " + quoted(db.problem, 200) + " holds no successful snapshot");
   const int m = static_cast<int>(m_dict_snapshots.size());
-
   const int nt = problem.num_load_terms();
-  m_offset = options.lifting == LiftingKind::Harmonic ? harmonic_offsets(problem) : problem.lifting_terms();
-  Eigen::MatrixXd& primal = m_primal;
-  primal.resize(nd, m);
+  m_offset = reduced_model_offsets(problem, options.lifting);
   m_dict.resize(nc, m);
   for (int c = 0; c < m; ++c) {
     const int j = m_dict_snapshots[c];
-    primal.col(c) = db.primal.col(j);
     m_dict.col(c) = db.dual.col(j);
     m_dict_params.push_back(db.parameter(j));
   }
-  // The database stores u − u_lift; the reduced displacement is measured from the
-  // offset: u − u_off = (u − u_lift) − Σ_k φ_k (L̃_k − L_k).
-  if (options.lifting != LiftingKind::Dirichlet) {
-    for (int c = 0; c < m; ++c) {
-      const Eigen::VectorXd phi = problem.load_coefficients(m_dict_params[c]);
-      for (int k = 0; k < nt; ++k) primal.col(c) -= phi(k) * (m_offset[k] - problem.lifting_terms()[k]);
-    }
-  }
+  const ReducedSnapshots snapshots(problem, db, m_dict_snapshots, m_offset);
 
   // Primal basis: POD with the energy criterion (rom/pod.hpp); Dirichlet rows of
   // the snapshots are zero, so are those of Φ (set exactly, against rounding).
-  PodOptions pod_options;
+  // The snapshots are read whole only when kept or small enough for the SVD;
+  // otherwise the POD reads them by blocks and gives their coordinates.
+  PodOptions pod_options = options.pod;
   pod_options.delta = options.delta;
   Pod pod(pod_options);
-  pod.compute(primal);
+  const auto t_pod = std::chrono::steady_clock::now();
+  const bool whole = options.keep_primal_snapshots || pod.uses_svd(nd, m);
+  if (whole) {
+    m_primal = snapshots.read_all();
+    pod.compute(m_primal);
+  } else {
+    pod.compute(snapshots);
+  }
+  m_pod_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_pod).count();
   if (pod.info() != Status::Success)
-    throw InputError("POD of the primal snapshots of '" + db.problem + "' failed (" + to_string(pod.info()) + ")");
+    throw InputError("POD of the primal snapshots of " + quoted(db.problem, 200) + " failed (" + to_string(pod.info()) + ")");
   m_phi = pod.basis();
   m_sigma = pod.singular_values();
   const std::vector<char>& dirichlet = problem.is_dirichlet();
-  for (int i = 0; i < nd; ++i)
+  // (A basis of rank 0, δ = 1, has no row to clear: row() of an empty matrix is
+  // an offset on a null pointer.)
+  for (int i = 0; i < nd && m_phi.cols() > 0; ++i)
     if (dirichlet[i]) m_phi.row(i).setZero();
+  m_snapshot_coords = whole ? Eigen::MatrixXd(m_phi.transpose() * m_primal) : pod.coordinates();
+  if (!options.keep_primal_snapshots) m_primal.resize(nd, 0);
 
   // Affine reduced operators (file comment).
   const int r = primal_rank();
@@ -96,7 +140,8 @@ void ReducedModel::split_by_pair() {
   const fom::ContactModel& contact = m_problem.contact();
   const int pairs = contact.num_pairs(), nc = static_cast<int>(m_dict.rows()), m = dictionary_size();
   if (pairs < 2) return;
-  Eigen::MatrixXd dict(nc, 0), primal(m_primal.rows(), 0);
+  const bool primal_kept = m_primal.cols() == m;
+  Eigen::MatrixXd dict(nc, 0), primal(m_primal.rows(), 0), coords(m_snapshot_coords.rows(), 0);
   std::vector<int> snapshots;
   std::vector<fom::Param> params;
   std::vector<std::pair<int, int>> parts;  // (column, pair) of the new columns
@@ -111,17 +156,20 @@ void ReducedModel::split_by_pair() {
   }
   const int n = static_cast<int>(parts.size());
   dict.setZero(nc, n);
-  primal.resize(m_primal.rows(), n);
+  primal.resize(m_primal.rows(), primal_kept ? n : 0);
+  coords.resize(m_snapshot_coords.rows(), n);
   for (int c = 0; c < n; ++c) {
     const auto [p, k] = parts[static_cast<size_t>(c)];
     for (int s = 0; s < nc; ++s)
       if (k < 0 || contact.pair_of_row(s) == k) dict(s, c) = m_dict(s, p);
-    primal.col(c) = m_primal.col(p);
+    if (primal_kept) primal.col(c) = m_primal.col(p);
+    coords.col(c) = m_snapshot_coords.col(p);
     snapshots.push_back(m_dict_snapshots[static_cast<size_t>(p)]);
     params.push_back(m_dict_params[static_cast<size_t>(p)]);
   }
   m_dict = std::move(dict);
   m_primal = std::move(primal);
+  m_snapshot_coords = std::move(coords);
   m_dict_snapshots = std::move(snapshots);
   m_dict_params = std::move(params);
 }
@@ -133,7 +181,7 @@ ReducedModel::ReducedModel(const fom::Problem& problem, ReducedModelData data)
   const long m = data.dictionary.cols(), nq = problem.num_stiffness_terms(), nt = problem.num_load_terms();
   const auto require = [&](bool ok, const std::string& what, long got, long expected) {
     if (!ok)
-      throw InputError("reduced model of '" + problem.name() + "': " + what + " has size " + std::to_string(got) +
+      throw InputError("reduced model of " + quoted(problem.name(), 200) + ": " + what + " has size " + std::to_string(got) +
                        ", expected " + std::to_string(expected));
   };
   require(data.basis.rows() == n, "the basis' row count", data.basis.rows(), n);
@@ -160,8 +208,13 @@ ReducedModel::ReducedModel(const fom::Problem& problem, ReducedModelData data)
           data.dictionary_parameters.size(), m);
   for (const auto& p : data.dictionary_parameters)
     require(p.size() == problem.num_params(), "a dictionary parameter", p.size(), problem.num_params());
-  require(data.primal_snapshots.rows() == n && data.primal_snapshots.cols() == m, "the primal snapshots",
-          data.primal_snapshots.size(), n * m);
+  if (data.primal_snapshots.cols() > 0)
+    require(data.primal_snapshots.rows() == n && data.primal_snapshots.cols() == m, "the primal snapshots",
+            data.primal_snapshots.size(), n * m);
+  if (data.snapshot_coordinates.size() == 0 && data.primal_snapshots.cols() > 0)
+    data.snapshot_coordinates = data.basis.transpose() * data.primal_snapshots;
+  require(data.snapshot_coordinates.rows() == r && data.snapshot_coordinates.cols() == m,
+          "the snapshot coordinates", data.snapshot_coordinates.size(), r * m);
   m_phi = std::move(data.basis);
   m_sigma = std::move(data.singular_values);
   m_offset = std::move(data.offset_terms);
@@ -171,7 +224,9 @@ ReducedModel::ReducedModel(const fom::Problem& problem, ReducedModelData data)
   m_dict = std::move(data.dictionary);
   m_dict_snapshots = std::move(data.dictionary_snapshots);
   m_dict_params = std::move(data.dictionary_parameters);
-  m_primal = std::move(data.primal_snapshots);
+  m_primal = data.primal_snapshots.cols() > 0 ? std::move(data.primal_snapshots) : Eigen::MatrixXd(n, 0);
+  m_snapshot_coords = std::move(data.snapshot_coordinates);
+  m_options.keep_primal_snapshots = m_primal.cols() > 0;
   derive();
   m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -189,20 +244,20 @@ ReducedModelData ReducedModel::data() const {
   d.dictionary_snapshots = m_dict_snapshots;
   d.dictionary_parameters = m_dict_params;
   d.primal_snapshots = m_primal;
+  d.snapshot_coordinates = m_snapshot_coords;
   return d;
 }
 
 void ReducedModel::derive() {
   const std::vector<int>& surf = m_problem.contact().surface_dofs();
   const int ns = static_cast<int>(surf.size()), r = primal_rank(), nt = static_cast<int>(m_offset.size());
-  m_snapshot_coords = m_phi.transpose() * m_primal;
   build_parameter_grid();
   int snapshots = 0;
   for (int j : m_dict_snapshots) snapshots = std::max(snapshots, j + 1);
   m_siblings.assign(static_cast<size_t>(snapshots), {});
   for (int c = 0; c < dictionary_size(); ++c) m_siblings[static_cast<size_t>(m_dict_snapshots[static_cast<size_t>(c)])].push_back(c);
   m_phi_s.resize(ns, r);
-  for (int a = 0; a < ns; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
+  for (int a = 0; a < ns && r > 0; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
   m_phi_s_rows = m_phi_s;
   m_lift_s.resize(ns, nt);
   for (int k = 0; k < nt; ++k)

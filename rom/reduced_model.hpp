@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "fom/problem.hpp"
+#include "rom/pod.hpp"
 #include "rom/snapshot_database.hpp"
 
 namespace contactrom::rom {
@@ -56,6 +57,14 @@ struct ReducedModelOptions {
   bool split_pairs = true;
   /// Offset of the reduced displacement; see LiftingKind. Default Harmonic.
   LiftingKind lifting = LiftingKind::Harmonic;
+  /// Keep the primal snapshots u − u_off of the dictionary columns (n × m) in the
+  /// model. Only methods that combine whole training solutions need them (the convex
+  /// hull); the others use their reduced coordinates Φᵀ(u − u_off) (r × m), which are
+  /// always kept. Default true; OnlineModel keeps them only for a method that needs them.
+  bool keep_primal_snapshots = true;
+  /// How the POD is computed: algorithm, threads, block size, MPI ranks (rom/pod.hpp);
+  /// its delta is replaced by `delta` above. Default PodOptions().
+  PodOptions pod;
 };
 
 /// \brief Everything a ReducedModel holds besides its problem — the offline product
@@ -72,8 +81,42 @@ struct ReducedModelData {
   Eigen::MatrixXd dictionary;              ///< D_d, n_c × m
   std::vector<int> dictionary_snapshots;   ///< database snapshot index of each column
   std::vector<fom::Param> dictionary_parameters;  ///< parameter of each column
-  Eigen::MatrixXd primal_snapshots;        ///< u − u_off of each column, n × m
+  /// u − u_off of each column, n × m; or empty (0 columns) when the model does not keep
+  /// them (ReducedModelOptions::keep_primal_snapshots).
+  Eigen::MatrixXd primal_snapshots;
+  /// Φᵀ(u − u_off) of each column, r × m. May be left empty when primal_snapshots is
+  /// given (then computed from them).
+  Eigen::MatrixXd snapshot_coordinates;
 };
+
+/// \brief The database snapshots a reduced model keeps, in database order: those whose
+/// FOM status is Success (all with ReducedModelOptions::include_failed_snapshots).
+std::vector<int> reduced_model_columns(const SnapshotDatabase& db, const ReducedModelOptions& options);
+
+/// \brief The offset terms L̃_k of `lifting` (see LiftingKind).
+std::vector<Eigen::VectorXd> reduced_model_offsets(const fom::Problem& problem, LiftingKind lifting);
+
+/// \brief The matrix a reduced model's POD is taken of: u − u_off(μ_c) of the kept
+/// database snapshots (n_dofs × m), by blocks of rows, from the database in memory or
+/// on disk (SnapshotDatabase::primal_file). `db` and `problem` must outlive it.
+class ReducedSnapshots : public SnapshotBlocks {
+ public:
+  ReducedSnapshots(const fom::Problem& problem, const SnapshotDatabase& db, std::vector<int> columns,
+                   const std::vector<Eigen::VectorXd>& offset_terms);
+  Eigen::Index rows() const override { return m_stored->rows(); }
+  Eigen::Index cols() const override { return m_stored->cols(); }
+  void read_rows(Eigen::Index first, Eigen::Index count, Eigen::MatrixXd& out) const override;
+
+ private:
+  std::unique_ptr<SnapshotBlocks> m_stored;                 // u − u_lift, as stored
+  std::vector<std::pair<int, Eigen::VectorXd>> m_shift;     // (k, L̃_k − L_k) for the nonzero ones
+  Eigen::MatrixXd m_coefficients;                           // φ_k(μ_c), T × m
+};
+
+/// \brief The share of ReducedModel's construction that MPI ranks other than 0 take
+/// in when `options.pod.reduction` spans several ranks: the collective POD of the
+/// snapshots (rank 0 builds the model, with the same options).
+void share_reduced_model_pod(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options);
 
 /// \brief POD basis, dual dictionary and reduced operators; see the file comment.
 /// Immutable after construction and safe to share between threads.
@@ -124,9 +167,12 @@ class ReducedModel {
   const std::vector<int>& sibling_columns(int p) const {
     return m_siblings[static_cast<size_t>(m_dict_snapshots[static_cast<size_t>(p)])];
   }
-  /// Primal snapshots u − u_lift of the dictionary columns (n_dofs × m), for methods
-  /// that need them (e.g. monolithic dictionaries).
+  /// Primal snapshots u − u_off of the dictionary columns (n_dofs × m), for methods
+  /// that need them (e.g. monolithic dictionaries); n_dofs × 0 when the model does not
+  /// keep them (has_primal_snapshots()).
   const Eigen::MatrixXd& primal_snapshots() const { return m_primal; }
+  /// Whether primal_snapshots() holds one column per dictionary column.
+  bool has_primal_snapshots() const { return m_primal.cols() == m_dict.cols() && m_dict.cols() > 0; }
   /// \brief Reduced coordinates of the dictionary columns' primal snapshots,
   /// \f$ \hat u_p = \Phi^T (u_p - u_{off}(\mu_p)) \f$ (r × m): the best reduced
   /// approximation of each training solution, used to warm-start the online methods.
@@ -193,6 +239,8 @@ class ReducedModel {
 
   /// Offline time spent building the model (POD + reduced operators), seconds.
   double setup_time() const { return m_setup_time; }
+  /// Of which the POD (reading the snapshots included), seconds (0 for a loaded model).
+  double pod_time() const { return m_pod_time; }
 
  private:
   const fom::Problem& m_problem;
@@ -219,7 +267,7 @@ class ReducedModel {
   Eigen::LLT<Eigen::MatrixXd> m_k_llt;
   Eigen::MatrixXd m_k_inv;
   bool m_single_ok = false;
-  double m_setup_time = 0.0;
+  double m_setup_time = 0.0, m_pod_time = 0.0;
 };
 
 /// \brief K̂(μ)⁻¹ for one online query: with a single stiffness term the offline

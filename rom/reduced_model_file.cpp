@@ -8,8 +8,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/format.hpp"
 #include "core/atomic_file.hpp"
 #include "core/errors.hpp"
+#include "core/input_file.hpp"
 #include "core/version.hpp"
 #include "fom/kkt.hpp"
 #include "rom/dense_csv.hpp"
@@ -94,7 +96,9 @@ void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
   for (size_t c = 0; c < d.dictionary_parameters.size(); ++c)
     params.col(static_cast<Eigen::Index>(c)) = d.dictionary_parameters[c];
   write_columns(f, dcpl, "dictionary_parameters", params);
-  write_columns(f, dcpl, "primal_snapshots", d.primal_snapshots);
+  write_columns(f, dcpl, "snapshot_coordinates", d.snapshot_coordinates);
+  // The primal snapshots (n × m, most of the file) only for a method that combines them.
+  if (d.primal_snapshots.cols() > 0) write_columns(f, dcpl, "primal_snapshots", d.primal_snapshots);
   write_problem_record(f, dcpl, record_problem(rom.problem()));
 }
 
@@ -112,7 +116,9 @@ OnlineModel::OnlineModel(std::shared_ptr<const fom::Problem> problem, const Snap
     : m_problem(std::move(problem)), m_method(method), m_options(options) {
   // The method name first: building the model costs a POD.
   check_online_method(method);
-  m_model = std::make_unique<ReducedModel>(*m_problem, db, model_options);
+  ReducedModelOptions kept = model_options;
+  kept.keep_primal_snapshots = online_method_needs_primal_snapshots(method);
+  m_model = std::make_unique<ReducedModel>(*m_problem, db, kept);
   m_solver = make_online_solver(m_method, *m_model, m_options);
 }
 
@@ -125,12 +131,12 @@ void OnlineModel::save(const std::string& path) const {
   try {
     hdf5::write_file(path, [this](hid_t f, hid_t dcpl) { write_model(f, dcpl, *this); });
   } catch (const hdf5::Failure& e) {
-    throw InputError("cannot write reduced model '" + path + "': HDF5 failed on " + e.what());
+    throw InputError("cannot write reduced model " + quoted(path, 200) + ": HDF5 failed on " + e.what());
   }
 }
 
 OnlineModel OnlineModel::load(const std::string& path) {
-  const std::string label = "reduced model '" + path + "'";
+  const std::string label = "reduced model " + quoted(path, 200);
   Handle file(hdf5::open_file(path, "reduced model", "contactrom reduce"), H5Fclose, "the file structure");
   const hid_t f = file.id();
   ReducedModelData d;
@@ -142,7 +148,7 @@ OnlineModel OnlineModel::load(const std::string& path) {
       throw InputError(label + " is not a contactrom reduced model (attribute kind is not '" + kKind +
                        "'; a snapshot database is read with --db, not --rom)");
     const int version = hdf5::read_int_attribute(f, "format_version");
-    if (version != kReducedModelFormatVersion)
+    if (version != kReducedModelFormatVersion && version != 1)
       throw InputError(label + " has format_version " + std::to_string(version) + ", but this contactrom reads version " +
                        std::to_string(kReducedModelFormatVersion) + "; rebuild it with contactrom reduce");
     method = hdf5::read_string_attribute(f, "method");
@@ -151,7 +157,7 @@ OnlineModel OnlineModel::load(const std::string& path) {
       throw hdf5::Refused("attribute delta is " + fom::format_number(d.options.delta) + ", expected a number >= 0");
     const std::string lifting = hdf5::read_string_attribute(f, "lifting");
     if (lifting != "harmonic" && lifting != "dirichlet")
-      throw hdf5::Refused("attribute lifting is '" + lifting + "', expected 'harmonic' or 'dirichlet'");
+      throw hdf5::Refused("attribute lifting is " + quoted(lifting, 200) + ", expected 'harmonic' or 'dirichlet'");
     d.options.lifting = lifting == "dirichlet" ? LiftingKind::Dirichlet : LiftingKind::Harmonic;
     d.options.include_failed_snapshots = hdf5::read_int_attribute(f, "include_failed_snapshots") != 0;
     const std::vector<std::string> keys = hdf5::read_string_list(f, "options/keys", hdf5::file_size(f));
@@ -168,6 +174,9 @@ OnlineModel OnlineModel::load(const std::string& path) {
     hsize_t rows = 0, cols = 0;
     hdf5::read_double_dataset(f, "singular_values", sigma, rows, cols);
     if (cols != 1 || rows < r) throw hdf5::Refused("dataset /singular_values holds fewer values than modes");
+    for (double v : sigma)
+      if (!std::isfinite(v) || v < 0.0)
+        throw hdf5::Refused("dataset /singular_values holds " + fom::format_number(v) + ", expected finite values >= 0");
     d.singular_values = Eigen::Map<Eigen::VectorXd>(sigma.data(), static_cast<Eigen::Index>(rows));
     const auto [nt, n_offset] = shape2(f, "offset");
     const Eigen::MatrixXd offset = read_columns(f, "offset", n, nt);
@@ -187,7 +196,20 @@ OnlineModel OnlineModel::load(const std::string& path) {
     const auto [mp, np] = shape2(f, "dictionary_parameters");
     const Eigen::MatrixXd params = read_columns(f, "dictionary_parameters", np, m);
     for (hsize_t c = 0; c < m; ++c) d.dictionary_parameters.push_back(params.col(static_cast<Eigen::Index>(c)));
-    d.primal_snapshots = read_columns(f, "primal_snapshots", n, m);
+    // Version 1 stored the primal snapshots always and no coordinates; version 2 the
+    // coordinates always and the snapshots only for a method that needs them.
+    bool needs_primal = false;
+    try {
+      needs_primal = online_method_needs_primal_snapshots(method);
+    } catch (const InputError&) {  // an unknown method is reported below, naming the file
+    }
+    if (version == 1 || needs_primal) d.primal_snapshots = read_columns(f, "primal_snapshots", n, m);
+    if (version == 1) {
+      d.snapshot_coordinates = d.basis.transpose() * d.primal_snapshots;
+      if (!needs_primal) d.primal_snapshots.resize(0, 0);
+    } else {
+      d.snapshot_coordinates = read_columns(f, "snapshot_coordinates", r, m);
+    }
     const double scale = std::max(1.0, d.dictionary.size() ? d.dictionary.cwiseAbs().maxCoeff() : 0.0);
     if (d.dictionary.size() && d.dictionary.minCoeff() < -1e-9 * scale)
       throw hdf5::Refused("dataset /dictionary holds a negative pressure");
@@ -195,7 +217,8 @@ OnlineModel OnlineModel::load(const std::string& path) {
     // The surface rows are stored for readers of the file; the model takes them from the basis.
     const auto [r_s, n_s] = shape2(f, "surface_basis");
     if (r_s != r) throw hdf5::Refused("dataset /surface_basis does not hold one row per mode");
-    (void)mp, (void)n_offset, (void)n_s;
+    read_columns(f, "surface_basis", n_s, r);  // its numbers are finite, as every stored number
+    (void)mp, (void)n_offset;
     file.close("file close");
   } catch (const hdf5::Refused& e) {
     throw InputError(label + " is not a valid contactrom reduced model: " + e.what());
@@ -219,12 +242,9 @@ OnlineModel OnlineModel::load(const std::string& path) {
 }
 
 std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::Problem& problem) {
-  std::ifstream in(path);
-  if (!in) throw InputError("parameter file '" + path + "' cannot be opened");
-  std::stringstream text;
-  text << in.rdbuf();
+  // A regular file of at most 256 MiB (millions of queries): never /dev/zero.
+  std::string all = read_input_file(path, "parameter file", std::uintmax_t{1} << 28), header;
   // An optional header naming the components becomes a comment (line numbers kept).
-  std::string all = text.str(), header;
   for (const std::string& name : problem.param_names()) header += (header.empty() ? "" : ",") + name;
   size_t start = 0;
   while (start < all.size()) {
@@ -242,9 +262,9 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
     break;
   }
   std::istringstream lines(all);
-  const Eigen::MatrixXd values = read_dense_csv(lines, "parameter file '" + path + "'");
+  const Eigen::MatrixXd values = read_dense_csv(lines, "parameter file " + quoted(path, 200));
   if (values.cols() != problem.num_params())
-    throw InputError("parameter file '" + path + "' has " + std::to_string(values.cols()) + " values per line, but " +
+    throw InputError("parameter file " + quoted(path, 200) + " has " + std::to_string(values.cols()) + " values per line, but " +
                      problem.name() + " has " + std::to_string(problem.num_params()) + " parameters (" + header + ")");
   std::vector<fom::Param> out;
   for (Eigen::Index i = 0; i < values.rows(); ++i) {
@@ -252,7 +272,7 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
     try {
       problem.check_param(mu);
     } catch (const InputError& e) {
-      throw InputError("parameter file '" + path + "' data row " + std::to_string(i + 1) + ": " + e.what());
+      throw InputError("parameter file " + quoted(path, 200) + " data row " + std::to_string(i + 1) + ": " + e.what());
     }
     out.push_back(mu);
   }
@@ -260,7 +280,11 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
 }
 
 void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results) {
-  write_file_atomically(path, [&](std::ostream& out) {
+  write_file_atomically(path, query_csv_writer(rom, results));
+}
+
+FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResult>& results) {
+  return [&rom, &results](std::ostream& out) {
     for (const std::string& name : rom.problem().param_names()) out << name << ',';
     out << "status,converged,iterations,sparsity,contact_force,time_s,selected,coefficients,penetration,separation\n";
     for (const OnlineResult& res : results) {
@@ -275,7 +299,7 @@ void write_query_csv(const std::string& path, const OnlineModel& rom, const std:
       out << ',' << fom::format_number(res.contact.penetration) << ',' << fom::format_number(res.contact.complementarity)
           << '\n';
     }
-  });
+  };
 }
 
 }  // namespace contactrom::rom

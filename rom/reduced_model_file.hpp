@@ -21,6 +21,7 @@
 #include <memory>
 #include <string>
 
+#include "core/atomic_file.hpp"
 #include "fom/problem.hpp"
 #include "rom/online_solver.hpp"
 #include "rom/online_methods.hpp"
@@ -30,7 +31,9 @@
 namespace contactrom::rom {
 
 /// \brief Version of the reduced-model file layout (attribute `format_version`).
-inline constexpr int kReducedModelFormatVersion = 1;
+/// Version 2 stores the snapshots' reduced coordinates and the primal snapshots only
+/// for a method that needs them; version-1 files are still read.
+inline constexpr int kReducedModelFormatVersion = 2;
 
 /// \brief A reduced model with its online method, ready to query; see the file comment.
 /// Immutable after construction; solve() is thread-safe.
@@ -88,5 +91,8 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
 /// (Σ weights · pressure), time_s (online core), selected (space-separated database
 /// snapshot indices) and coefficients (space-separated, in the order of `selected`).
 void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results);
+
+/// \brief The content of write_query_csv() (for a set of files published together).
+FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResult>& results);
 
 }  // namespace contactrom::rom

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <type_traits>
 
@@ -126,57 +128,267 @@ std::vector<int> SnapshotDatabase::successful_snapshots() const {
   return out;
 }
 
-void write_database(const std::string& path, const SnapshotDatabase& db) {
-  const hsize_t n = static_cast<hsize_t>(db.num_snapshots());
-  if (db.dual.cols() != db.primal.cols() || db.parameters.cols() != db.primal.cols() || db.status.size() != n ||
-      db.iterations.size() != n || db.pairing_iterations.size() != n || db.time_s.size() != n)
-    throw std::invalid_argument("write_database: inconsistent snapshot counts");
-  if (db.lifting_terms.rows() != db.primal.rows())
-    throw std::invalid_argument("write_database: lifting terms and snapshots differ in size");
-  try {
-    hdf5::write_file(path, [&db](hid_t f, hid_t dcpl) {
-      const hsize_t n = static_cast<hsize_t>(db.num_snapshots());
-      const int version = kDatabaseFormatVersion;
-      write_scalar_attribute(f, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &version);
-      write_string_attribute(f, "created_by", db.created_by);
-      write_string_attribute(f, "training_kind", db.training_kind);
-      write_scalar_attribute(f, "training_size", H5T_STD_I32LE, H5T_NATIVE_INT, &db.training_size);
-      write_string_attribute(f, "status_names", "success,no_convergence,numerical_issue,invalid_input");
-      write_scalar_attribute(f, "setup_time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &db.setup_time_s);
-      write_scalar_attribute(f, "wall_time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &db.wall_time_s);
-      write_scalar_attribute(f, "threads", H5T_STD_I32LE, H5T_NATIVE_INT, &db.threads);
+namespace {
 
-      // Column-major width × n_snap == row-major n_snap × width: no transposition.
-      write_dataset(f, dcpl, "parameters", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n,
-                    static_cast<hsize_t>(db.parameters.rows()), db.parameters.data());
-      write_dataset(f, dcpl, "primal", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n, static_cast<hsize_t>(db.primal.rows()),
-                    db.primal.data());
-      write_dataset(f, dcpl, "dual", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n, static_cast<hsize_t>(db.dual.rows()),
-                    db.dual.data());
-      std::vector<int> status(db.status.size());
-      for (size_t j = 0; j < status.size(); ++j) status[j] = static_cast<int>(db.status[j]);
-      write_dataset(f, dcpl, "status", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, status.data());
-      write_dataset(f, dcpl, "iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, db.iterations.data());
-      write_dataset(f, dcpl, "pairing_iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0,
-                    db.pairing_iterations.data());
-      write_dataset(f, dcpl, "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, n, 0, db.time_s.data());
-      write_problem_record(f, dcpl, problem_record(db));
-    });
+/// Every field of `db`, in write_database's layout; the primal snapshots by `write_primal`
+/// (which does nothing when they were streamed into the file).
+void write_fields(hid_t f, hid_t dcpl, const SnapshotDatabase& db, const std::function<void()>& write_primal) {
+  const hsize_t n = static_cast<hsize_t>(db.num_snapshots());
+  const int version = kDatabaseFormatVersion;
+  write_scalar_attribute(f, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &version);
+  write_string_attribute(f, "created_by", db.created_by);
+  write_string_attribute(f, "training_kind", db.training_kind);
+  write_scalar_attribute(f, "training_size", H5T_STD_I32LE, H5T_NATIVE_INT, &db.training_size);
+  write_string_attribute(f, "status_names", "success,no_convergence,numerical_issue,invalid_input");
+  write_scalar_attribute(f, "setup_time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &db.setup_time_s);
+  write_scalar_attribute(f, "wall_time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &db.wall_time_s);
+  write_scalar_attribute(f, "threads", H5T_STD_I32LE, H5T_NATIVE_INT, &db.threads);
+
+  // Column-major width × n_snap == row-major n_snap × width: no transposition.
+  write_dataset(f, dcpl, "parameters", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n,
+                static_cast<hsize_t>(db.parameters.rows()), db.parameters.data());
+  write_primal();
+  write_dataset(f, dcpl, "dual", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, n, static_cast<hsize_t>(db.dual.rows()),
+                db.dual.data());
+  std::vector<int> status(db.status.size());
+  for (size_t j = 0; j < status.size(); ++j) status[j] = static_cast<int>(db.status[j]);
+  write_dataset(f, dcpl, "status", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, status.data());
+  write_dataset(f, dcpl, "iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, db.iterations.data());
+  write_dataset(f, dcpl, "pairing_iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, db.pairing_iterations.data());
+  write_dataset(f, dcpl, "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, n, 0, db.time_s.data());
+  write_problem_record(f, dcpl, problem_record(db));
+}
+
+/// Reads single primal snapshots (dataset rows) of the files of a database left on disk.
+class PrimalRowReader {
+ public:
+  explicit PrimalRowReader(const SnapshotDatabase& db) : m_db(db) {
+    for (const std::string& path : db.primal_files)
+      m_files.push_back(std::make_unique<Handle>(hdf5::open_file(path, "database", "contactrom offline"), H5Fclose,
+                                                 "the file structure"));
+  }
+  /// Primal snapshot j of the database.
+  void read(int j, Eigen::VectorXd& u) const {
+    const SnapshotDatabase::PrimalRef& ref = m_db.primal_refs.at(static_cast<size_t>(j));
+    const std::string& path = m_db.primal_files.at(static_cast<size_t>(ref.file));
+    u.resize(m_db.num_dofs());
+    try {
+      Handle set(H5Dopen2(m_files[static_cast<size_t>(ref.file)]->id(), "primal", H5P_DEFAULT), H5Dclose, "dataset /primal");
+      Handle space(H5Dget_space(set.id()), H5Sclose, "dataset /primal");
+      const hsize_t start[2] = {static_cast<hsize_t>(ref.row), 0}, count[2] = {1, static_cast<hsize_t>(u.size())};
+      hdf5::check(H5Sselect_hyperslab(space.id(), H5S_SELECT_SET, start, nullptr, count, nullptr), "dataset /primal");
+      Handle memory(H5Screate_simple(2, count, nullptr), H5Sclose, "dataset /primal");
+      hdf5::check(H5Dread(set.id(), H5T_NATIVE_DOUBLE, memory.id(), space.id(), H5P_DEFAULT, u.data()), "dataset /primal");
+    } catch (const Hdf5Failure& e) {
+      throw InputError("database '" + path + "' is truncated or corrupt (HDF5 cannot read " + e.what() + ")");
+    }
+    for (Eigen::Index i = 0; i < u.size(); ++i)
+      if (!std::isfinite(u(i)))
+        throw InputError("database '" + path + "' is not a valid contactrom database: dataset /primal row " +
+                         std::to_string(ref.row) + ", column " + std::to_string(i) + " holds " + format_number(u(i)) +
+                         ", expected finite numbers");
+  }
+
+ private:
+  const SnapshotDatabase& m_db;
+  std::vector<std::unique_ptr<Handle>> m_files;
+};
+
+}  // namespace
+
+struct DatabaseWriter::Impl {
+  std::string path, label;
+  int num_dofs = 0, num_snapshots = 0;
+  std::mutex mutex;
+  std::unique_ptr<Handle> file, dcpl, primal;
+};
+
+DatabaseWriter::DatabaseWriter(std::string path, int num_dofs, int num_snapshots, std::string label)
+    : m_impl(std::make_unique<Impl>()) {
+  m_impl->path = std::move(path);
+  m_impl->label = label.empty() ? m_impl->path : std::move(label);
+  m_impl->num_dofs = num_dofs;
+  m_impl->num_snapshots = num_snapshots;
+  hdf5::silence();
+  try {
+    Handle fcpl(H5Pcreate(H5P_FILE_CREATE), H5Pclose, "file creation properties");
+    hdf5::check(H5Pset_obj_track_times(fcpl.id(), false), "file creation properties");
+    Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "file access properties");
+    // The 1.8 format with checksummed metadata, as hdf5::create_memory_file().
+    hdf5::check(H5Pset_libver_bounds(fapl.id(), H5F_LIBVER_V18, H5F_LIBVER_V18), "file access properties");
+    m_impl->file = std::make_unique<Handle>(H5Fcreate(m_impl->path.c_str(), H5F_ACC_TRUNC, fcpl.id(), fapl.id()),
+                                            H5Fclose, "file creation");
+    m_impl->dcpl = std::make_unique<Handle>(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "dataset creation properties");
+    hdf5::check(H5Pset_obj_track_times(m_impl->dcpl->id(), false), "dataset creation properties");
+    Handle primal_dcpl(H5Pcopy(m_impl->dcpl->id()), H5Pclose, "dataset creation properties");
+    // Allocated whole now (its declared size is then within the file's), never filled:
+    // every row is written once.
+    hdf5::check(H5Pset_layout(primal_dcpl.id(), H5D_CONTIGUOUS), "dataset creation properties");
+    hdf5::check(H5Pset_alloc_time(primal_dcpl.id(), H5D_ALLOC_TIME_EARLY), "dataset creation properties");
+    hdf5::check(H5Pset_fill_time(primal_dcpl.id(), H5D_FILL_TIME_NEVER), "dataset creation properties");
+    const hsize_t dims[2] = {static_cast<hsize_t>(num_snapshots), static_cast<hsize_t>(num_dofs)};
+    Handle space(H5Screate_simple(2, dims, nullptr), H5Sclose, "dataset /primal");
+    m_impl->primal = std::make_unique<Handle>(
+        H5Dcreate2(m_impl->file->id(), "primal", H5T_IEEE_F64LE, space.id(), H5P_DEFAULT, primal_dcpl.id(), H5P_DEFAULT),
+        H5Dclose, "dataset /primal");
   } catch (const Hdf5Failure& e) {
-    throw InputError("cannot write database '" + path + "': HDF5 failed on " + e.what());
+    throw InputError("cannot write database '" + m_impl->label + "': HDF5 failed on " + e.what());
   }
 }
 
-SnapshotDatabase read_database(const std::string& path) {
+DatabaseWriter::~DatabaseWriter() = default;
+
+void DatabaseWriter::write_primal(int j, const Eigen::VectorXd& u) {
+  std::lock_guard<std::mutex> lock(m_impl->mutex);
+  if (!m_impl->primal || j < 0 || j >= m_impl->num_snapshots || u.size() != m_impl->num_dofs)
+    throw std::invalid_argument("DatabaseWriter::write_primal: snapshot index or size out of range");
+  try {
+    Handle space(H5Dget_space(m_impl->primal->id()), H5Sclose, "dataset /primal");
+    const hsize_t start[2] = {static_cast<hsize_t>(j), 0}, count[2] = {1, static_cast<hsize_t>(u.size())};
+    hdf5::check(H5Sselect_hyperslab(space.id(), H5S_SELECT_SET, start, nullptr, count, nullptr), "dataset /primal");
+    Handle memory(H5Screate_simple(2, count, nullptr), H5Sclose, "dataset /primal");
+    if (u.size() > 0)
+      hdf5::check(H5Dwrite(m_impl->primal->id(), H5T_NATIVE_DOUBLE, memory.id(), space.id(), H5P_DEFAULT, u.data()),
+                  "dataset /primal");
+  } catch (const Hdf5Failure& e) {
+    throw InputError("cannot write database '" + m_impl->label + "': HDF5 failed on " + e.what() + " (disk full?)");
+  }
+}
+
+void DatabaseWriter::finish(const SnapshotDatabase& db) {
+  std::lock_guard<std::mutex> lock(m_impl->mutex);
+  if (db.num_snapshots() != m_impl->num_snapshots || db.num_dofs() != m_impl->num_dofs)
+    throw std::invalid_argument("DatabaseWriter::finish: the database's sizes differ from the file's");
+  try {
+    write_fields(m_impl->file->id(), m_impl->dcpl->id(), db, [] {});
+    m_impl->primal->close("dataset /primal");
+    m_impl->primal.reset();
+    m_impl->file->close("file close");
+  } catch (const Hdf5Failure& e) {
+    throw InputError("cannot write database '" + m_impl->label + "': HDF5 failed on " + e.what() + " (disk full?)");
+  }
+}
+
+void remove_primal_files(const SnapshotDatabase& db) {
+  for (const std::string& path : db.primal_files) std::remove(path.c_str());
+}
+
+void write_database(const std::string& path, const SnapshotDatabase& db) {
+  const hsize_t n = static_cast<hsize_t>(db.num_snapshots());
+  const hsize_t stored = db.primal_in_memory() ? static_cast<hsize_t>(db.primal.cols()) : db.primal_refs.size();
+  if (db.dual.cols() != db.parameters.cols() || stored != n || db.status.size() != n || db.iterations.size() != n ||
+      db.pairing_iterations.size() != n || db.time_s.size() != n)
+    throw std::invalid_argument("write_database: inconsistent snapshot counts");
+  if (db.lifting_terms.rows() != db.primal.rows())
+    throw std::invalid_argument("write_database: lifting terms and snapshots differ in size");
+  if (!db.primal_in_memory()) {  // snapshot by snapshot through a temporary file
+    check_output_path(path);
+    const std::string tmp = temporary_path_for(path);
+    try {
+      {
+        const PrimalRowReader reader(db);
+        DatabaseWriter writer(tmp, db.num_dofs(), db.num_snapshots(), path);
+        Eigen::VectorXd u;
+        for (int j = 0; j < db.num_snapshots(); ++j) {
+          reader.read(j, u);
+          writer.write_primal(j, u);
+        }
+        writer.finish(db);
+      }
+      commit_temporary(tmp, path);
+    } catch (...) {
+      std::remove(tmp.c_str());
+      throw;
+    }
+    return;
+  }
+  try {
+    hdf5::write_file(path, [&db](hid_t f, hid_t dcpl) {
+      write_fields(f, dcpl, db, [&] {
+        write_dataset(f, dcpl, "primal", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, static_cast<hsize_t>(db.num_snapshots()),
+                      static_cast<hsize_t>(db.primal.rows()), db.primal.data());
+      });
+    });
+  } catch (const Hdf5Failure& e) {
+    throw InputError("cannot write database " + quoted(path, 200) + ": HDF5 failed on " + e.what());
+  }
+}
+
+namespace {
+
+/// Columns `columns` (all if empty) of a matrix in memory.
+class SelectedColumns : public SnapshotBlocks {
+ public:
+  SelectedColumns(const Eigen::MatrixXd& m, std::vector<int> columns) : m_matrix(m), m_columns(std::move(columns)) {
+    if (m_columns.empty())
+      for (Eigen::Index j = 0; j < m.cols(); ++j) m_columns.push_back(static_cast<int>(j));
+  }
+  Eigen::Index rows() const override { return m_matrix.rows(); }
+  Eigen::Index cols() const override { return static_cast<Eigen::Index>(m_columns.size()); }
+  void read_rows(Eigen::Index first, Eigen::Index count, Eigen::MatrixXd& out) const override {
+    out.resize(count, cols());
+    for (Eigen::Index c = 0; c < cols(); ++c) out.col(c) = m_matrix.col(m_columns[static_cast<size_t>(c)]).segment(first, count);
+  }
+
+ private:
+  const Eigen::MatrixXd& m_matrix;
+  std::vector<int> m_columns;
+};
+
+/// Columns on disk, possibly in several files: one DatasetBlocks per file, its
+/// columns scattered into place.
+class ReferencedColumns : public SnapshotBlocks {
+ public:
+  ReferencedColumns(const SnapshotDatabase& db, std::vector<int> columns) : m_rows(db.num_dofs()) {
+    if (columns.empty())
+      for (int j = 0; j < db.num_snapshots(); ++j) columns.push_back(j);
+    std::vector<std::vector<int>> rows(db.primal_files.size());
+    for (int j : columns) {
+      const SnapshotDatabase::PrimalRef& ref = db.primal_refs.at(static_cast<size_t>(j));
+      m_place.push_back({ref.file, static_cast<int>(rows.at(static_cast<size_t>(ref.file)).size())});
+      rows[static_cast<size_t>(ref.file)].push_back(ref.row);
+    }
+    for (size_t f = 0; f < rows.size(); ++f)
+      m_files.push_back(rows[f].empty() ? nullptr : std::make_unique<DatasetBlocks>(db.primal_files[f], "primal", rows[f]));
+  }
+  Eigen::Index rows() const override { return m_rows; }
+  Eigen::Index cols() const override { return static_cast<Eigen::Index>(m_place.size()); }
+  void read_rows(Eigen::Index first, Eigen::Index count, Eigen::MatrixXd& out) const override {
+    std::vector<Eigen::MatrixXd> parts(m_files.size());
+    for (size_t f = 0; f < m_files.size(); ++f)
+      if (m_files[f]) m_files[f]->read_rows(first, count, parts[f]);
+    out.resize(count, cols());
+    for (size_t c = 0; c < m_place.size(); ++c)
+      out.col(static_cast<Eigen::Index>(c)) = parts[static_cast<size_t>(m_place[c].first)].col(m_place[c].second);
+  }
+
+ private:
+  Eigen::Index m_rows;
+  std::vector<std::unique_ptr<DatasetBlocks>> m_files;
+  std::vector<std::pair<int, int>> m_place;  // (file, column among that file's)
+};
+
+}  // namespace
+
+std::unique_ptr<SnapshotBlocks> primal_blocks(const SnapshotDatabase& db, const std::vector<int>& columns) {
+  if (db.primal_in_memory()) return std::make_unique<SelectedColumns>(db.primal, columns);
+  // One file read in order: a single DatasetBlocks.
+  bool identity = db.primal_files.size() == 1;
+  for (int j = 0; identity && j < db.num_snapshots(); ++j) identity = db.primal_refs[static_cast<size_t>(j)].row == j;
+  if (identity) return std::make_unique<DatasetBlocks>(db.primal_files[0], "primal", columns);
+  return std::make_unique<ReferencedColumns>(db, columns);
+}
+
+SnapshotDatabase read_database(const std::string& path, bool load_primal) {
   Handle file(hdf5::open_file(path, "database", "contactrom offline"), H5Fclose, "the file structure");
   SnapshotDatabase db;
   try {
     const hid_t f = file.id();
     if (!has_attribute(f, "format_version"))
-      throw InputError("database '" + path + "' has no format_version attribute; not a contactrom database");
+      throw InputError("database " + quoted(path, 200) + " has no format_version attribute; not a contactrom database");
     const int version = hdf5::read_int_attribute(f, "format_version");
     if (version != kDatabaseFormatVersion)
-      throw InputError("database '" + path + "' has format_version " + std::to_string(version) +
+      throw InputError("database " + quoted(path, 200) + " has format_version " + std::to_string(version) +
                        ", but this contactrom reads version " + std::to_string(kDatabaseFormatVersion) + "; rebuild it with contactrom offline");
     db.created_by = read_string_attribute(f, "created_by");
     db.training_kind = read_string_attribute(f, "training_kind");
@@ -192,7 +404,19 @@ SnapshotDatabase read_database(const std::string& path) {
     if (hdf5::dataset_shape(f, "status").size() != 1) throw hdf5::Refused("dataset /status is not one-dimensional");
     hdf5::read_int_dataset(f, "status", status, n, cols);
     db.parameters = read_matrix(f, "parameters", n);
-    db.primal = read_matrix(f, "primal", n);
+    if (load_primal) {
+      db.primal = read_matrix(f, "primal", n);
+    } else {  // shape only; DatasetBlocks checks the values as it reads them
+      const std::vector<hsize_t> dims = hdf5::dataset_shape(f, "primal");
+      if (dims.size() != 2 || dims[0] != n)
+        throw hdf5::Refused("dataset /primal has " + std::to_string(dims[0]) + " rows, expected " + std::to_string(n) +
+                            " (one per snapshot) and rank 2");
+      if (dims[1] * n > hdf5::file_size(f) / sizeof(double))
+        throw hdf5::Refused("dataset /primal declares more bytes than the file holds");
+      db.primal.resize(static_cast<Eigen::Index>(dims[1]), 0);
+      db.primal_files = {path};
+      for (hsize_t j = 0; j < n; ++j) db.primal_refs.push_back({0, static_cast<int>(j)});
+    }
     db.dual = read_matrix(f, "dual", n);
     db.iterations = read_vector<int>(f, "iterations", n);
     db.pairing_iterations = read_vector<int>(f, "pairing_iterations", n);
@@ -208,13 +432,13 @@ SnapshotDatabase read_database(const std::string& path) {
       throw hdf5::Refused("dataset /parameters has " + std::to_string(db.parameters.rows()) +
                         " columns but param_names lists " + std::to_string(db.param_names.size()));
     if (db.training_kind != "train" && db.training_kind != "level" && db.training_kind != "list")
-      throw hdf5::Refused("attribute training_kind is '" + db.training_kind + "', expected 'train', 'level' or 'list'");
+      throw hdf5::Refused("attribute training_kind is " + quoted(db.training_kind, 200) + ", expected 'train', 'level' or 'list'");
     validate_values(db);
     file.close("file close");
   } catch (const hdf5::Refused& e) {
-    throw InputError("database '" + path + "' is not a valid contactrom database: " + e.what());
+    throw InputError("database " + quoted(path, 200) + " is not a valid contactrom database: " + e.what());
   } catch (const Hdf5Failure& e) {
-    throw InputError("database '" + path + "' is truncated or corrupt (HDF5 cannot read " + e.what() + ")");
+    throw InputError("database " + quoted(path, 200) + " is truncated or corrupt (HDF5 cannot read " + e.what() + ")");
   }
   return db;
 }
@@ -223,21 +447,21 @@ void check_database(const SnapshotDatabase& db, const fom::Problem& problem, con
   check_database_problem(db, problem, path);
   const std::string selector = problem.definition().training.selector();
   if (db.training_kind != selector)
-    throw InputError("database '" + path + "' selects its training set by '" + db.training_kind + "', but " +
-                     problem.name() + " uses '" + selector + "'");
+    throw InputError("database " + quoted(path, 200) + " selects its training set by " + quoted(db.training_kind, 200) + ", but " +
+                     problem.name() + " uses " + quoted(selector, 200));
   check_training_set(db, problem, path);
 }
 
 void check_database_problem(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path) {
   if (db.problem != problem.name())
-    throw InputError("database '" + path + "' was built for problem '" + db.problem + "', not '" + problem.name() + "'");
+    throw InputError("database " + quoted(path, 200) + " was built for problem " + quoted(db.problem, 200) + ", not " + quoted(problem.name(), 200));
   if (db.mesh_fingerprint != problem.fingerprint())
-    throw InputError("database '" + path + "' was built for mesh fingerprint " + db.mesh_fingerprint +
+    throw InputError("database " + quoted(path, 200) + " was built for mesh fingerprint " + db.mesh_fingerprint +
                      " but the current " + problem.name() + " mesh is " + problem.fingerprint() +
                      "; rebuild it with contactrom offline");
   if (db.num_dofs() != problem.num_dofs() || db.num_constraints() != problem.contact().num_constraints() ||
       db.parameters.rows() != problem.num_params())
-    throw InputError("database '" + path + "' holds " + std::to_string(db.num_dofs()) + " dofs, " +
+    throw InputError("database " + quoted(path, 200) + " holds " + std::to_string(db.num_dofs()) + " dofs, " +
                      std::to_string(db.num_constraints()) + " contact rows and " +
                      std::to_string(db.parameters.rows()) + " parameters, but " + problem.name() + " has " +
                      std::to_string(problem.num_dofs()) + ", " + std::to_string(problem.contact().num_constraints()) +
@@ -249,7 +473,7 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
     try {
       problem.check_param(db.parameter(j));
     } catch (const InputError& e) {
-      throw InputError("database '" + path + "' dataset /parameters row " + std::to_string(j) + ": " + e.what());
+      throw InputError("database " + quoted(path, 200) + " dataset /parameters row " + std::to_string(j) + ": " + e.what());
     }
   }
   const std::string option = db.training_kind == "level" ? "level " : db.training_kind == "list" ? "the list of " : "training size ";
@@ -257,10 +481,10 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
   try {
     expected = fom::training_set(problem, db.training_size);
   } catch (const InputError& e) {
-    throw InputError("database '" + path + "' attribute training_size: " + e.what());
+    throw InputError("database " + quoted(path, 200) + " attribute training_size: " + e.what());
   }
   const auto mismatch = [&](const std::string& why) {
-    return InputError("database '" + path + "' claims " + option + std::to_string(db.training_size) + " of " +
+    return InputError("database " + quoted(path, 200) + " claims " + option + std::to_string(db.training_size) + " of " +
                       problem.name() + ", but " + why + "; expected the snapshots of that training set");
   };
   if (static_cast<int>(expected.size()) != db.num_snapshots())
@@ -277,8 +501,12 @@ void describe_problem(const fom::Problem& problem, SnapshotDatabase& db) {
   set_problem_record(db, record_problem(problem));
 }
 
+std::unique_ptr<fom::Problem> rebuild_database_problem(const SnapshotDatabase& db, const std::string& path) {
+  return rebuild_problem(problem_record(db), "database " + quoted(path, 200));
+}
+
 std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, const std::string& path) {
-  auto problem = rebuild_problem(problem_record(db), "database '" + path + "'");
+  auto problem = rebuild_database_problem(db, path);
   check_database(db, *problem, path);
   return problem;
 }

@@ -29,6 +29,7 @@
 
 #include "core/errors.hpp"
 #include "fom/problem.hpp"
+#include "rom/snapshot_blocks.hpp"
 
 namespace contactrom::rom {
 
@@ -52,7 +53,22 @@ struct SnapshotDatabase {
   int training_size = 0;                  ///< n of `--train n` or `--level n`
   std::vector<std::string> param_names;   ///< names of the parameter components
   Eigen::MatrixXd parameters;             ///< n_params × n_snap, column j = μ_j
-  Eigen::MatrixXd primal;                 ///< n_dofs × n_snap, u(μ_j) − u_lift(μ_j) (zero on Dirichlet dofs)
+  /// n_dofs × n_snap, u(μ_j) − u_lift(μ_j) (zero on Dirichlet dofs); n_dofs × 0 when
+  /// they are left on disk (primal_files).
+  Eigen::MatrixXd primal;
+  /// Where a primal snapshot on disk is: row `row` of the `/primal` dataset of
+  /// primal_files[file].
+  struct PrimalRef {
+    int file = 0;
+    int row = 0;
+    bool operator==(const PrimalRef& o) const { return file == o.file && row == o.row; }
+  };
+  /// Files holding the primal snapshots when they are not in memory (a database read
+  /// with read_database(path, false), the parts of a streamed offline run); empty when
+  /// `primal` holds them.
+  std::vector<std::string> primal_files;
+  /// With primal_files: where each snapshot's primal is (one per snapshot).
+  std::vector<PrimalRef> primal_refs;
   Eigen::MatrixXd dual;                   ///< n_c × n_snap, contact pressures λ(μ_j)
   std::vector<Status> status;             ///< FOM outcome of each snapshot
   std::vector<int> iterations;            ///< FOM active-set iterations of each snapshot
@@ -62,7 +78,9 @@ struct SnapshotDatabase {
   double wall_time_s = 0.0;               ///< wall time of the whole offline run (s)
   int threads = 1;                        ///< worker threads of the offline run
 
-  int num_snapshots() const { return static_cast<int>(primal.cols()); }
+  int num_snapshots() const { return static_cast<int>(parameters.cols()); }
+  /// Whether the primal snapshots are in memory (else in primal_file).
+  bool primal_in_memory() const { return primal_files.empty(); }
   int num_dofs() const { return static_cast<int>(primal.rows()); }
   int num_constraints() const { return static_cast<int>(dual.rows()); }
   /// Parameter of snapshot j.
@@ -73,10 +91,49 @@ struct SnapshotDatabase {
 
 /// \brief Writes `db` to `path` (HDF5) atomically: the file is built in memory,
 /// written to a temporary file next to `path` and renamed over it once complete.
+/// A database whose primal snapshots are on disk (primal_files) is written through
+/// a DatabaseWriter instead, one snapshot at a time, to the temporary file.
 /// \throws InputError naming `path` and the reason if the target is refused
 ///   (core/atomic_file.hpp: a link, folder or device), the folder is not writable
 ///   or the disk is full; no partial file is left behind.
 void write_database(const std::string& path, const SnapshotDatabase& db);
+
+/// \brief A database file written on disk snapshot by snapshot, so that no process
+/// holds all the primal snapshots at once (the offline stage streams them as it
+/// computes them; write_database() copies snapshots left on disk through it).
+///
+/// The file is created at `path` itself (callers write to a temporary path and
+/// rename it: core/atomic_file.hpp) in the same layout as write_database's, with
+/// `/primal` allocated whole up front (contiguous, uncompressed); write_primal()
+/// fills its rows in any order, finish() writes everything else and closes it.
+/// The arrays equal those write_database() writes for the same database.
+class DatabaseWriter {
+ public:
+  /// \brief Creates `path` with room for `num_snapshots` primal snapshots of `num_dofs` values.
+  /// \param label the database named in error messages (default: `path`), e.g. the
+  ///   target a temporary file becomes.
+  /// \throws InputError naming `label` if it cannot be created.
+  DatabaseWriter(std::string path, int num_dofs, int num_snapshots, std::string label = "");
+  /// Closes the file if finish() was not called (the caller removes it).
+  ~DatabaseWriter();
+  DatabaseWriter(const DatabaseWriter&) = delete;
+  DatabaseWriter& operator=(const DatabaseWriter&) = delete;
+
+  /// \brief Writes primal snapshot j (0 ≤ j < num_snapshots). Thread-safe (serialised).
+  /// \throws InputError naming the file if the write fails (disk full).
+  void write_primal(int j, const Eigen::VectorXd& u);
+  /// \brief Writes every other field of `db` (its own primal is not read), then closes the file.
+  /// \throws InputError naming the file if a write or the close fails.
+  void finish(const SnapshotDatabase& db);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> m_impl;
+};
+
+/// \brief Deletes the files of `db.primal_files` (the temporary parts of a streamed run,
+/// once written into their database). Errors are ignored.
+void remove_primal_files(const SnapshotDatabase& db);
 
 /// \brief Reads a database written by write_database.
 /// \throws InputError (one line, naming `path`) if the file is missing, is not an
@@ -84,7 +141,15 @@ void write_database(const std::string& path, const SnapshotDatabase& db);
 ///   inconsistent dataset sizes or an attribute of the wrong shape or type, declares
 ///   a dataset larger than the file, or holds values no offline run writes
 ///   (non-finite numbers, negative pressures, times or counts).
-SnapshotDatabase read_database(const std::string& path);
+/// \param load_primal false: the primal snapshots stay on disk (`primal` gets 0 columns,
+///   `primal_files` = {path}); primal_blocks() reads them by blocks and write_database()
+///   copies them row by row, checking them as they go.
+SnapshotDatabase read_database(const std::string& path, bool load_primal = true);
+
+/// \brief The primal snapshots of `db` (n_dofs × n_snap) by blocks of rows: from memory,
+/// or from `db.primal_files`, restricted to `columns` (database snapshot indices, in
+/// order; empty: all). The database must outlive the source.
+std::unique_ptr<SnapshotBlocks> primal_blocks(const SnapshotDatabase& db, const std::vector<int>& columns = {});
 
 /// \brief Checks that `db` (read from `path`) was built for `problem`: same
 /// problem name, same mesh fingerprint (mesh + problem options), same numbers of
@@ -99,8 +164,12 @@ void check_database(const SnapshotDatabase& db, const fom::Problem& problem, con
 void check_database_problem(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path);
 
 /// \brief Rebuilds the problem from the database alone (problem-file text and mesh;
-/// `rope` by name) and checks that it matches (check_database).
+/// `rope` by name), whatever snapshots it holds (a part of a run, for `merge`).
 /// \throws InputError naming `path` if the stored problem cannot be rebuilt.
+std::unique_ptr<fom::Problem> rebuild_database_problem(const SnapshotDatabase& db, const std::string& path);
+
+/// \brief rebuild_database_problem(), then check_database(): the database must be
+/// that problem's complete training set, in order.
 std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, const std::string& path);
 
 /// \brief Fills the problem fields of `db` (name, fingerprint, text, mesh, contact

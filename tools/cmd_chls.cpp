@@ -53,7 +53,7 @@ struct ChlsArgs {
 };
 
 void run_chls(const ChlsArgs& a) {
-  if (!a.out.empty()) check_output_path(a.out);
+  if (!a.out.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.db});
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
   const rom::DatabaseChls chls = rom::chls_of_database(db);
@@ -110,7 +110,7 @@ struct HullArgs {
 };
 
 void run_hull_report(const HullArgs& a) {
-  if (!a.out.empty()) check_output_path(a.out);
+  if (!a.out.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.db});
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
   rom::check_convex_hull_applicable(*problem);

@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "core/format.hpp"
 #include "core/errors.hpp"
 #include "core/stopwatch.hpp"
 #include "fom/active_set_solver.hpp"
@@ -87,7 +88,7 @@ void run_demo(const DemoArgs& a) {
   } else {
     std::error_code ec;
     fs::create_directories(dir, ec);
-    if (ec || !fs::is_directory(dir)) throw InputError("cannot create folder '" + dir + "'");
+    if (ec || !fs::is_directory(dir)) throw InputError("cannot create folder " + quoted(dir, 200));
   }
   struct Remove {
     std::string dir;

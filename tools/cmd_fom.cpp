@@ -7,9 +7,11 @@
 #include <nlohmann/json.hpp>
 
 #include "baselines/ipopt_qp.hpp"
+
+#include "core/format.hpp"
 #include "fom/active_set_solver.hpp"
+#include "fom/contact_checks.hpp"
 #include "fom/field_output.hpp"
-#include "fom/kkt.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 
@@ -27,6 +29,8 @@ void run_fom(const FomArgs& a) {
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);
   const fom::Param mu = parse_problem_param(*problem, a.param);
+  const std::vector<std::string> warnings = fom::reference_contact_warnings(*problem);
+  for (const std::string& w : warnings) std::cerr << "contactrom: warning: " << w << "\n";
   fom::FomSolution sol;
   double setup = 0.0;
   if (a.solver == "active-set") {
@@ -41,9 +45,9 @@ void run_fom(const FomArgs& a) {
   // A failed solve may carry no field at all (its status and message say why).
   const bool has_fields = sol.u.size() == problem->num_dofs() && sol.lambda.size() == problem->contact().num_constraints();
   if (!has_fields)
-    throw InputError("the " + a.solver + " solver returned no solution for problem '" + problem->name() + "' (status " +
+    throw InputError("the " + a.solver + " solver returned no solution for problem " + quoted(problem->name(), 200) + " (status " +
                      to_string(sol.status) + (sol.message.empty() ? "" : ": " + sol.message) + ")");
-  const fom::KktResiduals kkt = fom::kkt_residuals(*problem, mu, sol.u, sol.lambda);
+  const fom::KktResiduals& kkt = sol.kkt;  // the residuals the status was certified with
   if (!a.out.empty()) {
     fom::write_fields(a.out, problem->name(), *problem, mu, sol.u, sol.lambda);
   }
@@ -62,6 +66,7 @@ void run_fom(const FomArgs& a) {
   j["setup_time_s"] = setup;
   j["contact_force"] = fom::contact_force(*problem, sol.lambda);
   j["kkt"] = kkt_json(kkt);
+  j["warnings"] = warnings;
   if (a.json) {
     std::cout << j.dump() << std::endl;
     return;

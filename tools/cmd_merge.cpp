@@ -1,10 +1,11 @@
 // contactrom merge A.h5 B.h5 ... --out C.h5 [--json]
 // Concatenates databases of the same problem and training set (e.g. the parts of
-// `contactrom offline --part k/K`) in the order given; refuses databases of another
+// `contactrom offline --part k/K`), sorted into the order of their training set; refuses databases of another
 // problem, mesh or training set and repeated parameters (rom/database_merge.hpp).
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "core/atomic_file.hpp"
 #include "rom/database_merge.hpp"
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"
@@ -19,9 +20,12 @@ struct MergeArgs {
 };
 
 void run_merge(const MergeArgs& a) {
+  check_output_path(a.out);
+  check_output_not_input(a.out, a.inputs);
   std::vector<rom::SnapshotDatabase> dbs;
-  for (const auto& path : a.inputs) dbs.push_back(rom::read_database(path));
-  const rom::SnapshotDatabase merged = rom::merge_databases(dbs, a.inputs);
+  // The primal snapshots stay on disk: the merged file is written one snapshot at a time.
+  for (const auto& path : a.inputs) dbs.push_back(rom::read_database(path, false));
+  const rom::SnapshotDatabase merged = rom::merge_in_training_order(dbs, a.inputs);
   rom::write_database(a.out, merged);
   if (a.json) {
     nlohmann::json j;
@@ -39,7 +43,7 @@ void run_merge(const MergeArgs& a) {
 CommandRegistrar reg("merge", [](CLI::App& app) {
   auto args = std::make_shared<MergeArgs>();
   auto* sub = app.add_subcommand("merge", "Concatenate snapshot databases of the same problem and training set");
-  sub->add_option("inputs", args->inputs, "databases (.h5), in the order of their snapshots")->required();
+  sub->add_option("inputs", args->inputs, "databases (.h5), in any order (the snapshots are sorted into training order)")->required();
   sub->add_option("--out", args->out, "merged database (.h5)")->required();
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_merge(*args); });

@@ -18,7 +18,9 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "core/format.hpp"
 #include "core/errors.hpp"
+#include "fom/contact_checks.hpp"
 #include "rom/database_merge.hpp"
 #include "rom/offline.hpp"
 #ifdef CONTACTROM_HAVE_MPI
@@ -54,10 +56,18 @@ std::vector<fom::Param> training_part(const std::vector<fom::Param>& params, con
   int k = 0, parts = 0;
   char tail = 0;
   if (std::sscanf(text.c_str(), "%d/%d%c", &k, &parts, &tail) != 2)
-    throw InputError("--part '" + text + "' invalid; expected k/K, e.g. 1/4");
+    throw InputError("--part " + quoted(text, 200) + " invalid; expected k/K, e.g. 1/4");
   const auto [begin, end] = rom::part_range(static_cast<int>(params.size()), k, parts);
   return std::vector<fom::Param>(params.begin() + begin, params.begin() + end);
 }
+
+/// Removes the file of a streamed part when the run ends (a no-op once it was renamed into place).
+struct TemporaryPart {
+  std::string path;
+  TemporaryPart(const TemporaryPart&) = delete;
+  TemporaryPart& operator=(const TemporaryPart&) = delete;
+  ~TemporaryPart() { std::remove(path.c_str()); }
+};
 
 /// Rank and size of the MPI run this process belongs to ({0, 1} when serial).
 struct Ranks {
@@ -96,14 +106,25 @@ void run_offline(const OfflineArgs& a) {
   const bool appending = !a.append.empty();
   const std::string& out = appending ? a.append : a.out;
   check_output_path(out);  // before the snapshots are computed (every rank: all refuse alike)
+  if (!appending) check_output_not_input(out, {a.problem});
   fom::ProblemOptions popt;
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);
+  if (ranks.root())
+    for (const std::string& w : fom::reference_contact_warnings(*problem)) std::cerr << "contactrom: warning: " << w << "\n";
   const fom::SamplingPlan& plan = problem->definition().training;
+  // Two runs appending to one database at once would each read, extend and
+  // rename it, and one's snapshots would be lost: the second waits for the first
+  // (the lock is held until the file is written).
+  std::unique_ptr<FileLock> lock;
+  if (appending && ranks.root())
+    lock = std::make_unique<FileLock>(a.append, [&] {
+      std::cerr << "contactrom: waiting for another run that is updating " << quoted(a.append, 200) << "\n";
+    });
   // The database appended to is read on every rank (all refuse alike) and checked
   // against the run before any snapshot is computed.
   rom::SnapshotDatabase existing;
-  if (appending) existing = rom::read_database(a.append);
+  if (appending) existing = rom::read_database(a.append, false);
   // --append without --train/--level: the database's training set.
   const bool size_from_db = appending && !a.train && !a.level && plan.selector() != "list";
   const int n = size_from_db ? existing.training_size
@@ -114,6 +135,18 @@ void run_offline(const OfflineArgs& a) {
   if (appending) {
     rom::check_appendable(existing, a.append, *problem, plan.selector(), n);
     params = rom::parameters_not_in(existing, params);
+    // Snapshots out of training order (parts merged in the wrong order by an older
+    // contactrom) are put in order, as a whole run would have them.
+    const rom::SnapshotDatabase sorted = rom::sorted_by_training(existing, a.append, training);
+    if (params.empty() && sorted.parameters != existing.parameters) {
+      write_on_root(out, [&]() -> const rom::SnapshotDatabase& { return sorted; }, ranks);
+      if (ranks.root()) std::cout << (a.json ? nlohmann::json{{"problem", problem->name()}, {"snapshots", 0},
+                                                              {"total_snapshots", existing.num_snapshots()},
+                                                              {"out", out}, {"reordered", true}}.dump()
+                                             : a.append + " holds these snapshots; rewritten in training order")
+                                  << std::endl;
+      return;
+    }
     if (params.empty()) {  // every rank knows it: none computes, the file is left as it is
       if (ranks.root()) std::cout << (a.json ? nlohmann::json{{"problem", problem->name()}, {"snapshots", 0},
                                                               {"total_snapshots", existing.num_snapshots()},
@@ -129,6 +162,12 @@ void run_offline(const OfflineArgs& a) {
   rom::ProgressBar bar(std::cerr, label, ranks.root() && (a.progress || ::isatty(STDERR_FILENO)));
   rom::OfflineOptions options;
   options.threads = a.threads;
+  // Snapshots are streamed to a file of this process as they are computed; it
+  // becomes the database (serial), or is copied into it (append, MPI ranks), and is
+  // removed when this function ends.
+  options.stream_to = temporary_path_for(out);
+  options.stream_label = out;
+  const TemporaryPart part{options.stream_to};
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
   const std::string kind = plan.selector();
 #ifdef CONTACTROM_HAVE_MPI
@@ -144,6 +183,9 @@ void run_offline(const OfflineArgs& a) {
     if (appending) appended = rom::append_snapshots(existing, a.append, db, training);
     return appending ? appended : db;
   };
+  if (!appending && ranks.size == 1) {  // the streamed file is the database: publish it as it is
+    commit_temporary(options.stream_to, out);
+  }
   if (!ranks.root()) {
     write_on_root(out, result, ranks);
     return;
@@ -157,7 +199,7 @@ void run_offline(const OfflineArgs& a) {
               << ") status " << to_string(db.status[j]) << "; stored with its status and left out of the ROM\n";
   }
   const int stored = appending ? existing.num_snapshots() : 0;
-  write_on_root(out, result, ranks);
+  if (appending || ranks.size > 1) write_on_root(out, result, ranks);
 
   double fom_sum = 0.0;
   for (double t : db.time_s) fom_sum += t;

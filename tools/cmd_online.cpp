@@ -15,6 +15,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "core/format.hpp"
 #include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 #include "fom/active_set_solver.hpp"
@@ -136,11 +137,11 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
 }
 
 void run_online(const OnlineArgs& a) {
-  if (!a.out.empty() && a.param.empty()) check_output_path(a.out);
+  if (!a.out.empty() && a.param.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.db});
   if (!a.param.empty() && a.validation)
     throw InputError("--param and --validation exclude each other; give one");
   if (!a.param.empty() && a.out.size() >= 4 && a.out.compare(a.out.size() - 4, 4, ".csv") == 0)
-    throw InputError("--out '" + a.out + "' with --param names the folder of the VTU/CSV fields, not a CSV file; "
+    throw InputError("--out " + quoted(a.out, 200) + " with --param names the folder of the VTU/CSV fields, not a CSV file; "
                      "expected a folder name (a CSV of results comes from --validation or contactrom query --out)");
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);

@@ -44,7 +44,7 @@ nlohmann::json result_json(const rom::OnlineModel& rom, const rom::OnlineResult&
 
 void run_query(const QueryArgs& a) {
   if (a.param.empty() == a.params.empty()) throw InputError("give exactly one of --param V and --params FILE.csv");
-  if (!a.out.empty()) check_output_path(a.out);
+  if (!a.out.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.rom, a.params});
   const auto t0 = std::chrono::steady_clock::now();
   const rom::OnlineModel rom = rom::OnlineModel::load(a.rom);
   const double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -59,12 +59,18 @@ void run_query(const QueryArgs& a) {
     times.push_back(results.back().time_s);
     if (results.back().status != Status::Success) ++failed;
   }
-  if (!a.out.empty()) rom::write_query_csv(a.out, rom, results);
+  // The CSV and every field file are published together, or none of them.
   if (!a.fields.empty()) {
     const std::string stem = problem.name() + "_" + rom.method();
+    std::vector<fom::FieldSet> sets;
     for (size_t i = 0; i < results.size(); ++i)
-      fom::write_fields(a.fields, results.size() == 1 ? stem : stem + "_" + std::to_string(i), problem, results[i].mu,
-                        results[i].u, results[i].lambda);
+      sets.push_back({results.size() == 1 ? stem : stem + "_" + std::to_string(i), results[i].mu, &results[i].u,
+                      &results[i].lambda});
+    std::vector<std::pair<std::string, FileWriter>> csv;
+    if (!a.out.empty()) csv.emplace_back(a.out, rom::query_csv_writer(rom, results));
+    fom::write_field_sets(a.fields, problem, sets, csv);
+  } else if (!a.out.empty()) {
+    rom::write_query_csv(a.out, rom, results);
   }
   nlohmann::json j;
   j["problem"] = problem.name();

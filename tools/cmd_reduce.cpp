@@ -1,4 +1,5 @@
-// contactrom reduce --db DB.h5 --method M [--delta D] [--option K=V]... --out ROM.h5 [--json]
+// contactrom reduce --db DB.h5 --method M [--delta D] [--option K=V]... --out ROM.h5 [--threads T] [--json]
+//   mpirun -np N contactrom reduce ...   (built with CONTACTROM_MPI): the ranks share the POD
 // Builds the reduced model (POD basis, dual dictionary, reduced operators) and its
 // online method from a snapshot database and writes it to a reduced-model file,
 // which `contactrom query` (and Python's contactrom.ReducedModel.load) answer
@@ -12,6 +13,10 @@
 #include "rom/online_methods.hpp"
 #include "rom/reduced_model_file.hpp"
 #include "rom/snapshot_database.hpp"
+#ifdef CONTACTROM_HAVE_MPI
+#include "rom/offline_mpi.hpp"
+#include "rom/pod_mpi.hpp"
+#endif
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 
@@ -20,16 +25,37 @@ namespace {
 
 struct ReduceArgs : MethodArgs {
   std::string db, out;
+  int threads = 0;
+  std::string pod = "auto";
   bool json = false;
 };
 
 void run_reduce(const ReduceArgs& a) {
   check_output_path(a.out);
+  check_output_not_input(a.out, {a.db});
   rom::check_online_method(a.method);
   const auto t0 = std::chrono::steady_clock::now();
-  const rom::SnapshotDatabase db = rom::read_database(a.db);
+  // The primal snapshots stay on disk: the POD reads them by blocks (rom/pod.hpp).
+  const rom::SnapshotDatabase db = rom::read_database(a.db, false);
   std::shared_ptr<const fom::Problem> problem = rom::problem_from_database(db, a.db);
-  const rom::OnlineModel rom(problem, db, a.model_options(), a.method, a.solver_options());
+  rom::ReducedModelOptions model_options = a.model_options();
+  model_options.pod.threads = a.threads;
+  model_options.pod.algorithm = a.pod == "svd"         ? rom::PodAlgorithm::Svd
+                                : a.pod == "snapshots" ? rom::PodAlgorithm::Snapshots
+                                                       : rom::PodAlgorithm::Auto;
+#ifdef CONTACTROM_HAVE_MPI
+  // Under mpirun the ranks share the POD (rom/pod_mpi.hpp); rank 0 builds and writes the model.
+  std::unique_ptr<rom::mpi::WorldPodReduction> ranks;
+  if (rom::mpi::active() && rom::mpi::world_size() > 1) {
+    ranks = std::make_unique<rom::mpi::WorldPodReduction>();
+    model_options.pod.reduction = ranks.get();
+    if (ranks->rank() != 0) {
+      rom::share_reduced_model_pod(*problem, db, model_options);
+      return;
+    }
+  }
+#endif
+  const rom::OnlineModel rom(problem, db, model_options, a.method, a.solver_options());
   warn_if_no_primal_modes(rom.model());
   rom.save(a.out);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -46,6 +72,7 @@ void run_reduce(const ReduceArgs& a) {
   j["out"] = a.out;
   j["bytes"] = ec ? 0 : bytes;
   j["time_s"] = seconds;
+  j["pod_time_s"] = rom.model().pod_time();
   if (a.json) {
     std::cout << j.dump() << std::endl;
     return;
@@ -63,6 +90,11 @@ CommandRegistrar reg("reduce", [](CLI::App& app) {
       ->check(non_empty_path())->required();
   add_method_options(sub, *args);
   sub->add_option("--out", args->out, "reduced-model file to write (HDF5)")->check(non_empty_path())->required();
+  sub->add_option("--pod", args->pod,
+                  "POD algorithm: auto (svd up to 2^24 snapshot entries, else snapshots), svd (BDCSVD in memory) or "
+                  "snapshots (method of snapshots with a Rayleigh-Ritz step, read by blocks)")
+      ->check(CLI::IsMember({"auto", "svd", "snapshots"}));
+  add_integer(sub, "--threads", args->threads, "worker threads of the POD (default: hardware concurrency)", 1, 1024);
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_reduce(*args); });
 });

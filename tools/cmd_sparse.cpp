@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "core/format.hpp"
 #include "core/errors.hpp"
 #include "core/nnls.hpp"
 #include "rom/dense_csv.hpp"
@@ -128,7 +129,7 @@ void check_gram_fits(const SparseArgs& args, const MatrixXd& d) {
 
 void run_sparse(const SparseArgs& args, bool has_tol, bool has_max_iter, bool has_atoms) {
   if (args.method != "nnls" && args.method != "omp" && args.method != "focuss" && args.method != "nnfocuss") {
-    throw InputError("unknown --method '" + args.method + "': expected nnls, omp, focuss or nnfocuss");
+    throw InputError("unknown --method " + contactrom::quoted(args.method, 200) + ": expected nnls, omp, focuss or nnfocuss");
   }
   if (has_atoms && args.method != "omp") {
     throw InputError("--atoms " + std::to_string(args.atoms) + " given with --method " + args.method +
@@ -146,8 +147,8 @@ void run_sparse(const SparseArgs& args, bool has_tol, bool has_max_iter, bool ha
   const MatrixXd d = contactrom::rom::read_dense_csv(args.dictionary);
   const VectorXd x = contactrom::rom::read_vector_csv(args.signal);
   if (x.size() != d.rows()) {
-    throw InputError("signal '" + args.signal + "' has " + std::to_string(x.size()) + " values, expected " +
-                     std::to_string(d.rows()) + " (the rows of dictionary '" + args.dictionary + "')");
+    throw InputError("signal " + contactrom::quoted(args.signal, 200) + " has " + std::to_string(x.size()) + " values, expected " +
+                     std::to_string(d.rows()) + " (the rows of dictionary " + contactrom::quoted(args.dictionary, 200) + ")");
   }
 
   check_gram_fits(args, d);

@@ -24,6 +24,7 @@
 #include "baselines/kkt_verifier.hpp"
 #include "baselines/reduced_active_set.hpp"
 #include "baselines/verification.hpp"
+#include "core/format.hpp"
 #include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 #include "fom/active_set_solver.hpp"
@@ -136,7 +137,7 @@ baselines::VerifyOptions verify_options(const VerifyArgs& a) {
   baselines::VerifyOptions options;
   options.methods = methods_of(a);
   if (a.reference != "ipopt" && a.reference != "fom")
-    throw InputError("--reference '" + a.reference + "' unknown; expected ipopt or fom");
+    throw InputError("--reference " + quoted(a.reference, 200) + " unknown; expected ipopt or fom");
   options.reference = a.reference;
   options.threads = a.threads;
   options.bench = a.bench;
@@ -215,7 +216,7 @@ void print_text(const VerifyArgs& a, const rom::SnapshotDatabase& db, const rom:
 }
 
 void run_verify(const VerifyArgs& a) {
-  if (!a.out.empty()) check_output_path(a.out);
+  if (!a.out.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.db});
   baselines::VerifyOptions options = verify_options(a);
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);

@@ -13,6 +13,7 @@
 #include <new>
 #include <stdexcept>
 
+#include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 #include "core/version.hpp"
 #include "fom/input_values.hpp"
@@ -33,6 +34,8 @@ int main(int argc, char** argv) {
   CLI::App app{"contactrom: sparse dictionary reduced-order models for frictionless contact"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "contactrom " + version());
+  // An interrupted run leaves no temporary file behind (core/atomic_file.hpp).
+  remove_temporaries_on_signals();
   auto& table = cli::command_table();
   std::sort(table.begin(), table.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   for (auto& entry : table) entry.setup(app);

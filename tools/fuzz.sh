@@ -17,7 +17,7 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
   CC=${CC:-clang} CXX=${CXX:-clang++} cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DCONTACTROM_FUZZ=ON -DCONTACTROM_BUILD_TESTS=OFF >/dev/null || exit 100
 fi
-targets="fuzz_csv fuzz_database"
+targets="fuzz_csv fuzz_database fuzz_msh"
 [ -f "$root/fom/problem_file.hpp" ] && targets="$targets fuzz_problem_file"
 [ -f "$root/rom/reduced_model_file.hpp" ] && targets="$targets fuzz_reduced_model"
 [ $# -gt 2 ] && { shift 2; targets="$*"; }
@@ -33,7 +33,7 @@ triage() {
   frames=$(printf '%s\n' "$report" | grep -E '^ +#[0-9]+ ')
   [ -z "$frames" ] && { echo "not reproduced"; return; }
   first=$(printf '%s\n' "$frames" | grep -vE ' in (__interceptor_|__asan|__sanitizer|__ubsan|__lsan|malloc|calloc|realloc|free|memcpy|memmove|memset|strlen|operator new|operator delete|fuzzer::)|libc\.so|sysdeps/|libFuzzer|StaticAlarmHandler' | head -1)
-  case "$first" in *libhdf5*) echo libhdf5 ;; *) echo contactrom ;; esac
+  case "$first" in *libhdf5*) echo libhdf5 ;; *libgmsh* | *libOCC* | *libTK*) echo libgmsh ;; *) echo contactrom ;; esac
 }
 
 for target in $targets; do
@@ -48,7 +48,7 @@ for target in $targets; do
   # itself crashes, hangs or runs out of memory on some corrupted files
   # (fuzz/README.md); each finding is then replayed and attributed below.
   mode=""
-  case "$target" in fuzz_database | fuzz_reduced_model) mode="-fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1" ;; esac
+  case "$target" in fuzz_database | fuzz_reduced_model | fuzz_msh) mode="-fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1" ;; esac
   # -timeout: a single input running longer than 30 s is reported as a hang.
   # shellcheck disable=SC2086
   "$build/fuzz/$target" "$work" $mode -max_total_time="$seconds" -timeout=30 -rss_limit_mb=4096 \
@@ -60,12 +60,12 @@ for target in $targets; do
   for artifact in "$findings"/crash-* "$findings"/leak-* "$findings"/oom-* "$findings"/timeout-* "$findings"/slow-unit-*; do
     [ -f "$artifact" ] || continue
     case $(triage "$build/fuzz/$target" "$artifact") in
-      libhdf5) theirs=$((theirs + 1)) ;;
+      libhdf5 | libgmsh) theirs=$((theirs + 1)) ;;
       contactrom) ours=$((ours + 1)); echo "  $artifact: in contactrom's code" ;;
       *) lost=$((lost + 1)) ;;
     esac
   done
-  summary="$target: ${runs:-?} runs in ${seconds} s; findings in contactrom: $ours, inside libhdf5: $theirs, not reproduced: $lost"
+  summary="$target: ${runs:-?} runs in ${seconds} s; findings in contactrom: $ours, inside libhdf5/libgmsh: $theirs, not reproduced: $lost"
   # In fork mode libFuzzer goes on after a finding: the attribution decides.
   passed=$([ -n "$mode" ] && echo $((ours == 0)) || echo $((rc == 0)))
   if [ "$passed" = 1 ]; then

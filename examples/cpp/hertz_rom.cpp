@@ -1,9 +1,16 @@
 // Solves the `hertz` problem with the full-order model and with reduced models
 // built from 12 snapshots (offline in memory), then compares them at one query.
 //   hertz_rom [PROBLEM] [D]    PROBLEM: a shipped name or a .toml path (default hertz)
+// Shipped problems are looked up in the installed package's data folder
+// (contactrom_DATA_DIR of find_package(contactrom), passed by CMakeLists.txt as
+// CONTACTROM_DATA_DIR), unless CONTACTROM_PROBLEM_DIR / CONTACTROM_MESH_DIR say
+// otherwise. Errors end the program as a user's program would: bad input (an
+// unknown problem, a parameter out of range) with its one-line message and code 2.
 #include <cstdlib>
+#include <exception>
 #include <iostream>
 
+#include "core/errors.hpp"
 #include "fom/active_set_solver.hpp"
 #include "fom/kkt.hpp"
 #include "fom/problem.hpp"
@@ -11,7 +18,9 @@
 #include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   using namespace contactrom;
   const auto problem = fom::make_problem(argc > 1 ? argv[1] : "hertz");
   const fom::Param mu = fom::parse_param(*problem, argc > 2 ? argv[2] : "0.1275");
@@ -35,4 +44,22 @@ int main(int argc, char** argv) {
               << ", " << r.time_s * 1e6 << " us\n";
   }
   return ref.status == Status::Success ? EXIT_SUCCESS : EXIT_FAILURE;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+#ifdef CONTACTROM_DATA_DIR
+  setenv("CONTACTROM_PROBLEM_DIR", CONTACTROM_DATA_DIR "/problems", /*overwrite=*/0);
+  setenv("CONTACTROM_MESH_DIR", CONTACTROM_DATA_DIR "/meshes", 0);
+#endif
+  try {
+    return run(argc, argv);
+  } catch (const contactrom::InputError& e) {
+    std::cerr << "hertz_rom: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "hertz_rom: error: " << e.what() << "\n";
+    return 1;
+  }
 }

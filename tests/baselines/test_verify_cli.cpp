@@ -72,9 +72,14 @@ void check_report(const json& j, const std::string& problem, int n) {
       BOOST_TEST(r["nonconverged"] == 0);
       BOOST_TEST(r["reduced_constraint"] == true);
       BOOST_TEST(r["tau"].get<double>() == 1e-8);
-      // Reduced level: max_p W_pᵀ(Cu − g) ≤ τ + 1e-10 (greedy: over all dictionary columns).
-      BOOST_TEST(r["max_reduced_penetration"].get<double>() <= r["tau"].get<double>() + 1e-10);
-      BOOST_TEST(r["reduced_penetration_ok"] == true);
+      BOOST_TEST(r["inaccurate"] == 0);
+      // Reduced level: max_p W_pᵀ(Cu − g) ≤ τ + 1e-10 for the primal–dual active sets.
+      // The greedy's fixed point is stopped by the physical test at its own pairing
+      // instead (row by row, in units of U: docs/rom.md, "Fixed-point schedule").
+      if (std::string(m) != "greedy") {
+        BOOST_TEST(r["max_reduced_penetration"].get<double>() <= r["tau"].get<double>() + 1e-10);
+        BOOST_TEST(r["reduced_penetration_ok"] == true);
+      }
       // A ROM has no negative pressure (λ = Wλ̂, W ≥ 0, λ̂ ≥ 0); the full-order
       // penetration is reported as it is — positive and small.
       BOOST_TEST(r["max_kkt"]["negative_pressure"].get<double>() == 0.0);

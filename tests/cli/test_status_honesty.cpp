@@ -88,11 +88,11 @@ BOOST_AUTO_TEST_CASE(no_reduced_answer_is_a_success_with_large_contact_residuals
   // 7–8 reported as success). Every answer is now judged row by row at its own
   // pairing: over the validation set, no method reports success with a penetration
   // or a separation under pressure above the default tolerance (0.05 U), nor with a
-  // primal error above 0.5; and the answers that fail are counted as inaccurate.
+  // primal error above 0.5. (The dictionary is split by contact pair, so no column
+  // spans both pairs any more; the check is what would catch one that did.)
   const std::string dir = contactrom::test::temp_dir();
   const std::string db = dir + "/pb8.h5";
   BOOST_REQUIRE(run_command(kExe + " offline --problem punch_beam --train 8 --out " + db).exit_code == 0);
-  int inaccurate = 0;
   for (const char* method : {"greedy", "greedy-nested", "cpg", "full-dictionary"}) {
     BOOST_TEST_CONTEXT(method) {
       const std::string csv = dir + "/" + method + ".csv";
@@ -100,7 +100,7 @@ BOOST_AUTO_TEST_CASE(no_reduced_answer_is_a_success_with_large_contact_residuals
                                  " --json");
       BOOST_REQUIRE(r.exit_code == 0);
       const auto j = nlohmann::json::parse(r.out);
-      inaccurate += j["inaccurate"].get<int>();
+      BOOST_TEST(j.contains("inaccurate"));
       std::ifstream in(csv);
       std::string line;
       std::getline(in, line);
@@ -124,5 +124,4 @@ BOOST_AUTO_TEST_CASE(no_reduced_answer_is_a_success_with_large_contact_residuals
       BOOST_TEST_MESSAGE(method << ": " << successes << " successes of " << rows);
     }
   }
-  BOOST_TEST(inaccurate >= 1);  // the cancelling pairs above are caught, not hidden
 }

@@ -58,7 +58,10 @@ expect("${out}" "\"iterations\"" "installed CLI solves hertz")
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/cpp -B ${WORK_DIR}/example -G ${GENERATOR}
     -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} ${example_flags})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/example -j 2)
-# The example is not under the prefix: it is given the installed problem file.
+# The example is not under the prefix: it finds the shipped problem by name in the
+# installed package (as the installed problem file, below).
+run(${WORK_DIR}/example/hertz_rom hertz 0.1275)
+expect("${out}" "FOM: success" "the example finds the shipped hertz in the installed package")
 run(${WORK_DIR}/example/hertz_rom ${prefix}/share/contactrom/problems/hertz.toml 0.1275)
 message(STATUS "${out}")
 expect("${out}" "FOM: success" "FOM status")

@@ -81,3 +81,50 @@ def test_database_is_not_a_reduced_model(hertz_db_path):
     with pytest.raises(ValueError) as e:
         contactrom.ReducedModel.load(str(hertz_db_path))
     assert message_of(e) == expected
+
+
+def test_arrays_are_checked_at_the_boundary():
+    hertz = contactrom.problem("hertz")
+    u = np.zeros(hertz.num_dofs)
+    lam = np.zeros(hertz.num_constraints)
+    for bad in (np.nan, np.inf, -np.inf):
+        v = u.copy()
+        v[3] = bad
+        for call in (hertz.C, hertz.g, hertz.normal_gaps):
+            with pytest.raises(ValueError, match=r"u\[3\] is .*expected finite numbers"):
+                call(v)
+        with pytest.raises(ValueError, match="expected finite numbers"):
+            hertz.kkt_residuals(0.1, v, lam)
+        m = lam.copy()
+        m[0] = bad
+        with pytest.raises(ValueError, match=r"lam\[0\]"):
+            hertz.kkt_residuals(0.1, u, m)
+        with pytest.raises(ValueError, match=r"lam\[0\]"):
+            hertz.contact_force(m)
+    with pytest.raises(ValueError, match="entries; expected"):
+        hertz.C(u[:-1])
+
+
+def test_scalars_are_checked_at_the_boundary():
+    hertz = contactrom.problem("hertz")
+    with pytest.raises(ValueError, match="is a number or a sequence") as e:
+        hertz.check_param(None)
+    assert "nan" not in str(e.value)
+    with pytest.raises(ValueError, match="is not a finite number"):
+        hertz.check_param(10**400)
+    with pytest.raises(ValueError, match="is not a finite number"):
+        hertz.check_param(-(10**400))
+
+
+def test_paths_may_be_path_like(tmp_path):
+    import pathlib
+    source = pathlib.Path(__file__).resolve().parents[2]  # the source tree
+    problem = contactrom.problem("rope")
+    db = contactrom.offline(problem, 3)
+    path = tmp_path / "rope.h5"
+    db.save(path)
+    assert contactrom.load_database(path).problem.name == "rope"
+    rom = contactrom.ReducedModel(db)
+    rom.save(tmp_path / "rom.h5")
+    assert contactrom.ReducedModel.load(tmp_path / "rom.h5").problem.name == "rope"
+    assert contactrom.Problem.from_file(source / "problems" / "hertz.toml").name == "hertz"

@@ -60,6 +60,35 @@ BOOST_AUTO_TEST_CASE(merge_of_the_parts_equals_the_whole) {
   check_same_snapshots(merge_databases(parts, {"a", "b", "c"}), whole);
 }
 
+BOOST_AUTO_TEST_CASE(merge_of_parts_on_disk_refers_to_them_and_writes_the_whole) {
+  // Parts read without their primal snapshots are merged by reference (and in
+  // another order by append_snapshots); writing copies the snapshots one by one.
+  const auto params = contactrom::fom::training_set(hertz(), 7);
+  const SnapshotDatabase whole = contactrom::rom::generate_snapshots(hertz(), params, "train", 7);
+  std::vector<SnapshotDatabase> parts;
+  std::vector<std::string> names;
+  for (int k = 1; k <= 3; ++k) {
+    const auto [begin, end] = part_range(7, k, 3);
+    names.push_back(work_dir() + "/disk_part" + std::to_string(k) + ".h5");
+    contactrom::rom::write_database(names.back(), contactrom::rom::generate_snapshots(
+        hertz(), std::vector<contactrom::fom::Param>(params.begin() + begin, params.begin() + end), "train", 7));
+    parts.push_back(contactrom::rom::read_database(names.back(), false));
+  }
+  const SnapshotDatabase merged = merge_databases(parts, names);
+  BOOST_TEST(!merged.primal_in_memory());
+  BOOST_TEST(merged.primal_files == names);
+  const std::string out = work_dir() + "/disk_merged.h5";
+  contactrom::rom::write_database(out, merged);
+  check_same_snapshots(contactrom::rom::read_database(out), whole);
+  // The last part appended to the first two (reordered into training order).
+  const SnapshotDatabase appended = contactrom::rom::append_snapshots(
+      merge_databases({parts[2], parts[0]}, {names[2], names[0]}), "x", parts[1], params);
+  contactrom::rom::write_database(out, appended);
+  check_same_snapshots(contactrom::rom::read_database(out), whole);
+  // In memory and on disk do not mix.
+  BOOST_CHECK_THROW(merge_databases({parts[0], whole}, {"a", "b"}), std::invalid_argument);
+}
+
 BOOST_AUTO_TEST_CASE(incompatible_databases_and_repeated_parameters_are_refused) {
   const SnapshotDatabase a = contactrom::rom::generate_snapshots(hertz(), 2);
   auto refused = [&](const SnapshotDatabase& b, const std::string& what) {

@@ -46,6 +46,7 @@ const rom::ReducedModel& hand_model() {
 /// with a cap of k iterations the k-th iterate itself (not the best one).
 rom::GreedyOptions paper_options(int cap) {
   rom::GreedyOptions o;
+  o.schedule = rom::GreedySchedule::Interleaved;
   o.init = rom::WarmStart::Empty;
   o.anderson_depth = 0;
   o.nested_on_cycle = false;
@@ -173,6 +174,9 @@ BOOST_AUTO_TEST_CASE(every_schedule_and_start_reaches_the_hand_solution) {
   rom::GreedyOptions nested;
   nested.schedule = rom::GreedySchedule::Nested;
   variants.emplace_back("nested", nested);
+  rom::GreedyOptions interleaved;
+  interleaved.schedule = rom::GreedySchedule::Interleaved;
+  variants.emplace_back("interleaved", interleaved);
   for (rom::WarmStart init : {rom::WarmStart::Empty, rom::WarmStart::Nearest, rom::WarmStart::Primal}) {
     rom::GreedyOptions o;
     o.init = init;

@@ -55,6 +55,51 @@ BOOST_AUTO_TEST_CASE(snapshots_are_bit_identical_for_any_thread_count) {
   BOOST_TEST(back.mesh_fingerprint == hertz().fingerprint());
 }
 
+BOOST_AUTO_TEST_CASE(streamed_snapshots_are_those_of_the_run_in_memory) {
+  // Streamed to a file as they are computed (any thread order), the snapshots and
+  // every other array are bitwise those of the run in memory; the database refers
+  // to the file and reads back from it whole or by blocks.
+  contactrom::rom::OfflineOptions memory, streamed;
+  memory.threads = 1;
+  streamed.threads = 3;
+  streamed.stream_to = work_dir() + "/streamed9.h5";
+  const auto a = contactrom::rom::generate_snapshots(hertz(), 9, memory);
+  const auto b = contactrom::rom::generate_snapshots(hertz(), 9, streamed);
+  BOOST_TEST(!b.primal_in_memory());
+  BOOST_TEST(b.primal.cols() == 0);
+  BOOST_TEST(b.num_snapshots() == 9);
+  BOOST_TEST(b.num_dofs() == a.num_dofs());
+  const auto back = contactrom::rom::read_database(streamed.stream_to);
+  check_same_snapshots(a, back);
+  BOOST_TEST(contactrom::test::bitwise_equal(contactrom::rom::primal_blocks(b)->read_all(), a.primal));
+  // A database on disk written elsewhere is copied snapshot by snapshot, unchanged.
+  const std::string copy = work_dir() + "/streamed9_copy.h5";
+  contactrom::rom::write_database(copy, contactrom::rom::read_database(streamed.stream_to, false));
+  check_same_snapshots(a, contactrom::rom::read_database(copy));
+  // Blocks of rows of a subset of the columns, in the order asked.
+  const auto part = contactrom::rom::primal_blocks(contactrom::rom::read_database(copy, false), {7, 2, 4});
+  Eigen::MatrixXd rows;
+  part->read_rows(100, 50, rows);
+  BOOST_TEST(rows.rows() == 50);
+  BOOST_TEST(rows.cols() == 3);
+  BOOST_TEST(contactrom::test::bitwise_equal(rows.col(0), a.primal.col(7).segment(100, 50)));
+  BOOST_TEST(contactrom::test::bitwise_equal(rows.col(1), a.primal.col(2).segment(100, 50)));
+  BOOST_TEST(contactrom::test::bitwise_equal(rows.col(2), a.primal.col(4).segment(100, 50)));
+}
+
+BOOST_AUTO_TEST_CASE(cli_offline_streams_the_database_of_the_run_in_memory) {
+  const std::string path = work_dir() + "/cli_stream12.h5";
+  const auto r = run_command(exe + " offline --problem hertz --train 12 --threads 2 --out " + path);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  const auto a = contactrom::rom::generate_snapshots(hertz(), 12);
+  check_same_snapshots(a, contactrom::rom::read_database(path));
+  // No temporary part is left next to it.
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(path).parent_path()))
+    files += e.path().filename().string().find("cli_stream12") != std::string::npos ? 1 : 0;
+  BOOST_TEST(files == 1);
+}
+
 BOOST_AUTO_TEST_CASE(snapshot_is_fom_solution_minus_lifting) {
   contactrom::rom::OfflineOptions options;
   options.threads = 2;

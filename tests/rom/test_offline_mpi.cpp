@@ -1,6 +1,7 @@
 // Tests of the MPI offline stage (built with CONTACTROM_MPI): mpirun -np 2 and 3
 // write a database whose arrays are bit-identical to the serial run's; bad input
-// and I/O errors end every rank with a non-zero code, one message and no file.
+// and I/O errors end every rank with a non-zero code, one message and no file;
+// `mpirun -np 2 reduce` shares the POD and gives the serial basis to rounding.
 #define BOOST_TEST_MODULE rom_offline_mpi
 #include <boost/test/unit_test.hpp>
 
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "common/database_checks.hpp"
+#include "rom/reduced_model_file.hpp"
 #include "rom/snapshot_database.hpp"
 
 namespace fs = std::filesystem;
@@ -86,4 +88,38 @@ BOOST_AUTO_TEST_CASE(mpi_offline_unwritable_target_fails_with_one_message_and_no
   BOOST_TEST(contactrom_lines(r.err) == 1, r.err);
   BOOST_TEST(r.err.find("no/such/dir/x.h5") != std::string::npos, r.err);
   BOOST_TEST(!fs::exists(target));
+}
+
+namespace {
+
+/// sin of the largest principal angle between the spans of two orthonormal bases.
+double subspace_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  const Eigen::MatrixXd residual = a - b * (b.transpose() * a);
+  return Eigen::JacobiSVD<Eigen::MatrixXd>(residual).singularValues()(0);
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(mpi_reduce_shares_the_pod_and_gives_the_serial_basis) {
+  const std::string dir = work_dir(), db = dir + "/reduce40.h5";
+  auto r = run_command(exe + " offline --problem hertz --train 40 --threads 1 --out " + db);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  const auto reduce = [&](const std::string& launcher, const std::string& pod, const std::string& out) {
+    const auto res = run_command(launcher + exe + " reduce --db " + db + " --method greedy --delta 1e-10 --pod " + pod +
+                                 " --threads 1 --out " + out);
+    BOOST_TEST_REQUIRE(res.exit_code == 0, res.err);
+    return contactrom::rom::OnlineModel::load(out);
+  };
+  const auto svd = reduce("", "svd", dir + "/rom_svd.h5");
+  const auto serial = reduce("", "snapshots", dir + "/rom_serial.h5");
+  const auto ranks = reduce(mpirun(2), "snapshots", dir + "/rom_mpi.h5");
+  const int rank = svd.model().primal_rank();
+  BOOST_TEST(rank >= 5);
+  for (const auto* other : {&serial, &ranks}) {
+    BOOST_TEST_REQUIRE(other->model().primal_rank() == rank);
+    const Eigen::VectorXd a = svd.model().singular_values().head(rank), b = other->model().singular_values().head(rank);
+    BOOST_TEST(((a - b).array().abs() / a.array()).maxCoeff() <= 1e-10);
+    BOOST_TEST(subspace_distance(other->model().basis(), svd.model().basis()) <= 1e-8);
+  }
+  BOOST_TEST(subspace_distance(ranks.model().basis(), serial.model().basis()) <= 1e-8);
 }

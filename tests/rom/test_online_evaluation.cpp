@@ -163,8 +163,18 @@ BOOST_AUTO_TEST_CASE(summary_statistics_leave_absolute_rows_out_of_the_error_mea
   BOOST_TEST(s.mean_sparsity == 1.25);
   BOOST_TEST(s.max_sparsity == 2);
   BOOST_TEST(s.mean_iterations == 14.75);
-  BOOST_TEST(std::abs(s.mean_time_s - 3.75e-6) <= 1e-20);
-  BOOST_TEST(std::abs(s.median_time_s - 2.5e-6) <= 1e-20);
+  // A query's time is its method's plus the full-order contact check's.
+  const double prescribed[] = {3e-6, 1e-6, 2e-6, 9e-6};
+  std::vector<double> times;
+  double mean_t = 0.0;
+  for (size_t i = 0; i < s.rows.size(); ++i) {
+    BOOST_TEST(s.rows[i].time_s >= prescribed[i]);
+    BOOST_TEST(s.rows[i].time_s <= prescribed[i] + 1e-3);
+    times.push_back(s.rows[i].time_s);
+    mean_t += s.rows[i].time_s / 4.0;
+  }
+  BOOST_TEST(std::abs(s.mean_time_s - mean_t) <= 1e-15);
+  BOOST_TEST(s.median_time_s == rom::median(times));
   BOOST_TEST(s.nonconverged == 1);
   BOOST_TEST(s.fom_failures == 1);
 }
@@ -182,7 +192,7 @@ BOOST_AUTO_TEST_CASE(csv_rows_read_back) {
     std::vector<std::string> f;
     std::stringstream fields(line);
     for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
-    BOOST_REQUIRE(f.size() == 10u);
+    BOOST_REQUIRE(f.size() == 12u);
     BOOST_TEST(std::stod(f[0]) == row.mu(0));  // numbers written to read back exactly
     BOOST_TEST(std::stod(f[1]) == row.primal_error);
     BOOST_TEST(std::stod(f[2]) == row.dual_error);
@@ -233,7 +243,8 @@ BOOST_AUTO_TEST_CASE(median_and_timing_samples) {
   rom::OnlineSamples pass;
   rom::time_online_pass(evaluated().solver, evaluated().params, pass);
   BOOST_TEST(pass.core.size() == 4u);
-  BOOST_TEST(pass.core[0] == 3e-6);  // the solver's own core time
+  BOOST_TEST(pass.core[0] >= 3e-6);  // the solver's own core time and the contact check's
+  BOOST_TEST(pass.core[0] <= 3e-6 + 1e-3);
   BOOST_TEST(pass.without.empty());  // operator_time_s = −1: not measured
 }
 

@@ -148,3 +148,107 @@ BOOST_AUTO_TEST_CASE(edge_cases) {
   BOOST_REQUIRE(pod3.rank() == 1);
   BOOST_TEST(std::abs(pod3.basis().col(0).dot(x.normalized())) == 1.0, boost::test_tools::tolerance(1e-14));
 }
+
+namespace {
+
+/// Options of the method of snapshots reading `s` in blocks of about `rows` rows.
+PodOptions snapshot_options(double delta, const Eigen::MatrixXd& s, int rows, int threads) {
+  PodOptions o;
+  o.delta = delta;
+  o.algorithm = contactrom::rom::PodAlgorithm::Snapshots;
+  o.block_bytes = static_cast<std::int64_t>(sizeof(double)) * s.cols() * rows;
+  o.threads = threads;
+  return o;
+}
+
+/// sin of the largest principal angle between the spans of two orthonormal bases.
+double subspace_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  const Eigen::MatrixXd residual = a - b * (b.transpose() * a);
+  return Eigen::JacobiSVD<Eigen::MatrixXd>(residual).singularValues()(0);
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(method_of_snapshots_matches_the_svd) {
+  // 400 singular values decaying geometrically over nine decades: δ = 1e-10 keeps
+  // modes down to about 1e-5 σ₁, where the Gram matrix alone would give six digits.
+  // (No δ falls exactly on a partial sum of the tail.)
+  Eigen::VectorXd sigma(400);
+  for (int i = 0; i < sigma.size(); ++i) sigma(i) = std::pow(10.0, -9.1 * i / 399.0);
+  const Eigen::MatrixXd s = with_singular_values(3000, 400, sigma, 31);
+  for (double delta : {1e-4, 1e-6, 1e-8, 1e-10}) {
+    PodOptions svd_options;
+    svd_options.delta = delta;
+    svd_options.algorithm = contactrom::rom::PodAlgorithm::Svd;
+    Pod svd(svd_options), snap(snapshot_options(delta, s, 290, 2));
+    svd.compute(s);
+    snap.compute(s);
+    BOOST_REQUIRE(svd.info() == Status::Success);
+    BOOST_REQUIRE(snap.info() == Status::Success);
+    BOOST_TEST_CONTEXT("delta " << delta << " rank " << svd.rank()) {
+      BOOST_TEST(snap.rank() == svd.rank());
+      const int r = std::min(snap.rank(), svd.rank());
+      const Eigen::ArrayXd relative =
+          (snap.singular_values().head(r) - svd.singular_values().head(r)).array().abs() / svd.singular_values().head(r).array();
+      BOOST_TEST(relative.maxCoeff() <= 1e-10);
+      BOOST_TEST(subspace_distance(snap.basis(), svd.basis()) <= 1e-8);
+      const Eigen::MatrixXd gram = snap.basis().transpose() * snap.basis();
+      BOOST_TEST((gram - Eigen::MatrixXd::Identity(r, r)).cwiseAbs().maxCoeff() <= 1e-13);
+      BOOST_TEST((snap.coordinates() - snap.basis().transpose() * s).cwiseAbs().maxCoeff() <= 1e-13 * sigma(0));
+      // The discarded energy of both is the planted tail, to rounding.
+      BOOST_TEST(snap.kept_energy() == svd.kept_energy(), boost::test_tools::tolerance(1e-13));
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(method_of_snapshots_does_not_depend_on_the_threads) {
+  Eigen::VectorXd sigma(60);
+  for (int i = 0; i < sigma.size(); ++i) sigma(i) = std::pow(0.7, i);
+  const Eigen::MatrixXd s = with_singular_values(1500, 200, sigma, 41);
+  Pod one(snapshot_options(1e-10, s, 100, 1)), three(snapshot_options(1e-10, s, 100, 3));
+  one.compute(s);
+  three.compute(s);
+  BOOST_REQUIRE(one.info() == Status::Success);
+  BOOST_TEST(one.rank() == three.rank());
+  BOOST_TEST((one.basis() - three.basis()).cwiseAbs().maxCoeff() == 0.0);
+  BOOST_TEST((one.singular_values() - three.singular_values()).cwiseAbs().maxCoeff() == 0.0);
+}
+
+BOOST_AUTO_TEST_CASE(method_of_snapshots_edge_cases) {
+  // Planted rank 5 (δ = 0: the numerical rank) and its exact reconstruction.
+  const Eigen::MatrixXd s = random_matrix(1000, 5, 3) * random_matrix(5, 80, 4);
+  Pod pod(snapshot_options(0.0, s, 64, 2));
+  pod.compute(s);
+  BOOST_REQUIRE(pod.info() == Status::Success);
+  BOOST_TEST(pod.rank() == 5);
+  BOOST_TEST((pod.basis() * (pod.basis().transpose() * s) - s).norm() / s.norm() < 1e-13);
+
+  const Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(20, 4);
+  Pod z(snapshot_options(1e-8, zero, 8, 1));
+  z.compute(zero);
+  BOOST_TEST(z.info() == Status::Success);
+  BOOST_TEST(z.rank() == 0);
+  BOOST_TEST(z.basis().rows() == 20);
+
+  Eigen::MatrixXd bad = Eigen::MatrixXd::Ones(50, 3);
+  bad(20, 1) = std::numeric_limits<double>::infinity();
+  Pod b(snapshot_options(1e-8, bad, 8, 1));
+  b.compute(contactrom::rom::MatrixBlocks(bad));  // the block reader sees it, not a pre-check
+  BOOST_TEST(b.info() == Status::InvalidInput);
+
+  const Eigen::VectorXd x = random_matrix(50, 1, 5).col(0);
+  Pod one(snapshot_options(1e-8, x, 7, 2));
+  one.compute(x);
+  BOOST_REQUIRE(one.rank() == 1);
+  BOOST_TEST(std::abs(one.basis().col(0).dot(x.normalized())) == 1.0, boost::test_tools::tolerance(1e-14));
+}
+
+BOOST_AUTO_TEST_CASE(auto_takes_the_svd_up_to_the_size_limit) {
+  PodOptions o;
+  o.svd_max_entries = 1000;
+  const Pod pod(o);
+  BOOST_TEST(pod.uses_svd(100, 10));
+  BOOST_TEST(!pod.uses_svd(100, 11));
+  o.algorithm = contactrom::rom::PodAlgorithm::Svd;
+  BOOST_TEST(Pod(o).uses_svd(1000, 1000));
+}

@@ -8,7 +8,9 @@
 #include <memory>
 
 #include "fom/problem.hpp"
+#include "core/errors.hpp"
 #include "rom/offline.hpp"
+#include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
 
 using namespace contactrom;
@@ -164,4 +166,28 @@ BOOST_AUTO_TEST_CASE(two_contact_pairs_give_one_column_per_pair) {
   whole.delta = 1e-10;
   whole.split_pairs = false;
   BOOST_TEST(rom::ReducedModel(*b.problem, b.db, whole).dictionary_size() == b.db.num_snapshots());
+}
+
+BOOST_AUTO_TEST_CASE(delta_one_keeps_no_mode_and_every_method_runs_on_the_empty_basis) {
+  // δ = 1 (inside the documented range [0, 1]) discards every mode: the basis is
+  // empty, and every online method answers with the offset alone (no contact can be
+  // enforced) instead of touching rows of an empty matrix.
+  Built b("hertz", 6, 1.0);
+  BOOST_TEST(b.model->primal_rank() == 0);
+  const fom::Param mu = fom::Param::Constant(1, 0.1);
+  for (const std::string& method : rom::online_solver_names()) {
+    BOOST_TEST_CONTEXT(method) {
+      std::unique_ptr<rom::OnlineSolver> solver;
+      try {
+        solver = rom::make_online_solver(method, *b.model);
+      } catch (const InputError& e) {  // a method may refuse the empty basis, with a message
+        BOOST_TEST(std::string(e.what()).size() > 0u);
+        continue;
+      }
+      const rom::OnlineResult r = solver->solve(mu);
+      BOOST_TEST(r.u.size() == b.problem->num_dofs());
+      BOOST_TEST(r.u.allFinite());
+      BOOST_TEST(r.lambda.allFinite());
+    }
+  }
 }

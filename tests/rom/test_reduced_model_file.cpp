@@ -16,6 +16,7 @@
 #include "common/run_command.hpp"
 #include "fom/kkt.hpp"
 #include "fom/problem.hpp"
+#include "rom/hdf5_io.hpp"
 #include "rom/offline.hpp"
 #include "rom/reduced_model_file.hpp"
 
@@ -67,8 +68,9 @@ void check_same_answers(const OnlineModel& a, const OnlineModel& b) {
   }
 }
 
-/// Overwrites element 0 of a double dataset of an HDF5 file.
-void poke(const std::string& path, const char* dataset, double value) {
+/// Overwrites element 0 of a double dataset of an HDF5 file; with `checksum`, also
+/// stores the checksum of the new data (so that the reader's other checks see it).
+void poke(const std::string& path, const char* dataset, double value, bool checksum = true) {
   const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   BOOST_REQUIRE(f >= 0);
   const hid_t d = H5Dopen2(f, dataset, H5P_DEFAULT);
@@ -79,6 +81,15 @@ void poke(const std::string& path, const char* dataset, double value) {
   const hsize_t one[1] = {1};
   const hid_t mem = H5Screate_simple(1, one, nullptr);
   BOOST_REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, &value) >= 0);
+  if (checksum) {
+    std::vector<double> all(static_cast<size_t>(H5Sget_simple_extent_npoints(space)));
+    BOOST_REQUIRE(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, all.data()) >= 0);
+    const std::uint32_t sum = contactrom::rom::hdf5::data_checksum(all.data(), all.size() * sizeof(double));
+    const hid_t attr = H5Aopen(d, contactrom::rom::hdf5::kChecksumAttribute, H5P_DEFAULT);
+    BOOST_REQUIRE(attr >= 0);
+    BOOST_REQUIRE(H5Awrite(attr, H5T_NATIVE_UINT32, &sum) >= 0);
+    H5Aclose(attr);
+  }
   H5Sclose(mem), H5Sclose(space), H5Dclose(d), H5Fclose(f);
 }
 
@@ -107,6 +118,85 @@ BOOST_AUTO_TEST_CASE(saved_model_answers_like_the_original_for_every_method) {
       BOOST_TEST(loaded.method() == method);
       BOOST_TEST(contactrom::rom::options_to_map(method, loaded.options()) ==
                  contactrom::rom::options_to_map(method, original.options()));
+      check_same_answers(original, loaded);
+    }
+  }
+}
+
+namespace {
+
+bool has_dataset(const std::string& path, const char* name) {
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  BOOST_REQUIRE(f >= 0);
+  const bool found = H5Lexists(f, name, H5P_DEFAULT) > 0;
+  H5Fclose(f);
+  return found;
+}
+
+/// Turns a file written by save() back into the version-1 layout: primal snapshots
+/// always (here: the convex hull's), no snapshot coordinates, format_version 1.
+void make_version_1(const std::string& path) {
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  BOOST_REQUIRE(f >= 0);
+  BOOST_REQUIRE(H5Ldelete(f, "snapshot_coordinates", H5P_DEFAULT) >= 0);
+  const hid_t a = H5Aopen(f, "format_version", H5P_DEFAULT);
+  const int one = 1;
+  BOOST_REQUIRE(H5Awrite(a, H5T_NATIVE_INT, &one) >= 0);
+  H5Aclose(a), H5Fclose(f);
+}
+
+/// Adds the m × n dataset /primal_snapshots (one column of `primal` per row).
+void add_primal_snapshots(const std::string& path, const Eigen::MatrixXd& primal) {
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  BOOST_REQUIRE(f >= 0);
+  const hsize_t dims[2] = {static_cast<hsize_t>(primal.cols()), static_cast<hsize_t>(primal.rows())};
+  const hid_t space = H5Screate_simple(2, dims, nullptr);
+  const hid_t d = H5Dcreate2(f, "primal_snapshots", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  BOOST_REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, primal.data()) >= 0);
+  H5Dclose(d), H5Sclose(space), H5Fclose(f);
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(files_store_primal_snapshots_only_for_methods_that_combine_them) {
+  const std::string greedy = work_dir() + "/hertz10_greedy_lean.h5", hull = work_dir() + "/hertz10_hull_lean.h5";
+  const OnlineModel g(hertz(), hertz_db(), {}, "greedy"), h(hertz(), hertz_db(), {}, "convex-hull");
+  g.save(greedy);
+  h.save(hull);
+  BOOST_TEST(!has_dataset(greedy, "primal_snapshots"));
+  BOOST_TEST(has_dataset(hull, "primal_snapshots"));
+  BOOST_TEST(!g.model().has_primal_snapshots());
+  BOOST_TEST(fs::file_size(greedy) < fs::file_size(hull));
+  // The coordinates are the projections of the snapshots (as computed from them).
+  const OnlineModel loaded = OnlineModel::load(greedy);
+  const Eigen::MatrixXd& coords = loaded.model().snapshot_coordinates();
+  const Eigen::MatrixXd expected = h.model().basis().transpose() * h.model().primal_snapshots();
+  BOOST_TEST((coords - expected).cwiseAbs().maxCoeff() <= 1e-12 * expected.cwiseAbs().maxCoeff());
+  check_same_answers(g, loaded);
+  // A convex hull on a model without primal snapshots is refused, naming what is missing.
+  contactrom::rom::ReducedModelOptions lean;
+  lean.keep_primal_snapshots = false;
+  const contactrom::rom::ReducedModel model(*hertz(), hertz_db(), lean);
+  BOOST_TEST(one_line_error([&] { (void)contactrom::rom::make_online_solver("convex-hull", model); })
+                 .find("primal training snapshots") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(version_1_files_are_still_read) {
+  // Version 1 stored the primal snapshots for every method and no coordinates.
+  const OnlineModel hull(hertz(), hertz_db(), {}, "convex-hull");
+  const Eigen::MatrixXd& primal = hull.model().primal_snapshots();
+  const Eigen::MatrixXd expected = hull.model().basis().transpose() * primal;
+  for (const std::string method : {"greedy", "convex-hull"}) {
+    BOOST_TEST_CONTEXT("method " << method) {
+      const std::string path = work_dir() + "/hertz10_v1_" + method + ".h5";
+      const OnlineModel original(hertz(), hertz_db(), {}, method);
+      original.save(path);
+      if (method == "greedy") add_primal_snapshots(path, primal);
+      make_version_1(path);
+      const OnlineModel loaded = OnlineModel::load(path);
+      BOOST_TEST(loaded.method() == method);
+      BOOST_TEST(loaded.model().has_primal_snapshots() == (method == "convex-hull"));
+      BOOST_TEST((loaded.model().snapshot_coordinates() - expected).cwiseAbs().maxCoeff() == 0.0);
       check_same_answers(original, loaded);
     }
   }
@@ -197,6 +287,39 @@ BOOST_AUTO_TEST_CASE(damaged_or_wrong_files_are_refused_with_one_line) {
   const auto bad_param = run_command(exe + " query --rom " + good + " --param 0.5");
   BOOST_TEST(bad_param.exit_code == 2);
   BOOST_TEST(bad_param.err.find("0.5") != std::string::npos, bad_param.err);
+}
+
+BOOST_AUTO_TEST_CASE(every_stored_list_and_number_is_checked) {
+  const std::string good = work_dir() + "/hertz10_lists.h5";
+  OnlineModel(hertz(), hertz_db(), {}, "greedy").save(good);
+  // NaN or Inf in the singular values or the surface rows of the basis.
+  for (const char* dataset : {"singular_values", "surface_basis"})
+    for (double bad : {std::nan(""), HUGE_VAL}) {
+      const std::string damaged = work_dir() + "/damaged.h5";
+      fs::copy_file(good, damaged, fs::copy_options::overwrite_existing);
+      poke(damaged, dataset, bad);
+      const std::string e = one_line_error([&] { OnlineModel::load(damaged); });
+      BOOST_TEST(e.find(std::string("/") + dataset) != std::string::npos, e);
+    }
+  // The node list of the Dirichlet curve of the load without its last node: another
+  // problem (that node no longer pushed), which the stored fingerprint must refuse.
+  const std::string emptied = work_dir() + "/emptied.h5";
+  fs::copy_file(good, emptied, fs::copy_options::overwrite_existing);
+  const auto py = run_command(
+      "/usr/bin/python3 -c \"import h5py, numpy; f = h5py.File('" + emptied + "', 'a'); "
+      "names = [n.decode() for n in f['mesh/curve_names'][()]]; k = 'mesh/curve_%d_nodes' % names.index('top_load'); "
+      "data = f[k][()][:-1]; del f[k]; f.create_dataset(k, data=data); "
+      "import sys; sys.path.insert(0, '" + std::string(CONTACTROM_SOURCE_DIR) + "/fuzz'); "
+      "from hdf5_checksum import lookup3; f[k].attrs.create('checksum_lookup3', lookup3(data.tobytes()), dtype='<u4')\"");
+  BOOST_REQUIRE_MESSAGE(py.exit_code == 0, "needs /usr/bin/python3 with h5py: " << py.err);
+  const std::string e = one_line_error([&] { OnlineModel::load(emptied); });
+  BOOST_TEST(e.find("fingerprint") != std::string::npos, e);
+  // A number changed without its checksum: the file is damaged.
+  const std::string flipped = work_dir() + "/flipped.h5";
+  fs::copy_file(good, flipped, fs::copy_options::overwrite_existing);
+  poke(flipped, "dictionary", 0.5, false);
+  const std::string f = one_line_error([&] { OnlineModel::load(flipped); });
+  BOOST_TEST(f.find("/dictionary fails its checksum") != std::string::npos, f);
 }
 
 BOOST_AUTO_TEST_CASE(parameter_csv_is_checked_row_by_row) {

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <unistd.h>
@@ -256,4 +257,62 @@ BOOST_AUTO_TEST_CASE(unwritable_target_throws_input_error) {
   const std::string msg = input_error_of([&] { contactrom::rom::write_database(path, synthetic(2, 5, 3)); });
   BOOST_TEST(msg.find(path) != std::string::npos);
   BOOST_TEST(!fs::exists(path));
+}
+
+BOOST_AUTO_TEST_CASE(flipped_bits_are_refused_never_read_as_other_numbers) {
+  // Every dataset carries a checksum of its data: a single flipped bit anywhere in
+  // the file is refused (metadata: HDF5's checksums; data: contactrom's), or lies
+  // in bytes nobody reads, and the arrays read back unchanged.
+  const SnapshotDatabase db = synthetic(6, 40, 8);
+  const std::string good = temp().file("bits_good.h5"), bad = temp().file("bits_bad.h5");
+  contactrom::rom::write_database(good, db);
+  std::ifstream in(good, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::mt19937 gen(7);
+  int refused = 0, unchanged = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string flipped = bytes;
+    const size_t at = std::uniform_int_distribution<size_t>(0, flipped.size() - 1)(gen);
+    flipped[at] = static_cast<char>(flipped[at] ^ (1 << std::uniform_int_distribution<int>(0, 7)(gen)));
+    std::ofstream(bad, std::ios::binary | std::ios::trunc) << flipped;
+    try {
+      const SnapshotDatabase back = contactrom::rom::read_database(bad);
+      BOOST_TEST_CONTEXT("bit flipped in byte " << at << " of " << bytes.size()) {
+        BOOST_TEST(bitwise_equal(back.primal, db.primal));
+        BOOST_TEST(bitwise_equal(back.dual, db.dual));
+        BOOST_TEST(bitwise_equal(back.parameters, db.parameters));
+        BOOST_TEST((back.status == db.status && back.iterations == db.iterations && back.time_s == db.time_s));
+        BOOST_TEST(bitwise_equal(back.lifting_terms, db.lifting_terms));
+      }
+      ++unchanged;
+    } catch (const InputError&) {
+      ++refused;
+    }
+  }
+  BOOST_TEST_MESSAGE(refused << " flips refused, " << unchanged << " in bytes nobody reads");
+  BOOST_TEST(refused > 200);
+}
+
+BOOST_AUTO_TEST_CASE(links_and_storage_outside_the_file_are_refused) {
+  require_h5py();
+  const std::string path = temp().file("links.h5"), other = temp().file("elsewhere.h5");
+  contactrom::rom::write_database(path, synthetic(4, 10, 3));
+  // /time_s replaced by a link to a dataset of another file.
+  const std::string linked = temp().file("linked.h5");
+  fs::copy_file(path, linked, fs::copy_options::overwrite_existing);
+  std::string cmd = "/usr/bin/python3 -c \"import h5py, numpy; g = h5py.File('" + other +
+                    "', 'w'); g['t'] = numpy.zeros(4); g.close(); f = h5py.File('" + linked +
+                    "', 'a'); del f['time_s']; f['time_s'] = h5py.ExternalLink('" + other + "', '/t')\"";
+  BOOST_REQUIRE(std::system(cmd.c_str()) == 0);
+  const std::string e1 = input_error_of([&] { contactrom::rom::read_database(linked); });
+  BOOST_TEST(e1.find("link to another file") != std::string::npos, e1);
+  // /time_s stored in an external raw file.
+  const std::string external = temp().file("external.h5");
+  fs::copy_file(path, external, fs::copy_options::overwrite_existing);
+  std::ofstream(temp().file("raw.bin"), std::ios::binary) << std::string(32, '\0');
+  cmd = "/usr/bin/python3 -c \"import h5py; f = h5py.File('" + external + "', 'a'); del f['time_s']; "
+        "f.create_dataset('time_s', shape=(4,), dtype='<f8', external=[('" + temp().file("raw.bin") + "', 0, 32)])\"";
+  BOOST_REQUIRE(std::system(cmd.c_str()) == 0);
+  const std::string e2 = input_error_of([&] { contactrom::rom::read_database(external); });
+  BOOST_TEST(e2.find("outside the file") != std::string::npos, e2);
 }

@@ -174,7 +174,14 @@ BOOST_AUTO_TEST_CASE(vector_reader_takes_a_row_or_a_column_only) {
     contactrom::rom::read_vector_csv(dir.file("missing.csv"));
     BOOST_FAIL("no error for a missing file");
   } catch (const InputError& e) {
-    BOOST_TEST(std::string(e.what()) == "cannot open '" + dir.file("missing.csv") + "': no such file or not readable");
+    BOOST_TEST(std::string(e.what()) == "CSV file '" + dir.file("missing.csv") + "' not found");
+  }
+  // A device is not a CSV file: refused before reading (it would never end).
+  try {
+    contactrom::rom::read_vector_csv("/dev/zero");
+    BOOST_FAIL("no error for /dev/zero");
+  } catch (const InputError& e) {
+    BOOST_TEST(std::string(e.what()).find("not a regular file") != std::string::npos, e.what());
   }
 }
 

@@ -1,0 +1,37 @@
+#include "core/input_file.hpp"
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "core/format.hpp"
+
+namespace contactrom {
+
+void check_input_file(const std::string& path, const std::string& label, std::uintmax_t max_bytes) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) throw InputError(label + " " + quoted(path, 200) + " not found");
+    throw InputError(label + " " + quoted(path, 200) + " cannot be opened: " + std::strerror(errno));
+  }
+  if (!S_ISREG(st.st_mode))
+    throw InputError(label + " " + quoted(path, 200) + " is not a regular file (a folder, device or pipe); expected a file");
+  if (static_cast<std::uintmax_t>(st.st_size) > max_bytes)
+    throw InputError(label + " " + quoted(path, 200) + " has " + std::to_string(st.st_size) + " bytes, more than the " +
+                     std::to_string(max_bytes) + " accepted");
+}
+
+std::string read_input_file(const std::string& path, const std::string& label, std::uintmax_t max_bytes) {
+  check_input_file(path, label, max_bytes);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(label + " " + quoted(path, 200) + " cannot be read: " + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace contactrom

@@ -1,0 +1,103 @@
+#include "fom/contact_checks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/errors.hpp"
+#include "core/format.hpp"
+#include "fom/contact_model.hpp"
+
+namespace contactrom::fom {
+namespace {
+
+/// Per pair, in the reference configuration.
+struct PairAtRest {
+  std::string slave, master;
+  int rows = 0, paired = 0, unpaired_near = 0;
+  double overlap = 0.0;  ///< largest penetration of a paired slave node (length)
+};
+
+std::vector<PairAtRest> pairs_at_rest(const Problem& problem) {
+  std::vector<PairAtRest> out;
+  const auto* contact = dynamic_cast<const NodeToSegmentContact*>(&problem.contact());
+  const Mesh* mesh = problem.mesh();
+  if (!contact || !mesh) return out;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(contact->surface_dofs().size()));
+  const Pairing pairing = contact->search(zero);
+  ConstraintMatrix c;
+  Eigen::VectorXd g;
+  contact->assemble(pairing, c, g);
+  const std::vector<ContactPairSpec>& specs = problem.definition().contact;
+  out.resize(specs.size());
+  // "Near" a master curve: within its mean segment length (a node just beyond an
+  // end, as where two surfaces of different lengths meet), per pair.
+  std::vector<double> reach(specs.size(), 0.0);
+  for (size_t q = 0; q < specs.size(); ++q) {
+    out[q].slave = specs[q].slave, out[q].master = specs[q].master;
+    const auto& segments = mesh->group_segments(specs[q].master);
+    for (const auto& seg : segments) reach[q] += (mesh->nodes.col(seg[1]) - mesh->nodes.col(seg[0])).norm();
+    reach[q] /= static_cast<double>(std::max<size_t>(segments.size(), 1));
+  }
+  for (int s = 0; s < contact->num_constraints(); ++s) {
+    const size_t q = static_cast<size_t>(contact->pair_of_row(s));
+    if (q >= out.size()) continue;
+    PairAtRest& pair = out[q];
+    ++pair.rows;
+    if (pairing.segment[static_cast<size_t>(s)] >= 0) {
+      ++pair.paired;
+      pair.overlap = std::max(pair.overlap, -g(s) / contact->weights()(s));
+      continue;
+    }
+    // Unpaired: near the master curve (one of its nodes within U)?
+    const Eigen::Vector2d x = contact->constraint_points().col(s);
+    double nearest = HUGE_VAL;
+    for (int node : mesh->group_nodes(pair.master)) nearest = std::min(nearest, (mesh->nodes.col(node) - x).norm());
+    if (nearest <= reach[q]) ++pair.unpaired_near;
+  }
+  return out;
+}
+
+/// A length for a message, to 3 significant digits (0.05, not 0.04999999999999999).
+std::string length_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+std::string pair_name(size_t q, const PairAtRest& p) {
+  return "contact pair " + std::to_string(q) + " (slave " + quoted(p.slave, 200) + " on master " + quoted(p.master, 200) +
+         ")";
+}
+
+}  // namespace
+
+std::vector<std::string> reference_contact_warnings(const Problem& problem) {
+  std::vector<std::string> out;
+  const std::vector<PairAtRest> pairs = pairs_at_rest(problem);
+  const double u = problem.displacement_scale();
+  for (size_t q = 0; q < pairs.size(); ++q) {
+    const PairAtRest& p = pairs[q];
+    if (p.overlap > kReferenceOverlapFraction * u)
+      out.push_back(pair_name(q, p) + " overlaps by " + length_text(p.overlap) +
+                    " in the reference configuration, more than " + format_number(kReferenceOverlapFraction) +
+                    " of the displacement scale U = " + format_number(u) +
+                    "; expected surfaces that touch or are apart before loading");
+    if (p.unpaired_near > 0)
+      out.push_back(pair_name(q, p) + ": " + std::to_string(p.unpaired_near) + " of its " + std::to_string(p.rows) +
+                    " slave nodes lie just beyond the ends of the master curve (within one master segment of"
+                    " it) and are not paired, so no pressure acts there; expected a master curve that covers the"
+                    " slave curve");
+  }
+  return out;
+}
+
+void check_contact_pairs_face(const Problem& problem) {
+  const std::vector<PairAtRest> pairs = pairs_at_rest(problem);
+  for (size_t q = 0; q < pairs.size(); ++q)
+    if (pairs[q].rows > 0 && pairs[q].paired == 0)
+      throw InputError(pair_name(q, pairs[q]) + " has no slave node facing its master curve in the reference"
+                       " configuration, so none is ever paired; expected curves that face each other");
+}
+
+}  // namespace contactrom::fom
