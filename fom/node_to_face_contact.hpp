@@ -106,9 +106,9 @@ class NodeToFaceContact final : public ContactModel {
 
   /// Slave node ids of every row, in row order.
   const std::vector<int>& slave_nodes() const { return m_slave; }
-  int num_pairs() const { return static_cast<int>(m_pairs.size()); }
+  int num_pairs() const override { return static_cast<int>(m_pairs.size()); }
   /// Pair of a constraint row.
-  int pair_of_row(int row) const { return m_row_pair[static_cast<size_t>(row)]; }
+  int pair_of_row(int row) const override { return m_row_pair[static_cast<size_t>(row)]; }
 
  private:
   struct Pair {
