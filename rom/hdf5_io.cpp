@@ -219,6 +219,55 @@ double read_double_attribute(hid_t loc, const char* name) {
   return read_numeric_attribute<double>(loc, name, H5T_FLOAT, H5T_NATIVE_DOUBLE, "floating-point number");
 }
 
+namespace {
+std::uint32_t rot32(std::uint32_t x, int r) { return (x << r) | (x >> (32 - r)); }
+std::uint32_t word32(const unsigned char* p, size_t n) {
+  std::uint32_t w = 0;
+  for (size_t i = 0; i < n && i < 4; ++i) w |= static_cast<std::uint32_t>(p[i]) << (8 * i);
+  return w;
+}
+}  // namespace
+
+DataChecksum::DataChecksum(std::size_t total)
+    : m_a(0xdeadbeef + static_cast<std::uint32_t>(total)), m_b(m_a), m_c(m_a), m_remaining(total) {}
+
+void DataChecksum::add(const void* bytes, std::size_t size) {
+  const unsigned char* p = static_cast<const unsigned char*>(bytes);
+  for (std::size_t i = 0; i < size; ++i) {
+    m_buffer[m_buffered++] = p[i];
+    // A full block is mixed only while more than 12 bytes remain (lookup3's loop);
+    // the last block, of 1 to 12 bytes, goes to the final step.
+    if (m_buffered == 12 && m_remaining > 12) {
+      std::uint32_t& a = m_a;
+      std::uint32_t& b = m_b;
+      std::uint32_t& c = m_c;
+      a += word32(m_buffer, 4), b += word32(m_buffer + 4, 4), c += word32(m_buffer + 8, 4);
+      a -= c, a ^= rot32(c, 4), c += b, b -= a, b ^= rot32(a, 6), a += c;
+      c -= b, c ^= rot32(b, 8), b += a, a -= c, a ^= rot32(c, 16), c += b;
+      b -= a, b ^= rot32(a, 19), a += c, c -= b, c ^= rot32(b, 4), b += a;
+      m_remaining -= 12, m_buffered = 0;
+    }
+  }
+}
+
+std::uint32_t DataChecksum::value() const {
+  std::uint32_t a = m_a, b = m_b, c = m_c;
+  const size_t length = m_buffered;
+  if (length == 0) return c;
+  const unsigned char* k = m_buffer;
+  a += word32(k, length), b += length > 4 ? word32(k + 4, length - 4) : 0, c += length > 8 ? word32(k + 8, length - 8) : 0;
+  c ^= b, c -= rot32(b, 14), a ^= c, a -= rot32(c, 11), b ^= a, b -= rot32(a, 25);
+  c ^= b, c -= rot32(b, 16), a ^= c, a -= rot32(c, 4), b ^= a, b -= rot32(a, 14);
+  c ^= b, c -= rot32(b, 24);
+  return c;
+}
+
+void write_checksum_attribute(hid_t set, std::uint32_t sum, const std::string& what) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, what);
+  Handle attr(H5Acreate2(set, kChecksumAttribute, H5T_STD_U32LE, space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
+  check(H5Awrite(attr.id(), H5T_NATIVE_UINT32, &sum), what);
+}
+
 std::uint32_t data_checksum(const void* bytes, std::size_t size) {
   return lookup3(static_cast<const unsigned char*>(bytes), size);
 }

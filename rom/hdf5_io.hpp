@@ -77,6 +77,27 @@ inline constexpr const char* kChecksumAttribute = "checksum_lookup3";
 /// initial value 0), the hash HDF5 uses for its metadata.
 std::uint32_t data_checksum(const void* bytes, std::size_t size);
 
+/// \brief data_checksum() of data that arrives in pieces (e.g. a dataset read back by
+/// blocks of rows): the same value as over the whole, with O(1) memory.
+class DataChecksum {
+ public:
+  /// \param total the number of bytes that will be added in all
+  explicit DataChecksum(std::size_t total);
+  /// Adds the next `size` bytes.
+  void add(const void* bytes, std::size_t size);
+  /// The checksum, once `total` bytes were added.
+  std::uint32_t value() const;
+
+ private:
+  std::uint32_t m_a, m_b, m_c;
+  std::size_t m_remaining;  // bytes not yet mixed (buffered ones included)
+  unsigned char m_buffer[12];
+  std::size_t m_buffered = 0;
+};
+
+/// \brief Stores `sum` as the checksum attribute of dataset `set`.
+void write_checksum_attribute(hid_t set, std::uint32_t sum, const std::string& what);
+
 /// \brief Writes a scalar fixed-length UTF-8 string attribute (h5py returns it as bytes
 /// or str depending on its version; its length is the string's, at least 1).
 void write_string_attribute(hid_t loc, const char* name, const std::string& value);

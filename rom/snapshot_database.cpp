@@ -291,6 +291,25 @@ void DatabaseWriter::finish(const SnapshotDatabase& db) {
     throw std::invalid_argument("DatabaseWriter::finish: the database's sizes differ from the file's");
   try {
     write_fields(m_impl->file->id(), m_impl->dcpl->id(), db, [] {});
+    // The checksum of /primal, whose rows were written in any order: read back in
+    // blocks of rows, in file order (memory: one block).
+    {
+      const hsize_t rows = static_cast<hsize_t>(m_impl->num_snapshots), cols = static_cast<hsize_t>(m_impl->num_dofs);
+      hdf5::DataChecksum sum(static_cast<std::size_t>(rows * cols * sizeof(double)));
+      const hsize_t block = std::max<hsize_t>(1, (hsize_t{1} << 22) / std::max<hsize_t>(cols, 1));  // ≈ 32 MB
+      std::vector<double> buffer;
+      Handle space(H5Dget_space(m_impl->primal->id()), H5Sclose, "dataset /primal");
+      for (hsize_t r0 = 0; r0 < rows && cols > 0; r0 += block) {
+        const hsize_t start[2] = {r0, 0}, count[2] = {std::min(block, rows - r0), cols};
+        buffer.resize(static_cast<size_t>(count[0] * cols));
+        hdf5::check(H5Sselect_hyperslab(space.id(), H5S_SELECT_SET, start, nullptr, count, nullptr), "dataset /primal");
+        Handle memory(H5Screate_simple(2, count, nullptr), H5Sclose, "dataset /primal");
+        hdf5::check(H5Dread(m_impl->primal->id(), H5T_NATIVE_DOUBLE, memory.id(), space.id(), H5P_DEFAULT, buffer.data()),
+                    "dataset /primal");
+        sum.add(buffer.data(), buffer.size() * sizeof(double));
+      }
+      hdf5::write_checksum_attribute(m_impl->primal->id(), sum.value(), "dataset /primal");
+    }
     m_impl->primal->close("dataset /primal");
     m_impl->primal.reset();
     m_impl->file->close("file close");

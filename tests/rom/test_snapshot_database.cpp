@@ -5,6 +5,8 @@
 #define BOOST_TEST_MODULE rom_snapshot_database
 #include <boost/test/unit_test.hpp>
 
+#include "rom/hdf5_io.hpp"
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -315,4 +317,20 @@ BOOST_AUTO_TEST_CASE(links_and_storage_outside_the_file_are_refused) {
   BOOST_REQUIRE(std::system(cmd.c_str()) == 0);
   const std::string e2 = input_error_of([&] { contactrom::rom::read_database(external); });
   BOOST_TEST(e2.find("outside the file") != std::string::npos, e2);
+}
+
+BOOST_AUTO_TEST_CASE(checksum_by_pieces_equals_the_checksum_of_the_whole) {
+  // The streamed /primal is checksummed block by block: every split of the data
+  // (pieces of any size, lengths around lookup3's 12-byte blocks) gives the value
+  // of the whole.
+  std::vector<unsigned char> data(1000);
+  for (size_t i = 0; i < data.size(); ++i) data[i] = static_cast<unsigned char>((i * 2654435761u) >> 13);
+  for (size_t n : {size_t{0}, size_t{1}, size_t{11}, size_t{12}, size_t{13}, size_t{24}, size_t{25}, size_t{1000}}) {
+    const std::uint32_t whole = contactrom::rom::hdf5::data_checksum(data.data(), n);
+    for (size_t piece : {size_t{1}, size_t{5}, size_t{12}, size_t{17}, size_t{1000}}) {
+      contactrom::rom::hdf5::DataChecksum sum(n);
+      for (size_t at = 0; at < n; at += piece) sum.add(data.data() + at, std::min(piece, n - at));
+      BOOST_TEST(sum.value() == whole, "length " << n << ", pieces of " << piece);
+    }
+  }
 }
