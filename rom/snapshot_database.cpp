@@ -224,7 +224,7 @@ DatabaseWriter::DatabaseWriter(std::string path, int num_dofs, int num_snapshots
     if (fd >= 0) ::close(fd);
     if (err != 0) {
       std::remove(m_impl->path.c_str());
-      throw InputError("cannot write database '" + m_impl->label + "': " + std::strerror(err));
+      throw WriteFailure("cannot write database '" + m_impl->label + "': " + std::strerror(err));
     }
   }
   hdf5::silence();
@@ -269,7 +269,7 @@ void DatabaseWriter::write_primal(int j, const Eigen::VectorXd& u) {
   std::lock_guard<std::mutex> lock(m_impl->mutex);
   if (!m_impl->primal || j < 0 || j >= m_impl->num_snapshots || u.size() != m_impl->num_dofs)
     throw std::invalid_argument("DatabaseWriter::write_primal: snapshot index or size out of range");
-  if (m_impl->failed) throw InputError("cannot write database '" + m_impl->label + "': an earlier write failed (disk full?)");
+  if (m_impl->failed) throw WriteFailure("cannot write database '" + m_impl->label + "': an earlier write failed (disk full?)");
   hdf5::silence();  // per thread in a thread-safe libhdf5: the workers write
   try {
     Handle space(H5Dget_space(m_impl->primal->id()), H5Sclose, "dataset /primal");
@@ -281,7 +281,7 @@ void DatabaseWriter::write_primal(int j, const Eigen::VectorXd& u) {
                   "dataset /primal");
   } catch (const Hdf5Failure& e) {
     m_impl->failed = true;
-    throw InputError("cannot write database '" + m_impl->label + "': HDF5 failed on " + e.what() + " (disk full?)");
+    throw WriteFailure("cannot write database '" + m_impl->label + "': HDF5 failed on " + e.what() + " (disk full?)");
   }
 }
 
@@ -315,7 +315,7 @@ void DatabaseWriter::finish(const SnapshotDatabase& db) {
     m_impl->file->close("file close");
   } catch (const Hdf5Failure& e) {
     m_impl->failed = true;
-    throw InputError("cannot write database '" + m_impl->label + "': HDF5 failed on " + e.what() + " (disk full?)");
+    throw WriteFailure("cannot write database '" + m_impl->label + "': HDF5 failed on " + e.what() + " (disk full?)");
   }
 }
 

@@ -153,6 +153,10 @@ void add_primal_snapshots(const std::string& path, const Eigen::MatrixXd& primal
   const hid_t space = H5Screate_simple(2, dims, nullptr);
   const hid_t d = H5Dcreate2(f, "primal_snapshots", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   BOOST_REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, primal.data()) >= 0);
+  // As contactrom writes every dataset: with the checksum of its data.
+  contactrom::rom::hdf5::write_checksum_attribute(
+      d, contactrom::rom::hdf5::data_checksum(primal.data(), static_cast<size_t>(primal.size()) * sizeof(double)),
+      "dataset /primal_snapshots");
   H5Dclose(d), H5Sclose(space), H5Fclose(f);
 }
 
