@@ -150,7 +150,7 @@ void run_demo(const DemoArgs& a) {
               s.max_dual_error, sn.mean_dual_error, sn.max_dual_error);
   std::printf("   %-36s %10.2f %10d   %10.2f %10d\n", "sparsity |I| (selected snapshots)", s.mean_sparsity,
               s.max_sparsity, sn.mean_sparsity, sn.max_sparsity);
-  std::printf("   %-36s %10.2f %10s   %10.2f\n", "iterations (one-change solves)", s.mean_iterations, "",
+  std::printf("   %-36s %10.2f %10s   %10.2f\n", "iterations (reduced solves)", s.mean_iterations, "",
               sn.mean_iterations);
   std::printf("   %-36s %10d %10s   %10d\n", "not converged", s.nonconverged, "", sn.nonconverged);
   std::printf("   %-36s %10.1f %10s   %10.1f     (us; full field +%.1f us)\n", "ROM time per query (median)",
