@@ -41,9 +41,11 @@ ContactResiduals contact_residuals(const Problem& problem, const Pairing& pairin
   contact.assemble(pairing, c, g);
   gap.noalias() = c * u_surface;
   gap -= g;  // (Cu − g)_s = w_s d_s
-  const Eigen::VectorXd& w = contact.weights();
-  const double u_scale = problem.displacement_scale();
+  return contact_residuals_of_gaps(gap, contact.weights(), lambda, problem.displacement_scale());
+}
 
+ContactResiduals contact_residuals_of_gaps(const Eigen::VectorXd& gap, const Eigen::VectorXd& w,
+                                           const Eigen::VectorXd& lambda, double u_scale) {
   ContactResiduals r;
   const double lambda_max = lambda.size() > 0 ? lambda.cwiseAbs().maxCoeff() : 0.0;
   double force = 0.0, separation = 0.0, worst_separation = 0.0;

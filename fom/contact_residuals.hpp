@@ -62,6 +62,13 @@ ContactResiduals contact_residuals(const Problem& problem, const Eigen::VectorXd
 ContactResiduals contact_residuals(const Problem& problem, const Pairing& pairing, const Eigen::VectorXd& u_surface,
                                    const Eigen::VectorXd& lambda);
 
+/// \brief The residuals of the file comment from the gaps of a set of rows:
+/// `gap` = (Cu − g) on those rows, `weights` and `lambda` on the same rows (all of
+/// one length; rows in the result are positions in them). The other overloads, and
+/// a reduced method testing its own support rows, call this.
+ContactResiduals contact_residuals_of_gaps(const Eigen::VectorXd& gap, const Eigen::VectorXd& weights,
+                                           const Eigen::VectorXd& lambda, double displacement_scale);
+
 /// \brief The problem's tolerances: its file's `[rom]` `penetration_tolerance`,
 /// `complementarity_tolerance` and `negative_pressure_tolerance`, else the defaults
 /// of ContactTolerances.

@@ -580,6 +580,7 @@ struct GreedyActiveSet::Nested {
   std::vector<char> in_active;
   std::vector<int> solved;
   SelectionHistory seen;  // selections met on the current operators
+  Eigen::VectorXd w_r, lambda_r;  // physically_converged: weights and pressure on the support rows
   std::vector<double> feasible;  // settle_exact: the non-negative multipliers of `cols`
   std::vector<int> blocked;      // settle_exact: columns not offered again on these operators
   fom::AndersonMixer mixer{0};
@@ -778,22 +779,18 @@ struct GreedyActiveSet::Nested {
     const SupportRows& support = g->m_support;
     support.violation(q->ops.c, q->ops.g, u_s, gap, violation);  // gap = C_R u_s − g_R
     const Eigen::VectorXd& w = g->m_model.problem().contact().weights();
-    const double u_scale = g->m_model.problem().displacement_scale();
-    double penetration = 0.0, force = 0.0, separation = 0.0;
+    w_r.resize(gap.size());
+    lambda_r.setZero(gap.size());
     for (int i = 0; i < gap.size(); ++i) {
-      const double ws = w(support.rows[static_cast<size_t>(i)]);
-      const double d = ws > 0.0 ? gap(i) / ws : 0.0;
-      penetration = std::max(penetration, d / u_scale);
-      double l = 0.0;
-      for (int j = 0; j < n_lambda; ++j) l += (*dr)(i, cols[j].p) * lambda_storage(j);
-      force += ws * std::abs(l);
-      separation += ws * std::abs(l) * std::abs(d);
+      w_r(i) = w(support.rows[static_cast<size_t>(i)]);
+      for (int j = 0; j < n_lambda; ++j) lambda_r(i) += (*dr)(i, cols[j].p) * lambda_storage(j);
     }
-    const double complementarity = force > 0.0 ? separation / (u_scale * force) : 0.0;
+    const fom::ContactResiduals r =
+        fom::contact_residuals_of_gaps(gap, w_r, lambda_r, g->m_model.problem().displacement_scale());
     if (g->m_options.trace)
-      *g->m_options.trace << "greedy physical test: penetration=" << penetration
-                          << " U, separation under pressure=" << complementarity << " U\n";
-    return penetration <= tol.penetration && complementarity <= tol.complementarity;
+      *g->m_options.trace << "greedy physical test: penetration=" << r.penetration
+                          << " U, separation under pressure=" << r.complementarity << " U\n";
+    return r.penetration <= tol.penetration && r.complementarity <= tol.complementarity;
   }
 
   void trace_step(int rebuild, int remove, int add, double max_violation) {
