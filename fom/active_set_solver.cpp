@@ -183,6 +183,14 @@ bool condense(const Problem& problem, const Param& mu, Condensation& out, const 
   return true;
 }
 
+PairedSolution solve_at_pairing(const Problem& problem, const Condensation& cond, const ActiveSetOptions& options,
+                                const Eigen::VectorXd& u0_s, const Pairing& pairing, const ConstraintMatrix& c,
+                                const Eigen::VectorXd& g, const Eigen::VectorXd& x_s,
+                                const Eigen::VectorXd& lambda_start, int& iterations) {
+  WorkingSetQp qp(problem, cond, options, u0_s, lambda_start);
+  return qp.solve(pairing, c, g, x_s, iterations);
+}
+
 Eigen::MatrixXd unconstrained_load_responses(const Problem& problem, const Param& mu) {
   check_rigid_motions_held(problem);
   Condensation cond;

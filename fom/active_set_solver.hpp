@@ -113,6 +113,19 @@ bool condense(const Problem& problem, const Param& mu, Condensation& out, const 
 /// reduced model. \throws InputError if K(μ) is singular on the free dofs.
 Eigen::MatrixXd unconstrained_load_responses(const Problem& problem, const Param& mu);
 
+/// \brief The FOM's dual QP of one pairing, as solve() runs it inside its pairing
+/// loop (working set, warm start, rows outside the working set checked at the
+/// solution): the exact condensed problem at the fixed pairing whose operator is
+/// `c`, `g`, from the iterate `x_s` (surface displacement choosing the working set)
+/// and the multipliers `lambda_start`. Mesh-size free: it touches S and the surface
+/// only. Used by the reduced models' error estimate (rom/error_indicator.hpp).
+/// \param u0_s unconstrained displacement on the surface dofs
+/// \param iterations incremented by the QP's active-set iterations
+PairedSolution solve_at_pairing(const Problem& problem, const Condensation& cond, const ActiveSetOptions& options,
+                                const Eigen::VectorXd& u0_s, const Pairing& pairing, const ConstraintMatrix& c,
+                                const Eigen::VectorXd& g, const Eigen::VectorXd& x_s,
+                                const Eigen::VectorXd& lambda_start, int& iterations);
+
 /// \brief Custom active-set FOM solver; see the file comment.
 class ActiveSetSolver {
  public:

@@ -56,7 +56,65 @@ SummaryValues summary_values(const EvaluationSummary& s) {
                      {"inaccurate", static_cast<long long>(s.inaccurate)},
                      {"fom_failures", static_cast<long long>(s.fom_failures)}});
   if (s.kkt) v.emplace_back("max_kkt", s.max_kkt);
+  const EstimateQuality& q = s.estimates;
+  v.insert(v.end(), {{"estimated_rows", static_cast<long long>(q.rows)},
+                     {"primal_estimate_correlation", q.primal_correlation},
+                     {"dual_estimate_correlation", q.dual_correlation},
+                     {"primal_underestimated", static_cast<long long>(q.primal_underestimated)},
+                     {"dual_underestimated", static_cast<long long>(q.dual_underestimated)},
+                     {"min_primal_effectivity", q.min_primal_effectivity},
+                     {"max_primal_effectivity", q.max_primal_effectivity},
+                     {"min_dual_effectivity", q.min_dual_effectivity},
+                     {"max_dual_effectivity", q.max_dual_effectivity},
+                     {"mean_estimate_time_s", s.mean_estimate_time_s}});
   return v;
+}
+
+double rank_correlation(const std::vector<double>& x, const std::vector<double>& y) {
+  const size_t n = x.size();
+  if (n < 3 || y.size() != n) return std::numeric_limits<double>::quiet_NaN();
+  const auto ranks = [n](const std::vector<double>& v) {
+    std::vector<size_t> order(n);
+    for (size_t i = 0; i < n; ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&v](size_t a, size_t b) { return v[a] < v[b]; });
+    Eigen::VectorXd r(static_cast<Eigen::Index>(n));
+    for (size_t i = 0; i < n;) {
+      size_t j = i;
+      while (j + 1 < n && v[order[j + 1]] == v[order[i]]) ++j;
+      for (size_t k = i; k <= j; ++k) r(static_cast<Eigen::Index>(order[k])) = 0.5 * static_cast<double>(i + j);
+      i = j + 1;
+    }
+    return Eigen::VectorXd(r.array() - r.mean());
+  };
+  const Eigen::VectorXd rx = ranks(x), ry = ranks(y);
+  const double den = rx.norm() * ry.norm();
+  return den > 0.0 ? rx.dot(ry) / den : std::numeric_limits<double>::quiet_NaN();
+}
+
+EstimateQuality estimate_quality(const std::vector<EvaluationRow>& rows) {
+  EstimateQuality q;
+  std::vector<double> ep, ed, xp, xd;
+  const auto effectivity = [](double estimate, double error, double& lo, double& hi) {
+    if (!(error > 1e-12)) return;
+    const double ratio = estimate / error;
+    if (!(ratio >= lo)) lo = std::isnan(lo) ? ratio : std::min(lo, ratio);
+    if (!(ratio <= hi)) hi = std::isnan(hi) ? ratio : std::max(hi, ratio);
+  };
+  for (const EvaluationRow& row : rows) {
+    if (row.absolute_errors || row.absolute_estimates || !std::isfinite(row.primal_estimate) ||
+        !std::isfinite(row.dual_estimate) || !std::isfinite(row.primal_error) || !std::isfinite(row.dual_error))
+      continue;
+    ++q.rows;
+    ep.push_back(row.primal_error), xp.push_back(row.primal_estimate);
+    ed.push_back(row.dual_error), xd.push_back(row.dual_estimate);
+    if (row.primal_error > row.primal_estimate) ++q.primal_underestimated;
+    if (row.dual_error > row.dual_estimate) ++q.dual_underestimated;
+    effectivity(row.primal_estimate, row.primal_error, q.min_primal_effectivity, q.max_primal_effectivity);
+    effectivity(row.dual_estimate, row.dual_error, q.min_dual_effectivity, q.max_dual_effectivity);
+  }
+  q.primal_correlation = rank_correlation(xp, ep);
+  q.dual_correlation = rank_correlation(xd, ed);
+  return q;
 }
 
 std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& solver,
@@ -98,6 +156,10 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
     row.converged = res.converged;
     row.status = res.status;
     row.contact = res.contact;
+    row.primal_estimate = res.primal_estimate;
+    row.dual_estimate = res.dual_estimate;
+    row.absolute_estimates = res.absolute_estimates;
+    s.mean_estimate_time_s += res.estimate_time_s;
     for (int c : res.selected) row.selected.push_back(model.dictionary_snapshots()[c]);
     row.fom_status = ref.status;
     row.fom_time_s = ref.time_s;
@@ -122,7 +184,9 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
   s.mean_sparsity /= n;
   s.mean_iterations /= n;
   s.mean_time_s /= n;
+  s.mean_estimate_time_s /= n;
   s.median_time_s = median(times);
+  s.estimates = estimate_quality(s.rows);
   return s;
 }
 
@@ -130,7 +194,7 @@ void write_evaluation_csv(const std::string& path, const fom::Problem& problem, 
   write_file_atomically(path, [&](std::ostream& out) {
     for (const std::string& name : problem.param_names()) out << name << ',';
     out << "primal_error,dual_error,sparsity,iterations,time_s,converged,status,selected,errors,penetration,"
-           "separation\n";
+           "separation,primal_estimate,dual_estimate\n";
     for (const EvaluationRow& row : summary.rows) {
       for (int k = 0; k < row.mu.size(); ++k) out << format_number(row.mu(k)) << ',';
       out << format_number(row.primal_error) << ',' << format_number(row.dual_error) << ',' << row.sparsity << ','
@@ -138,7 +202,8 @@ void write_evaluation_csv(const std::string& path, const fom::Problem& problem, 
           << to_string(row.status) << ',';
       for (size_t j = 0; j < row.selected.size(); ++j) out << (j ? " " : "") << row.selected[j];
       out << ',' << (row.absolute_errors ? "absolute" : "relative") << ',' << format_number(row.contact.penetration)
-          << ',' << format_number(row.contact.complementarity) << '\n';
+          << ',' << format_number(row.contact.complementarity) << ',' << format_number(row.primal_estimate) << ','
+          << format_number(row.dual_estimate) << '\n';
     }
   });
 }

@@ -9,6 +9,7 @@
 /// \code
 ///   contactrom online --db hertz30.h5 --method greedy --delta 1e-8 --validation --out hertz30.csv --json
 /// \endcode
+#include <limits>
 #include <string>
 #include <utility>
 #include <variant>
@@ -43,6 +44,10 @@ struct EvaluationRow {
   bool converged = false;
   Status status = Status::Success;
   fom::ContactResiduals contact;  ///< the answer's full-order contact residuals (OnlineResult::contact)
+  /// The answer's error estimates (OnlineResult::primal_estimate, dual_estimate; NaN if none).
+  double primal_estimate = std::numeric_limits<double>::quiet_NaN();
+  double dual_estimate = std::numeric_limits<double>::quiet_NaN();
+  bool absolute_estimates = false;  ///< OnlineResult::absolute_estimates
   std::vector<int> selected;   ///< selected columns as database snapshot indices
   Status fom_status = Status::Success;
   double fom_time_s = 0.0;     ///< FOM reference time (measured in parallel: indicative only)
@@ -73,6 +78,29 @@ struct ErrorStatistics {
   double m_sum_primal = 0.0, m_sum_dual = 0.0;
 };
 
+/// \brief How well the error estimates of a set of rows match the true errors, over
+/// the rows whose errors and estimates are both relative and finite.
+struct EstimateQuality {
+  int rows = 0;                    ///< rows compared
+  /// Spearman rank correlation of estimate and true error (NaN below 3 rows).
+  double primal_correlation = std::numeric_limits<double>::quiet_NaN();
+  double dual_correlation = std::numeric_limits<double>::quiet_NaN();
+  /// Rows whose true error exceeds its estimate.
+  int primal_underestimated = 0, dual_underestimated = 0;
+  /// Smallest and largest effectivity estimate / error (rows with an error above 1e-12).
+  double min_primal_effectivity = std::numeric_limits<double>::quiet_NaN();
+  double max_primal_effectivity = std::numeric_limits<double>::quiet_NaN();
+  double min_dual_effectivity = std::numeric_limits<double>::quiet_NaN();
+  double max_dual_effectivity = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// \brief EstimateQuality of `rows`.
+EstimateQuality estimate_quality(const std::vector<EvaluationRow>& rows);
+
+/// \brief Spearman rank correlation of two samples of one length (average ranks for
+/// ties); NaN for fewer than 3 values or a constant sample.
+double rank_correlation(const std::vector<double>& x, const std::vector<double>& y);
+
 /// \brief Means and maxima over the rows; summary_values() lists them.
 struct EvaluationSummary : ErrorStatistics {
   std::string problem;      ///< name of the problem
@@ -91,6 +119,8 @@ struct EvaluationSummary : ErrorStatistics {
   int fom_failures = 0;   ///< reference FOM solves whose status != Success
   bool kkt = false;       ///< whether the rows' KKT residuals were computed (EvaluationOptions::kkt)
   double max_kkt = 0.0;   ///< largest KKT residual over the rows (if computed)
+  EstimateQuality estimates;         ///< the error estimates against the true errors
+  double mean_estimate_time_s = 0.0; ///< mean OnlineResult::estimate_time_s (part of mean_time_s)
 };
 
 /// \brief One value of a summary: a count, a real number or a word.
@@ -105,8 +135,11 @@ using SummaryValues = std::vector<std::pair<std::string, SummaryValue>>;
 /// dual_basis_size, primal_rank, validation_size, mean_primal_error,
 /// max_primal_error, mean_dual_error, max_dual_error, absolute_error_rows,
 /// max_absolute_primal_error, max_absolute_dual_error, mean_sparsity, max_sparsity,
-/// mean_iterations, mean_time_s, median_time_s, nonconverged, inaccurate, fom_failures, and
-/// max_kkt when the KKT residuals were computed.
+/// mean_iterations, mean_time_s, median_time_s, nonconverged, inaccurate, fom_failures,
+/// max_kkt when the KKT residuals were computed, and the EstimateQuality:
+/// estimated_rows, primal_estimate_correlation, dual_estimate_correlation,
+/// primal_underestimated, dual_underestimated, min/max_primal_effectivity,
+/// min/max_dual_effectivity, mean_estimate_time_s.
 SummaryValues summary_values(const EvaluationSummary& summary);
 
 /// \brief Appends the error entries shared by every evaluation against the FOM
@@ -125,7 +158,8 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
 /// after it), then primal_error, dual_error, sparsity, iterations, time_s,
 /// converged (0/1), status, selected (space-separated database snapshot indices),
 /// errors ("relative", or "absolute" where the FOM displacement is near zero),
-/// penetration and separation (the answer's contact residuals, units of U).
+/// penetration and separation (the answer's contact residuals, units of U),
+/// primal_estimate and dual_estimate (the answer's error estimates).
 void write_evaluation_csv(const std::string& path, const fom::Problem& problem, const EvaluationSummary& summary);
 
 }  // namespace contactrom::rom

@@ -45,6 +45,12 @@ OptionSpec complementarity_tolerance_spec() {
                 "[rom] value, else 5e-2");
 }
 
+/// The error estimate that every online method makes of its answers.
+OptionSpec estimate_spec() {
+  return flag("estimate", "true",
+              "estimate the primal and dual errors of every answer at the full order on the contact surface");
+}
+
 }  // namespace
 
 std::vector<OptionSpec> active_set_option_specs() {
@@ -55,7 +61,7 @@ std::vector<OptionSpec> active_set_option_specs() {
           number("step_tolerance", "1e-5", "relative change of u_hat under which the iteration may stop",
                  Interval::at_least(0)),
           flag("time_operators", "false", "measure the time spent building the contact operators"),
-          penetration_tolerance_spec(), complementarity_tolerance_spec()};
+          penetration_tolerance_spec(), complementarity_tolerance_spec(), estimate_spec()};
 }
 
 namespace {
@@ -104,7 +110,8 @@ std::vector<OptionSpec> convex_hull_specs() {
           number("focuss_tolerance", "1e-10", "nnFOCUSS stopping tolerance"),
           number("prune_tolerance", "1e-8", "nnFOCUSS pruning threshold"),
           penetration_tolerance_spec(),
-          complementarity_tolerance_spec()};
+          complementarity_tolerance_spec(),
+          estimate_spec()};
 }
 
 struct Registry {
@@ -143,6 +150,7 @@ std::string shared_value(const OnlineSolverOptions& o, const std::string& key) {
   if (key == "step_tolerance") return fom::format_number(o.step_tolerance);
   if (key == "penetration_tolerance") return fom::format_number(o.penetration_tolerance);
   if (key == "complementarity_tolerance") return fom::format_number(o.complementarity_tolerance);
+  if (key == "estimate") return o.estimate ? "true" : "false";
   return o.time_operators ? "true" : "false";  // time_operators
 }
 
@@ -162,6 +170,8 @@ void set_shared(OnlineSolverOptions& o, const std::string& key, const std::strin
     o.penetration_tolerance = parse_number(value, key);
   else if (key == "complementarity_tolerance")
     o.complementarity_tolerance = parse_number(value, key);
+  else if (key == "estimate")
+    o.estimate = flag_value(value);
   else
     o.time_operators = flag_value(value);
 }
@@ -182,7 +192,7 @@ void check_key(const OnlineMethod& m, const std::string& key) {
 const std::vector<std::string>& shared_option_keys() {
   static const std::vector<std::string> keys{"tau",           "tau_scaling",           "max_iterations",
                                              "step_tolerance", "time_operators",        "penetration_tolerance",
-                                             "complementarity_tolerance"};
+                                             "complementarity_tolerance", "estimate"};
   return keys;
 }
 
@@ -387,6 +397,7 @@ std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const 
   if (options.penetration_tolerance >= 0) tolerances.penetration = options.penetration_tolerance;
   if (options.complementarity_tolerance >= 0) tolerances.complementarity = options.complementarity_tolerance;
   solver->set_contact_tolerances(tolerances);
+  if (options.estimate) solver->set_error_indicator(model.error_indicator());
   return solver;
 }
 

@@ -13,7 +13,9 @@
 /// \endcode
 #include <Eigen/Dense>
 #include <chrono>
+#include <limits>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,8 @@
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::rom {
+
+class ErrorIndicator;
 
 /// \brief One online query of a ROM.
 struct OnlineResult {
@@ -41,6 +45,18 @@ struct OnlineResult {
   /// Row-by-row full-order contact residuals of (u, λ) at their own pairing
   /// (fom/contact_residuals.hpp), evaluated after every query on the contact surface.
   fom::ContactResiduals contact;
+  /// A posteriori estimates of the relative H¹ error of u and the relative L²(Γc)
+  /// error of λ against the FOM (the quantities of primal_error and dual_error),
+  /// made without the FOM solve (rom/error_indicator.hpp); NaN when not estimated
+  /// (OnlineSolverOptions::estimate off, a parameter-dependent stiffness, a failed
+  /// correction).
+  double primal_estimate = std::numeric_limits<double>::quiet_NaN();
+  double dual_estimate = std::numeric_limits<double>::quiet_NaN();  ///< see primal_estimate
+  /// The estimates are absolute (the corrected displacement is near zero), as
+  /// EvaluationRow::absolute_errors.
+  bool absolute_estimates = false;
+  /// Wall time of the error estimate, included in `time_s`.
+  double estimate_time_s = 0.0;
   /// Wall time of the online core (seconds): everything from μ to (û, λ̂_I) and the
   /// full pressure, nonlinear contact operators included; the full-field
   /// reconstruction Φû + u_lift (a mesh-size operation needed only for output) is
@@ -83,6 +99,8 @@ class OnlineSolver {
   virtual int dual_basis_size() const { return model().dictionary_size(); }
   /// Tolerances of the contact check (default: the problem's, fom::default_contact_tolerances).
   fom::ContactTolerances contact_tolerances() const;
+  /// Estimates the errors of every answer with `indicator` (nullptr: none).
+  void set_error_indicator(std::shared_ptr<const ErrorIndicator> indicator) { m_indicator = std::move(indicator); }
   /// Sets the tolerances of the contact check.
   void set_contact_tolerances(const fom::ContactTolerances& tolerances) { m_tolerances = tolerances, m_tolerances_set = true; }
 
@@ -93,12 +111,20 @@ class OnlineSolver {
  private:
   fom::ContactTolerances m_tolerances;
   bool m_tolerances_set = false;
+  std::shared_ptr<const ErrorIndicator> m_indicator;
 };
 
 /// \brief The full-order contact check of an online answer: sets `res.contact` and
 /// `res.check_time_s`, and turns a Success whose residuals exceed `tolerances` into
 /// Status::Inaccurate (message: the residuals above tolerance and their rows).
-void check_contact(const ReducedModel& model, const fom::ContactTolerances& tolerances, OnlineResult& res);
+/// \returns the pairing searched at the answer (storage of the calling thread, valid
+///   until its next check), or nullptr when the answer has no fields.
+const fom::Pairing* check_contact(const ReducedModel& model, const fom::ContactTolerances& tolerances, OnlineResult& res);
+
+/// \brief The error estimate of an answer (OnlineResult::primal_estimate, dual_estimate,
+/// absolute_estimates, estimate_time_s, added to time_s), at the pairing that
+/// check_contact() searched at it.
+void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairing, OnlineResult& res);
 
 /// \brief Settings shared by the online methods (each documents which it reads).
 struct OnlineSolverOptions {
@@ -116,6 +142,9 @@ struct OnlineSolverOptions {
   /// each < 0: the problem's (`[rom]` of its file, else fom::ContactTolerances).
   double penetration_tolerance = -1.0;
   double complementarity_tolerance = -1.0;
+  /// Estimate the errors of every answer (OnlineResult::primal_estimate and
+  /// dual_estimate; rom/error_indicator.hpp). Default true.
+  bool estimate = true;
   /// Measure OnlineResult::operator_time_s (greedy, greedy-nested, cpg,
   /// full-dictionary). Off by default: the clock reads add about 1 % to a query.
   bool time_operators = false;

@@ -1,5 +1,7 @@
 #include "rom/reduced_model.hpp"
 
+#include "rom/error_indicator.hpp"
+
 #include "core/format.hpp"
 
 #include <Eigen/SparseCholesky>
@@ -9,6 +11,7 @@
 #include <limits>
 
 #include "fom/active_set_solver.hpp"
+#include "rom/error_indicator.hpp"
 #include "rom/pod.hpp"
 
 namespace contactrom::rom {
@@ -246,6 +249,11 @@ ReducedModelData ReducedModel::data() const {
   d.primal_snapshots = m_primal;
   d.snapshot_coordinates = m_snapshot_coords;
   return d;
+}
+
+std::shared_ptr<const ErrorIndicator> ReducedModel::error_indicator() const {
+  std::call_once(m_indicator->once, [this] { m_indicator->indicator = std::make_shared<const ErrorIndicator>(*this); });
+  return m_indicator->indicator;
 }
 
 void ReducedModel::derive() {

@@ -18,6 +18,8 @@
 /// database whose FOM status is Success, uncompressed, in database order.
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include "fom/problem.hpp"
@@ -25,6 +27,8 @@
 #include "rom/snapshot_database.hpp"
 
 namespace contactrom::rom {
+
+class ErrorIndicator;
 
 /// \brief Which affine offset u_off(μ) = Σ_k φ_k(μ) L̃_k the reduced displacement is
 /// measured from (u = u_off(μ) + Φû). Both carry the Dirichlet data exactly.
@@ -237,6 +241,11 @@ class ReducedModel {
   /// \brief Full pressure \f$ \lambda = D_d[:, I]\,\hat\lambda_I \f$ (n_c).
   Eigen::VectorXd reconstruct_dual(const std::vector<int>& columns, const Eigen::VectorXd& coefficients) const;
 
+  /// \brief The error estimate of this model's answers (rom/error_indicator.hpp):
+  /// built on the first call (one factorisation of K; thread-safe) and shared by
+  /// every solver on the model and its copies.
+  std::shared_ptr<const ErrorIndicator> error_indicator() const;
+
   /// Offline time spent building the model (POD + reduced operators), seconds.
   double setup_time() const { return m_setup_time; }
   /// Of which the POD (reading the snapshots included), seconds (0 for a loaded model).
@@ -268,6 +277,11 @@ class ReducedModel {
   Eigen::MatrixXd m_k_inv;
   bool m_single_ok = false;
   double m_setup_time = 0.0, m_pod_time = 0.0;
+  struct IndicatorSlot {
+    std::once_flag once;
+    std::shared_ptr<const ErrorIndicator> indicator;
+  };
+  std::shared_ptr<IndicatorSlot> m_indicator = std::make_shared<IndicatorSlot>();  // built by error_indicator()
 };
 
 /// \brief K̂(μ)⁻¹ for one online query: with a single stiffness term the offline

@@ -286,7 +286,7 @@ void write_query_csv(const std::string& path, const OnlineModel& rom, const std:
 FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResult>& results) {
   return [&rom, &results](std::ostream& out) {
     for (const std::string& name : rom.problem().param_names()) out << name << ',';
-    out << "status,converged,iterations,sparsity,contact_force,time_s,selected,coefficients,penetration,separation\n";
+    out << "status,converged,iterations,sparsity,contact_force,time_s,selected,coefficients,penetration,separation,primal_estimate,dual_estimate\n";
     for (const OnlineResult& res : results) {
       for (int k = 0; k < res.mu.size(); ++k) out << fom::format_number(res.mu(k)) << ',';
       out << to_string(res.status) << ',' << (res.converged ? 1 : 0) << ',' << res.iterations << ','
@@ -297,7 +297,7 @@ FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResu
       out << ',';
       for (Eigen::Index j = 0; j < res.coefficients.size(); ++j) out << (j ? " " : "") << fom::format_number(res.coefficients(j));
       out << ',' << fom::format_number(res.contact.penetration) << ',' << fom::format_number(res.contact.complementarity)
-          << '\n';
+          << ',' << fom::format_number(res.primal_estimate) << ',' << fom::format_number(res.dual_estimate) << '\n';
     }
   };
 }

@@ -65,6 +65,8 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
   j["converged"] = res.converged;
   j["penetration"] = res.contact.penetration;
   j["separation"] = res.contact.complementarity;
+  j["primal_estimate"] = res.primal_estimate;
+  j["dual_estimate"] = res.dual_estimate;
   if (!res.message.empty()) j["message"] = res.message;
   j["iterations"] = res.iterations;
   j["sparsity"] = res.selected.size();

@@ -39,6 +39,8 @@ nlohmann::json result_json(const rom::OnlineModel& rom, const rom::OnlineResult&
   j["time_s"] = res.time_s;
   j["penetration"] = res.contact.penetration;
   j["separation"] = res.contact.complementarity;
+  j["primal_estimate"] = res.primal_estimate;
+  j["dual_estimate"] = res.dual_estimate;
   return j;
 }
 

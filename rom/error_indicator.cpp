@@ -1,0 +1,153 @@
+#include "rom/error_indicator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/stopwatch.hpp"
+#include "fom/kkt.hpp"
+#include "rom/reduced_model.hpp"
+
+namespace contactrom::rom {
+namespace {
+
+/// Surface dofs solved per block when forming E_sᵀ K⁻¹ H K⁻¹ E_s: bounds the dense
+/// n_free × block work space.
+constexpr int kSurfaceBlock = 64;
+
+/// Rows of a free-dof matrix at the surface dofs (zero rows for Dirichlet ones).
+Eigen::MatrixXd surface_rows(const Eigen::MatrixXd& x_free, const std::vector<int>& surface, const std::vector<int>& free_index) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(surface.size()), x_free.cols());
+  for (size_t j = 0; j < surface.size(); ++j)
+    if (free_index[surface[j]] >= 0) out.row(static_cast<Eigen::Index>(j)) = x_free.row(free_index[surface[j]]);
+  return out;
+}
+
+/// K_ff⁻¹ (M)_free for a matrix M on all dofs: the free rows of M, one solve per column.
+Eigen::MatrixXd solve_free(const fom::SparseCholesky& factor, const Eigen::MatrixXd& m, const std::vector<int>& free) {
+  Eigen::MatrixXd rhs(static_cast<Eigen::Index>(free.size()), m.cols());
+  for (size_t i = 0; i < free.size(); ++i) rhs.row(static_cast<Eigen::Index>(i)) = m.row(free[i]);
+  return factor.solve(rhs);
+}
+
+}  // namespace
+
+ErrorIndicator::ErrorIndicator(const ReducedModel& model, ErrorIndicatorOptions options)
+    : m_problem(model.problem()), m_rank(model.primal_rank()), m_options(std::move(options)) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (m_problem.stiffness_is_constant()) build(model);
+  m_setup_time = seconds_since(t0);
+}
+
+ErrorIndicator::~ErrorIndicator() = default;
+
+void ErrorIndicator::build(const ReducedModel& model) {
+  const fom::Problem& problem = m_problem;
+  const fom::Param mid = 0.5 * (problem.param_lower() + problem.param_upper());
+  if (!fom::condense(problem, mid, m_cond)) return;
+  const int n = problem.num_dofs(), r = m_rank, nt = problem.num_load_terms();
+  const std::vector<int>& free = problem.free_dofs();
+  const std::vector<int>& surf = problem.contact().surface_dofs();
+  const int ns = static_cast<int>(surf.size());
+  std::vector<int> free_index(static_cast<size_t>(n), -1);
+  for (size_t i = 0; i < free.size(); ++i) free_index[free[i]] = static_cast<int>(i);
+  const fom::SparseMatrix& h = problem.h1_gram();
+
+  // V = [Φ, L̃ − Z]: the answer is V (û, φ(μ)) + z(μ), with z(μ) = Z φ(μ).
+  const Eigen::MatrixXd& z = m_cond.z_load;
+  Eigen::MatrixXd v(n, r + nt);
+  v.leftCols(r) = model.basis();
+  for (int k = 0; k < nt; ++k) v.col(r + k) = model.offset_terms()[static_cast<size_t>(k)] - z.col(k);
+  const Eigen::MatrixXd hv = h * v, hz = h * z;
+  m_vhv = v.transpose() * hv;
+  m_zhz = z.transpose() * hz;
+  m_vhs = surface_rows(solve_free(*m_cond.factor, hv, free), surf, free_index).transpose();
+  m_zhs = surface_rows(solve_free(*m_cond.factor, hz, free), surf, free_index).transpose();
+
+  // E_sᵀ K⁻¹ H K⁻¹ E_s by blocks of surface dofs: X = K⁻¹ E_b, then K⁻¹ H X.
+  m_shs = Eigen::MatrixXd::Zero(ns, ns);
+  for (int first = 0; first < ns; first += kSurfaceBlock) {
+    const int count = std::min(kSurfaceBlock, ns - first);
+    Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(n, count);
+    for (int j = 0; j < count; ++j)
+      if (free_index[surf[first + j]] >= 0) unit(surf[first + j], j) = 1.0;
+    const Eigen::MatrixXd x_free = solve_free(*m_cond.factor, unit, free);
+    Eigen::MatrixXd x = Eigen::MatrixXd::Zero(n, count);
+    for (size_t i = 0; i < free.size(); ++i) x.row(free[i]) = x_free.row(static_cast<Eigen::Index>(i));
+    m_shs.middleCols(first, count) = surface_rows(solve_free(*m_cond.factor, h * x, free), surf, free_index);
+  }
+  m_shs = (0.5 * (m_shs + m_shs.transpose())).eval();
+  m_z_s = Eigen::MatrixXd(ns, nt);
+  for (int j = 0; j < ns; ++j) m_z_s.row(j) = z.row(surf[j]);
+  m_cond.factor.reset();  // every query needs S only
+
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(n);
+  m_near_zero = fom::kNearZeroReference * problem.displacement_scale() * std::sqrt(std::max(ones.dot(h * ones), 0.0));
+  m_available = m_vhv.allFinite() && m_vhs.allFinite() && m_shs.allFinite() && m_zhs.allFinite();
+}
+
+ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& lambda,
+                                       const fom::Pairing& pairing, const Eigen::VectorXd& u_surface) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  ErrorEstimate e;
+  const fom::Problem& problem = m_problem;
+  const fom::ContactModel& contact = problem.contact();
+  if (!m_available || u_hat.size() != m_rank || lambda.size() != contact.num_constraints()) return e;
+  const Eigen::VectorXd phi = problem.load_coefficients(mu);
+
+  // 1. The FOM's condensed problem at the answer's pairing, from the answer.
+  thread_local fom::ConstraintMatrix c;
+  thread_local Eigen::VectorXd g;
+  thread_local fom::Pairing current;
+  current = pairing;
+  contact.assemble(current, c, g);
+  const Eigen::VectorXd z_s = m_z_s * phi;
+  fom::PairedSolution sol = fom::solve_at_pairing(problem, m_cond, m_options.fom, z_s, current, c, g, u_surface,
+                                                  lambda.cwiseMax(0.0), e.qp_iterations);
+  for (int k = 1; k < m_options.pairing_iterations && sol.status == Status::Success && contact.has_pairing(); ++k) {
+    fom::Pairing next = contact.search_rows(sol.surface_displacement, nullptr, &current);
+    if (next.same_as(current, 1e-12)) break;
+    current = std::move(next);
+    contact.assemble(current, c, g);
+    sol = fom::solve_at_pairing(problem, m_cond, m_options.fom, z_s, current, c, g, sol.surface_displacement,
+                                sol.lambda, e.qp_iterations);
+  }
+  if (sol.status != Status::Success) {
+    e.status = Status::NumericalIssue;
+    e.time_s = seconds_since(t0);
+    return e;
+  }
+
+  // 2. Norms of u_r − u_c = V a + K⁻¹ E_s y and of u_c = Z φ − K⁻¹ E_s y, y = Cᵀ λ_c,
+  // from the offline products, on the support of y only.
+  const Eigen::VectorXd y = c.transpose() * sol.lambda;
+  Eigen::VectorXd a(m_vhv.rows());
+  a << u_hat, phi;
+  Eigen::VectorXd vy = Eigen::VectorXd::Zero(a.size()), zy = Eigen::VectorXd::Zero(phi.size());
+  double yqy = 0.0;
+  thread_local std::vector<int> support;
+  support.clear();
+  for (Eigen::Index j = 0; j < y.size(); ++j)
+    if (y(j) != 0.0) support.push_back(static_cast<int>(j));
+  for (int j : support) {
+    vy.noalias() += y(j) * m_vhs.col(j);
+    zy.noalias() += y(j) * m_zhs.col(j);
+    double row = 0.0;
+    for (int i : support) row += m_shs(i, j) * y(i);
+    yqy += y(j) * row;
+  }
+  const double error2 = a.dot(m_vhv * a) + 2.0 * a.dot(vy) + yqy;
+  const double norm2 = phi.dot(m_zhz * phi) - 2.0 * phi.dot(zy) + yqy;
+  const double norm = std::sqrt(std::max(norm2, 0.0));
+  e.absolute = norm < m_near_zero;
+  e.primal = std::sqrt(std::max(error2, 0.0)) / (e.absolute || norm == 0.0 ? 1.0 : norm);
+
+  // 3. The pressure against the correction's, in L²(Γc).
+  const Eigen::VectorXd& w = contact.weights();
+  const double dual2 = w.dot((lambda - sol.lambda).cwiseAbs2()), ref2 = w.dot(sol.lambda.cwiseAbs2());
+  e.dual = std::sqrt(dual2 / (e.absolute || ref2 == 0.0 ? 1.0 : ref2));
+  e.status = Status::Success;
+  e.time_s = seconds_since(t0);
+  return e;
+}
+
+}  // namespace contactrom::rom

@@ -1,0 +1,110 @@
+#pragma once
+/// \file error_indicator.hpp
+/// \brief A posteriori estimate of the errors of a reduced answer without the FOM
+/// solve: the answer is corrected by the exact condensed contact problem of the
+/// FOM on the contact surface, at the answer's own pairing, and the estimates are
+/// the errors of the answer against that correction, in the norms of the true
+/// errors (relative H¹ for the displacement, relative L²(Γc) for the pressure).
+/// Derivation in docs/theory.md ("Error estimate of a reduced answer").
+///
+/// Offline (once per model, one factorisation of K): the surface flexibility
+/// \f$ S = E_s^T K^{-1} E_s \f$ and the unconstrained load responses z_k (the FOM's
+/// condensation, fom::condense), and the H¹ products that let the norm of a field
+/// \f$ V a + K^{-1} E_s y \f$ be evaluated from its coordinates a and the surface
+/// force y: \f$ V^T H V \f$, \f$ V^T H K^{-1} E_s \f$ and
+/// \f$ E_s^T K^{-1} H K^{-1} E_s \f$ (H: the Gram matrix of the H¹ norm), with
+/// \f$ V = [\Phi,\ \tilde L - Z] \f$.
+///
+/// Per answer (û, λ_r) at μ, pairing P searched at its surface displacement u_s:
+///  1. C, g at P; the FOM dual QP at that pairing (fom::solve_at_pairing: working set
+///     of the rows within a margin of contact, warm-started by λ_r) gives λ_c;
+///     optionally re-paired at its displacement a few times;
+///  2. \f$ u_c = z(\mu) - K^{-1}E_s C^T\lambda_c \f$, never formed: with
+///     \f$ y = C^T\lambda_c \f$ and \f$ a = (\hat u, \phi(\mu)) \f$,
+///     \f$ \|u_r - u_c\|_H^2 = a^T V^T H V a + 2 a^T V^T H K^{-1}E_s y + y^T E_s^T K^{-1} H K^{-1} E_s y \f$;
+///  3. primal estimate \f$ \|u_r - u_c\|_H / \|u_c\|_H \f$, dual estimate
+///     \f$ \|\lambda_r - \lambda_c\|_{L^2(\Gamma_c)} / \|\lambda_c\|_{L^2(\Gamma_c)} \f$
+///     (absolute when \f$ u_c \f$ is near zero, as the true errors).
+/// Cost: the dual QP on the working set (Delassus block \f$ C_W S C_W^T \f$) and
+/// quadratic forms on the support of y: no mesh-size operation.
+///
+/// Requires a stiffness independent of the parameters (one factorisation serves
+/// every query); otherwise available() is false and the estimates are NaN.
+#include <Eigen/Dense>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "core/errors.hpp"
+#include "fom/active_set_solver.hpp"
+#include "fom/contact_model.hpp"
+#include "fom/problem.hpp"
+
+namespace contactrom::rom {
+
+class ReducedModel;
+
+/// \brief Options of ErrorIndicator (documented defaults).
+struct ErrorIndicatorOptions {
+  /// Pairings the correction is solved at: 1 = the answer's own pairing only; k > 1
+  /// re-pairs at the corrected displacement up to k − 1 times (stopping when the
+  /// pairing no longer changes). Default 1.
+  int pairing_iterations = 1;
+  /// Options of the FOM's dual QP (working-set margin, QP tolerances). Default: the FOM's.
+  fom::ActiveSetOptions fom;
+};
+
+/// \brief The estimate of one answer.
+struct ErrorEstimate {
+  double primal = std::numeric_limits<double>::quiet_NaN();  ///< estimate of the relative H¹ error (absolute if `absolute`)
+  double dual = std::numeric_limits<double>::quiet_NaN();    ///< estimate of the relative L²(Γc) error (absolute if `absolute`)
+  /// The corrected displacement is near zero (fom::kNearZeroReference): both are absolute.
+  bool absolute = false;
+  /// Success; NumericalIssue when the correction's QP failed (estimates NaN); InvalidInput
+  /// when the indicator is unavailable or the answer has no fields.
+  Status status = Status::InvalidInput;
+  int qp_iterations = 0;  ///< active-set iterations of the correction
+  double time_s = 0.0;    ///< wall time of the estimate
+};
+
+/// \brief The error estimate of a reduced model's answers; see the file comment.
+/// Immutable after construction; estimate() is const and thread-safe.
+class ErrorIndicator {
+ public:
+  /// \brief Builds the offline operators for `model` (its problem must outlive the indicator).
+  explicit ErrorIndicator(const ReducedModel& model, ErrorIndicatorOptions options = {});
+  ~ErrorIndicator();
+
+  /// Whether estimates can be made (a parameter-independent stiffness).
+  bool available() const { return m_available; }
+  /// The problem of the model.
+  const fom::Problem& problem() const { return m_problem; }
+  /// Seconds spent building the operators.
+  double setup_time() const { return m_setup_time; }
+
+  /// \brief Estimates the errors of the answer (û, λ) at μ.
+  /// \param u_hat reduced coordinates (size r of the model)
+  /// \param lambda pressure per constraint row
+  /// \param pairing the pairing searched at the answer's surface displacement `u_surface`
+  ErrorEstimate estimate(const fom::Param& mu, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& lambda,
+                         const fom::Pairing& pairing, const Eigen::VectorXd& u_surface) const;
+
+ private:
+  void build(const ReducedModel& model);
+
+  const fom::Problem& m_problem;
+  int m_rank = 0;
+  ErrorIndicatorOptions m_options;
+  bool m_available = false;
+  double m_setup_time = 0.0;
+  fom::Condensation m_cond;   // S and the unconstrained load responses (factor released)
+  Eigen::MatrixXd m_z_s;      // z_k on the surface dofs, n_s × T
+  Eigen::MatrixXd m_vhv;      // Vᵀ H V, (r+T)²
+  Eigen::MatrixXd m_vhs;      // Vᵀ H K⁻¹ E_s, (r+T) × n_s
+  Eigen::MatrixXd m_zhz;      // Zᵀ H Z, T × T
+  Eigen::MatrixXd m_zhs;      // Zᵀ H K⁻¹ E_s, T × n_s
+  Eigen::MatrixXd m_shs;      // E_sᵀ K⁻¹ H K⁻¹ E_s, n_s × n_s
+  double m_near_zero = 0.0;   // ‖u_c‖_H below which the estimates are absolute
+};
+
+}  // namespace contactrom::rom
