@@ -63,7 +63,7 @@ py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& probl
     std::visit([&d, &k = key](const auto& v) { d[k.c_str()] = v; }, value);
   const py::ssize_t n = static_cast<py::ssize_t>(s.rows.size());
   std::vector<fom::Param> mus;
-  py::array_t<double> primal(n), dual(n), time(n), penetration(n), separation(n);
+  py::array_t<double> primal(n), dual(n), time(n), penetration(n), separation(n), primal_estimate(n), dual_estimate(n);
   py::array_t<int> sparsity(n), iterations(n);
   py::array_t<bool> converged(n), absolute(n);
   py::list status;
@@ -79,6 +79,8 @@ py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& probl
     absolute.mutable_at(i) = row.absolute_errors;
     penetration.mutable_at(i) = row.contact.penetration;
     separation.mutable_at(i) = row.contact.complementarity;
+    primal_estimate.mutable_at(i) = row.primal_estimate;
+    dual_estimate.mutable_at(i) = row.dual_estimate;
     status.append(to_string(row.status));
   }
   py::dict rows;
@@ -93,6 +95,8 @@ py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& probl
   rows["absolute_errors"] = absolute;
   rows["penetration"] = penetration;
   rows["separation"] = separation;
+  rows["primal_estimate"] = primal_estimate;
+  rows["dual_estimate"] = dual_estimate;
   d["rows"] = rows;
   return d;
 }
@@ -212,6 +216,10 @@ works in memory but is refused when read back from a file.)doc");
       .def_property_readonly(
           "separation", [](const rom::OnlineResult& r) { return r.contact.complementarity; },
           "Separation under pressure (pressure-weighted mean |gap|) at its own pairing, in units of U.")
+      .def_readonly("primal_estimate", &rom::OnlineResult::primal_estimate,
+                    "Estimate of the relative H1 displacement error against the FOM, made without the FOM (NaN: none).")
+      .def_readonly("dual_estimate", &rom::OnlineResult::dual_estimate,
+                    "Estimate of the relative L2 pressure error against the FOM, made without the FOM (NaN: none).")
       .def_readonly("time_s", &rom::OnlineResult::time_s)
       .def("__repr__", [](const rom::OnlineResult& r) {
         return "<contactrom.RomSolution " + std::string(to_string(r.status)) + ", " + std::to_string(r.selected.size()) +
@@ -310,7 +318,8 @@ errors of rows whose FOM displacement is near zero are absolute, counted in
 'absolute_error_rows' with their maxima 'max_absolute_primal_error' and
 'max_absolute_dual_error', and left out of the relative means and maxima) plus
 'rows', the per-parameter arrays (mu, primal_error, dual_error, sparsity,
-iterations, time_s, converged, status, absolute_errors, penetration, separation).)doc")
+iterations, time_s, converged, status, absolute_errors, penetration, separation,
+primal_estimate, dual_estimate).)doc")
       .def("__repr__", [](const ReducedModel& r) {
         return "<contactrom.ReducedModel '" + r.rom->problem().name() + "' " + r.rom->method() + ": rank " +
                std::to_string(r.rom->model().primal_rank()) + ", dictionary " +

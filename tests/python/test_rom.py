@@ -60,6 +60,10 @@ def test_single_query_equals_cli(hertz_db_path, rom, mu):
     assert r.penetration == pytest.approx(cli["penetration"], rel=1e-12, abs=1e-300)
     assert r.separation == pytest.approx(cli["separation"], rel=1e-12, abs=1e-300)
     assert r.status != "success" or (r.penetration <= 0.05 and r.separation <= 0.05)
+    # The error estimates: the CLI's, and within a factor 3 of the true errors.
+    assert r.primal_estimate == pytest.approx(cli["primal_estimate"], rel=1e-9)
+    assert r.dual_estimate == pytest.approx(cli["dual_estimate"], rel=1e-9)
+    assert cli["primal_error"] <= 3 * r.primal_estimate <= 9 * cli["primal_error"]
 
 
 def test_inaccurate_answers_are_counted_and_reported_per_row(rom):

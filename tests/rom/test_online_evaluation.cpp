@@ -186,13 +186,13 @@ BOOST_AUTO_TEST_CASE(csv_rows_read_back) {
   std::istringstream in(test::slurp(path));
   std::string line;
   std::getline(in, line);
-  BOOST_TEST(line == "gamma,primal_error,dual_error,sparsity,iterations,time_s,converged,status,selected,errors,penetration,separation");
+  BOOST_TEST(line == "gamma,primal_error,dual_error,sparsity,iterations,time_s,converged,status,selected,errors,penetration,separation,primal_estimate,dual_estimate");
   for (const rom::EvaluationRow& row : e.summary.rows) {
     BOOST_REQUIRE(std::getline(in, line));
     std::vector<std::string> f;
     std::stringstream fields(line);
     for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
-    BOOST_REQUIRE(f.size() == 12u);
+    BOOST_REQUIRE(f.size() == 14u);
     BOOST_TEST(std::stod(f[0]) == row.mu(0));  // numbers written to read back exactly
     BOOST_TEST(std::stod(f[1]) == row.primal_error);
     BOOST_TEST(std::stod(f[2]) == row.dual_error);

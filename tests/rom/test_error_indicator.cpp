@@ -1,0 +1,119 @@
+// Error estimate of reduced answers (rom/error_indicator.hpp) on hertz: it follows
+// the true errors against the FOM (rank correlation, effectivity of the primal
+// estimate), is small at training parameters and large away from them, flags a
+// query that the dictionary cannot represent, and is absent when switched off.
+#define BOOST_TEST_MODULE rom_error_indicator
+#include <boost/test/unit_test.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "fom/active_set_solver.hpp"
+#include "fom/kkt.hpp"
+#include "fom/problem.hpp"
+#include "rom/error_indicator.hpp"
+#include "rom/offline.hpp"
+#include "rom/online_evaluation.hpp"
+#include "rom/online_methods.hpp"
+#include "rom/reduced_model.hpp"
+
+using namespace contactrom;
+
+namespace {
+
+struct Hertz {
+  std::unique_ptr<fom::Problem> problem = fom::make_problem("hertz");
+  fom::ActiveSetSolver fom_solver{*problem};
+  rom::SnapshotDatabase snapshots(const std::vector<fom::Param>& params) const {
+    rom::OfflineOptions options;
+    options.threads = 2;
+    return rom::generate_snapshots(*problem, params, "uniform", static_cast<int>(params.size()), options);
+  }
+};
+
+fom::Param param(double d) { return fom::Param::Constant(1, d); }
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(estimates_follow_the_true_errors_on_the_validation_set) {
+  Hertz h;
+  const rom::SnapshotDatabase db = rom::generate_snapshots(*h.problem, 12, {});
+  rom::ReducedModelOptions options;
+  options.delta = 1e-8;
+  const rom::ReducedModel model(*h.problem, db, options);
+  BOOST_REQUIRE(model.error_indicator()->available());
+  const auto solver = rom::make_online_solver("greedy", model);
+  const std::vector<fom::Param> params = fom::validation_set(*h.problem, 12);
+  const auto refs = rom::compute_references(h.fom_solver, params, 2);
+  const rom::EvaluationSummary s = rom::evaluate_online(*solver, params, refs);
+  const rom::EstimateQuality& q = s.estimates;
+  BOOST_TEST(q.rows >= static_cast<int>(params.size()) - 3);
+  BOOST_TEST(q.primal_correlation >= 0.9);
+  BOOST_TEST(q.dual_correlation >= 0.8);
+  // The primal estimate is the error against the FOM's exact surface problem at the
+  // answer's pairing: within a factor 2 of the true error on every query.
+  BOOST_TEST(q.min_primal_effectivity >= 0.5);
+  BOOST_TEST(q.max_primal_effectivity <= 2.0);
+}
+
+BOOST_AUTO_TEST_CASE(estimate_is_small_at_training_parameters_and_grows_between_them) {
+  Hertz h;
+  const std::vector<fom::Param> train = fom::training_set(*h.problem, 12);
+  const rom::SnapshotDatabase db = h.snapshots(train);
+  rom::ReducedModelOptions options;
+  options.delta = 1e-12;
+  const rom::ReducedModel model(*h.problem, db, options);
+  const auto solver = rom::make_online_solver("greedy", model);
+  double at_training = 0.0, between = 1e300;
+  for (size_t i = 4; i + 1 < train.size(); ++i) {
+    const rom::OnlineResult at = solver->solve(train[i]);
+    const fom::FomSolution ref = h.fom_solver.solve(train[i]);
+    const fom::ReferenceErrors err = fom::reference_errors(*h.problem, at.u, at.lambda, ref.u, ref.lambda);
+    BOOST_TEST(err.primal < 1e-5);  // the snapshot is reproduced...
+    BOOST_TEST(at.primal_estimate < 1e-5);  // ...and the estimate says so
+    BOOST_TEST(at.dual_estimate < 1e-4);
+    at_training = std::max(at_training, at.primal_estimate);
+    const rom::OnlineResult mid = solver->solve(0.5 * (train[i] + train[i + 1]));
+    BOOST_TEST(mid.primal_estimate > 0.0);
+    between = std::min(between, mid.primal_estimate);
+  }
+  BOOST_TEST(between > 10.0 * at_training);
+}
+
+BOOST_AUTO_TEST_CASE(flags_a_query_whose_contact_zone_no_column_covers) {
+  // Dictionary of shallow indentations only (small contact zones); a deep one needs
+  // pressure on rows no column covers.
+  Hertz h;
+  const rom::SnapshotDatabase db = h.snapshots({param(0.02), param(0.03), param(0.04), param(0.05)});
+  const rom::ReducedModel model(*h.problem, db);
+  const auto solver = rom::make_online_solver("greedy", model);
+  const fom::Param deep = param(0.3);
+  const rom::OnlineResult res = solver->solve(deep);
+  const fom::FomSolution ref = h.fom_solver.solve(deep);
+  const fom::ReferenceErrors err = fom::reference_errors(*h.problem, res.u, res.lambda, ref.u, ref.lambda);
+  BOOST_TEST(err.dual > 0.2);
+  BOOST_TEST(res.dual_estimate > 0.2);
+  BOOST_TEST(res.primal_estimate > 0.5 * err.primal);
+  BOOST_TEST(res.primal_estimate < 2.0 * err.primal);
+  // An interpolated query inside the dictionary's range stays well below.
+  const rom::OnlineResult inside = solver->solve(param(0.035));
+  BOOST_TEST(inside.dual_estimate < 0.5 * res.dual_estimate);
+}
+
+BOOST_AUTO_TEST_CASE(no_estimate_when_switched_off) {
+  Hertz h;
+  const rom::SnapshotDatabase db = rom::generate_snapshots(*h.problem, 12, {});
+  const rom::ReducedModel model(*h.problem, db);
+  const auto solver = rom::make_online_solver("greedy", model, rom::options_from_map("greedy", {{"estimate", "false"}}));
+  const rom::OnlineResult res = solver->solve(param(0.1));
+  BOOST_TEST(std::isnan(res.primal_estimate));
+  BOOST_TEST(std::isnan(res.dual_estimate));
+  BOOST_TEST(res.estimate_time_s == 0.0);
+}
+
+BOOST_AUTO_TEST_CASE(rank_correlation_of_monotone_and_reversed_samples) {
+  BOOST_TEST(rom::rank_correlation({1, 2, 3, 4}, {10, 20, 30, 1000}) == 1.0, boost::test_tools::tolerance(1e-12));
+  BOOST_TEST(rom::rank_correlation({1, 2, 3, 4}, {4, 3, 2, 1}) == -1.0, boost::test_tools::tolerance(1e-12));
+  BOOST_TEST(std::isnan(rom::rank_correlation({1, 2}, {1, 2})));
+}
