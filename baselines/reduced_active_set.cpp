@@ -151,6 +151,7 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
   // training snapshot, as the greedy's does (same pairing as a full search).
   if (nearest >= 0) ops.seed(m_model.snapshot_search_memory(nearest));
   std::vector<int> active, next, solved;  // positions in W
+  std::vector<std::vector<int>> seen;     // active sets met on the current operators (sorted)
   std::vector<char> in_active(mw, 0);
   rom::NnlsQp nnls(m_options.nnls);
   const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
@@ -194,6 +195,7 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
     // 2. û(x): primal–dual active set on the frozen operators, until its set is stable
     //    and every column is within τ at û.
     bool finite = true, solved_here = false;
+    seen.clear();
     while (solves < m_options.max_solves) {
       // Violation of every column at the current û, Ĉû − ĝ = Wᵀ(C_R u_s − g_R).
       u_s.noalias() = phi_s * u_hat;
@@ -214,6 +216,12 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
           if (!in_active[p] && violation(p) > m_threshold) next.push_back(p);
       const double worst = mw ? violation.maxCoeff() : -std::numeric_limits<double>::infinity();
       if (solved_here && next == active && worst <= m_threshold) break;
+      // A set met before on these operators: the primal–dual steps cycle (a column
+      // whose multiplier is zero leaves and is violated again); û(x) is taken as the
+      // last solve and the outer loop goes on from there.
+      std::sort(next.begin(), next.end());
+      if (std::find(seen.begin(), seen.end(), next) != seen.end()) break;
+      seen.push_back(next);
       first = false;
       for (int p : active) in_active[p] = 0;
       active.swap(next);
