@@ -10,8 +10,8 @@ once at d = 0.02 by `contactrom fom` under /usr/bin/time -v:
     /usr/bin/python3 tools/scaling3d.py --exe build/tools/contactrom --series dofs
     /usr/bin/python3 tools/scaling3d.py --exe build/tools/contactrom --series contact
 
-Series `dofs`: the whole mesh refined (a coarse and the shipped grading, refine
-0, 1, 2). Series `contact`: the shipped mesh with a larger and larger contact cap
+Series `dofs`: the whole mesh refined (coarse gradings and the shipped one,
+refine 0, 1, 2; 3.9k to 299k dofs). Series `contact`: the shipped mesh with a larger and larger contact cap
 and disk (about the same dofs, more contact nodes).
 
 Columns: dofs, contact rows (slave nodes), surface dofs (slave and master nodes,
@@ -28,10 +28,12 @@ import subprocess
 import tempfile
 
 COARSE = (0.03, 0.15, 0.2, 0.25)     # hmin, alpha, rc, rm
+FINER = (0.03, 0.13, 0.2, 0.25)
 MEDIUM = (0.025, 0.12, 0.2, 0.25)
 SHIPPED = (0.015, 0.08, 0.3, 0.4)    # meshes/hertz3d.geo's defaults
 SERIES = {  # (hmin, alpha, rc, rm, refine)
-    "dofs": [COARSE + (0,), SHIPPED + (0,), COARSE + (1,), SHIPPED + (1,), COARSE + (2,), MEDIUM + (2,)],
+    "dofs": [COARSE + (0,), SHIPPED + (0,), COARSE + (1,), SHIPPED + (1,), COARSE + (2,), FINER + (2,),
+             MEDIUM + (2,)],
     "contact": [(0.015, 0.08, rc, rc + 0.1, 0) for rc in (0.15, 0.3, 0.45, 0.6, 0.75, 0.9)]
                + [(0.015, 0.08, rc, rc + 0.1, 1) for rc in (0.15, 0.45, 0.6, 0.9)],
 }
