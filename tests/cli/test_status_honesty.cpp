@@ -158,7 +158,7 @@ BOOST_AUTO_TEST_CASE(a_delta_that_keeps_no_mode_gives_an_empty_basis_or_a_clear_
   for (const char* method : {"greedy", "greedy-nested", "cpg", "full-dictionary"}) {
     BOOST_TEST_CONTEXT("online " << method) {
       const auto r = run_command(kExe + " online --db " + db + " --method " + method + " --param 0.1 --delta 1 --json");
-      BOOST_REQUIRE(r.exit_code == 0, r.err);
+      BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
       BOOST_TEST(r.err.find("keeps no POD mode") != std::string::npos, r.err);
       const auto j = nlohmann::json::parse(r.out);
       BOOST_TEST(j["primal_rank"].get<int>() == 0);
@@ -167,9 +167,9 @@ BOOST_AUTO_TEST_CASE(a_delta_that_keeps_no_mode_gives_an_empty_basis_or_a_clear_
     }
     BOOST_TEST_CONTEXT("reduce and query " << method) {
       const auto r = run_command(kExe + " reduce --db " + db + " --method " + method + " --delta 1 --out " + rom);
-      BOOST_REQUIRE(r.exit_code == 0, r.err);
+      BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
       const auto q = run_command(kExe + " query --rom " + rom + " --param 0.1 --json");
-      BOOST_REQUIRE(q.exit_code == 0, q.err);
+      BOOST_TEST_REQUIRE(q.exit_code == 0, q.err);
       const auto j = nlohmann::json::parse(q.out);
       BOOST_TEST(j["primal_rank"].get<int>() == 0);
       BOOST_TEST(j["queries"][0]["status"].get<std::string>() != "success");
@@ -183,7 +183,7 @@ BOOST_AUTO_TEST_CASE(a_delta_that_keeps_no_mode_gives_an_empty_basis_or_a_clear_
   check_refused(run_command(kExe + " hull-report --db " + db + " --delta 1"), "keeps no mode at delta 1");
   // verify and bench run every method on the empty basis.
   const auto v = run_command(kExe + " verify --db " + db + " --method greedy,cpg --delta 1 --limit 5 --json");
-  BOOST_REQUIRE(v.exit_code == 0, v.err);
+  BOOST_TEST_REQUIRE(v.exit_code == 0, v.err);
   const auto vj = nlohmann::json::parse(v.out);
   for (const char* method : {"greedy", "cpg"}) BOOST_TEST(vj["methods"][method]["inaccurate"].get<int>() > 0, method);
   const auto b = run_command(kExe + " bench --db " + db + " --delta 1 --repeats 1 --json");
@@ -201,7 +201,7 @@ BOOST_AUTO_TEST_CASE(subnormal_parameters_give_honest_statuses_in_every_reduced_
     for (const char* d : {"5e-324", "1e-320"}) {
       BOOST_TEST_CONTEXT(method << " at d = " << d) {
         const auto r = run_command(kExe + " online --db " + db + " --method " + method + " --param " + d + " --json");
-        BOOST_REQUIRE(r.exit_code == 0, r.err);
+        BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
         const auto j = nlohmann::json::parse(r.out);
         const double worst = worst_residual(j);
         BOOST_TEST(std::isfinite(worst));
