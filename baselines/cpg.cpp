@@ -142,7 +142,7 @@ CpgOptions cpg_options(const rom::OnlineSolverOptions& options) {
 
 std::unique_ptr<rom::OnlineSolver> make_cpg_solver(const rom::ReducedModel& model,
                                                    const rom::OnlineSolverOptions& options) {
-  rom::check_extra_options(options, "cpg", {"cpg_tolerance", "cpg_max_size", "inner_solve", "init", "rebuild"});
+  rom::check_extra_options(options, "cpg", {"cpg_tolerance", "cpg_max_size", "inner_solve", "init", "rebuild", "anderson_depth", "surface_step", "max_solves"});
   return std::make_unique<CpgActiveSet>(model, cpg_options(options), reduced_active_set_options(options));
 }
 

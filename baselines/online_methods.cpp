@@ -20,6 +20,13 @@ std::vector<rom::OptionSpec> reduced_active_set_specs() {
                      {"nonnegative", "equality"}));
   o.push_back(choice("rebuild", "partial", "contact operators rebuilt on the changed rows only (partial) or all (full)",
                      {"partial", "full"}));
+  o.push_back({"anderson_depth", rom::OptionType::Integer, "5", "Anderson depth of the rebuild point (0: plain)", {},
+               Interval::closed(0, 1e6)});
+  o.push_back({"surface_step", rom::OptionType::Number, "1e-3",
+               "largest move of the contact surface (units of U) between the operators' point and the answer", {},
+               Interval::greater_than(0)});
+  o.push_back({"max_solves", rom::OptionType::Integer, "1000", "cap on the saddle-point solves of a query", {},
+               Interval::closed(1, 1e9)});
   return o;
 }
 

@@ -36,6 +36,9 @@ ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOption
   o.step_tolerance = g.step_tolerance;
   o.time_operators = g.time_operators;
   o.rebuild = g.rebuild;
+  o.anderson_depth = g.anderson_depth;
+  o.surface_step = g.surface_step;
+  o.max_solves = g.max_solves;
   if (const auto it = options.extra.find("inner_solve"); it != options.extra.end()) {
     if (it->second == "nonnegative")
       o.inner_solve = InnerSolve::NonNegative;
@@ -122,7 +125,7 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
   // training snapshots around μ (init = primal), the first active set then being the
   // set of columns violated there; or (init = cell) this method's own solutions at
   // those training parameters: their interpolated û and the union of their active sets.
-  Eigen::VectorXd u_hat, u_prev, lambda_i, u_s, v, violation, rhs;
+  Eigen::VectorXd u_hat, lambda_i, u_s, v, violation, rhs;
   std::vector<int> start;  // positions in W
   int nearest = -1;        // training snapshot nearest to the start (−1: cold)
   if (init == rom::WarmStart::Cell && !m_starts.empty()) {
@@ -148,85 +151,127 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
   // training snapshot, as the greedy's does (same pairing as a full search).
   if (nearest >= 0) ops.seed(m_model.snapshot_search_memory(nearest));
   std::vector<int> active, next, solved;  // positions in W
+  std::vector<std::vector<int>> seen;     // active sets met on the current operators (sorted)
   std::vector<char> in_active(mw, 0);
   rom::NnlsQp nnls(m_options.nnls);
   const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
-  bool small_step = init == rom::WarmStart::Empty;  // û = u_free is exact for I = ∅
   rom::OperatorClock operators(m_options.time_operators);
 
-  for (int k = 0;; ++k) {
-    // 1. Operators at the current û (surface rows only) and the violation of every
-    //    column, Ĉû − ĝ = Wᵀ(C_s u_s − g).
+  // The fixed point x ↦ û(x) of the greedy's default schedule (rom::GreedySchedule::
+  // FixedPoint), with this method's own solve on the frozen operators: operators
+  // built at x; û(x) by the primal–dual active set on them until its set is stable;
+  // x Anderson-accelerated (one history over the query) until the contact surface
+  // moves by at most surface_step; then the physical test at û's own pairing.
+  const fom::ContactTolerances tolerances = contact_tolerances();
+  const double scale = problem.displacement_scale();
+  rom::SupportRows::ResidualsScratch scratch;
+  AndersonMixer mixer(m_options.anderson_depth);
+  Eigen::VectorXd x = u_hat;  // where the operators are built
+  bool pending = false, failed_test = false, first = true;
+  int solves = 0;
+  for (int rebuild = 0;; ++rebuild) {
+    // 1. Operators at x (surface rows only); where x = û, the physical test at û's own pairing.
     operators.start();
-    u_s.noalias() = phi_s * u_hat;
+    u_s.noalias() = phi_s * x;
     u_s += lift_s;
     ops.rebuild(contact, m_support, u_s);
     operators.stop();
-    m_support.violation(ops.c, ops.g, u_s, v, violation);
-
-    // 2. Primal–dual update: drop the columns whose multiplier left the cone, add every
-    //    violated column. With the non-negative inner solve a zero multiplier on a
-    //    still-violated column keeps it (dropping and re-adding it would cycle).
-    next.clear();
-    if (k == 0) next = start;  // the warm start's set (empty otherwise)
-    for (size_t i = 0; i < active.size(); ++i) {
-      const double l = lambda_i(static_cast<Eigen::Index>(i));
-      const bool keep = nonnegative ? (l > 0.0 || violation(active[i]) > m_threshold) : l >= 0.0;
-      if (keep) next.push_back(active[i]);
-    }
-    if (k > 0 || start.empty())
-      for (int p = 0; p < mw; ++p)
-        if (!in_active[p] && violation(p) > m_threshold) next.push_back(p);
-    const bool changed = next != active;
-    const double worst = mw ? violation.maxCoeff() : -std::numeric_limits<double>::infinity();
-
-    // 3. Converged: stable set, reduced constraint met at the fresh pairing, û settled.
-    if (!changed && worst <= m_threshold && small_step) {
-      res.converged = true;
-      break;
-    }
-    if (k == m_options.max_iterations) break;
-
-    for (int p : active) in_active[p] = 0;
-    active.swap(next);
-    for (int p : active) in_active[p] = 1;
-
-    // 4. Saddle-point system on I by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ.
-    const int na = static_cast<int>(active.size());
-    u_prev = u_hat;
-    if (na == 0) {
-      u_hat = u_free;
-      lambda_i.resize(0);
-    } else {
-      c_hat_i.resize(na, r);
-      rhs.resize(na);
-      // Rows of Ĉ_I = W_Iᵀ C_R Φ_s and entries of ĝ_I = W_Iᵀ (g_R − C_R u_lift,s),
-      // as in the greedy: from the rows where each active column is non-zero.
-      operators.start();
-      for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], ops.c, ops.g, phi_s_rows, lift_s, c_hat_i.row(i));
-      operators.stop();
-      k_inv.apply(c_hat_i.transpose(), z);  // K̂⁻¹ Ĉ_Iᵀ
-      schur.noalias() = c_hat_i * z;
-      rhs = c_hat_i * u_free - rhs;
-      if (nonnegative) {
-        // min ½ λᵀ S λ − rhsᵀ λ, λ ≥ 0: the saddle-point system on I with the sign
-        // condition imposed (Lawson–Hanson; dependent rows are never freed together).
-        nnls.compute(schur);
-        lambda_i = nnls.solve(rhs);
-        if (nnls.info() == Status::InvalidInput) lambda_i = Eigen::VectorXd::Constant(na, std::numeric_limits<double>::quiet_NaN());
-      } else {
-        lambda_i = rom::schur_multipliers(schur, rhs, m_options.singular_tolerance);
+    if (pending) {
+      const fom::ContactResiduals r =
+          m_support.residuals(ops.c, ops.g, u_s, solved, lambda_i, contact.weights(), scale, scratch);
+      // Failing twice in a row: a fixed point of the reduced problem (see the greedy).
+      if ((r.penetration <= tolerances.penetration && r.complementarity <= tolerances.complementarity) ||
+          failed_test) {
+        res.converged = true;
+        break;
       }
-      u_hat.noalias() = u_free - z * lambda_i;
+      failed_test = true;
+    } else {
+      failed_test = false;
     }
-    solved = active;
-    res.iterations = k + 1;
-    if (!u_hat.allFinite() || !lambda_i.allFinite()) {
+    pending = false;
+    if (rebuild >= m_options.max_iterations || solves >= m_options.max_solves) break;
+
+    // 2. û(x): primal–dual active set on the frozen operators, until its set is stable
+    //    and every column is within τ at û.
+    bool finite = true, solved_here = false;
+    seen.clear();
+    while (solves < m_options.max_solves) {
+      // Violation of every column at the current û, Ĉû − ĝ = Wᵀ(C_R u_s − g_R).
+      u_s.noalias() = phi_s * u_hat;
+      u_s += lift_s;
+      m_support.violation(ops.c, ops.g, u_s, v, violation);
+      // Drop the columns whose multiplier left the cone, add every violated column.
+      // With the non-negative inner solve a zero multiplier on a still-violated
+      // column keeps it (dropping and re-adding it would cycle).
+      next.clear();
+      if (first) next = start;  // the warm start's set (empty otherwise)
+      for (size_t i = 0; i < active.size(); ++i) {
+        const double l = lambda_i(static_cast<Eigen::Index>(i));
+        const bool keep = nonnegative ? (l > 0.0 || violation(active[i]) > m_threshold) : l >= 0.0;
+        if (keep) next.push_back(active[i]);
+      }
+      if (!first || start.empty())
+        for (int p = 0; p < mw; ++p)
+          if (!in_active[p] && violation(p) > m_threshold) next.push_back(p);
+      const double worst = mw ? violation.maxCoeff() : -std::numeric_limits<double>::infinity();
+      if (solved_here && next == active && worst <= m_threshold) break;
+      // A set met before on these operators: the primal–dual steps cycle (a column
+      // whose multiplier is zero leaves and is violated again); û(x) is taken as the
+      // last solve and the outer loop goes on from there.
+      std::sort(next.begin(), next.end());
+      if (std::find(seen.begin(), seen.end(), next) != seen.end()) break;
+      seen.push_back(next);
+      first = false;
+      for (int p : active) in_active[p] = 0;
+      active.swap(next);
+      for (int p : active) in_active[p] = 1;
+
+      // Saddle-point system on I by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ.
+      const int na = static_cast<int>(active.size());
+      if (na == 0) {
+        u_hat = u_free;
+        lambda_i.resize(0);
+      } else {
+        c_hat_i.resize(na, r);
+        rhs.resize(na);
+        // Rows of Ĉ_I = W_Iᵀ C_R Φ_s and entries of ĝ_I = W_Iᵀ (g_R − C_R u_lift,s),
+        // as in the greedy: from the rows where each active column is non-zero.
+        operators.start();
+        for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], ops.c, ops.g, phi_s_rows, lift_s, c_hat_i.row(i));
+        operators.stop();
+        k_inv.apply(c_hat_i.transpose(), z);  // K̂⁻¹ Ĉ_Iᵀ
+        schur.noalias() = c_hat_i * z;
+        rhs = c_hat_i * u_free - rhs;
+        if (nonnegative) {
+          // min ½ λᵀ S λ − rhsᵀ λ, λ ≥ 0: the saddle-point system on I with the sign
+          // condition imposed (Lawson–Hanson; dependent rows are never freed together).
+          nnls.compute(schur);
+          lambda_i = nnls.solve(rhs);
+          if (nnls.info() == Status::InvalidInput) lambda_i = Eigen::VectorXd::Constant(na, std::numeric_limits<double>::quiet_NaN());
+        } else {
+          lambda_i = rom::schur_multipliers(schur, rhs, m_options.singular_tolerance);
+        }
+        u_hat.noalias() = u_free - z * lambda_i;
+      }
+      solved = active;
+      solved_here = true;
+      res.iterations = ++solves;
+      if (!(finite = u_hat.allFinite() && lambda_i.allFinite())) break;
+    }
+    if (!finite) {
       res.status = Status::NumericalIssue;
       res.message = "reduced saddle-point solve produced a non-finite value";
       break;
     }
-    small_step = (u_hat - u_prev).norm() <= m_options.step_tolerance * u_hat.norm();
+    // 3. The next point: û itself once the surface moved by at most surface_step
+    //    (then tested at its own pairing), else the Anderson extrapolation.
+    if (rom::surface_step(m_model, u_hat, x) <= m_options.surface_step) {
+      pending = true;
+      x = u_hat;
+    } else {
+      mixer.next(x, u_hat, x);
+    }
   }
 
   res.u_hat = u_hat;
@@ -243,7 +288,7 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
   if (res.status == Status::Success && !res.converged) {
     res.status = Status::NoConvergence;
     res.message = m_name + " active set did not converge in " + std::to_string(m_options.max_iterations) +
-                  " iterations";
+                  " operator rebuilds (or " + std::to_string(m_options.max_solves) + " solves)";
   }
   const auto t1 = clock::now();
   res.time_s = std::chrono::duration<double>(t1 - t0).count();

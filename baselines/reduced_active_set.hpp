@@ -15,22 +15,28 @@
 /// \f[ \begin{bmatrix} \hat K & \hat C_I^T \\ \hat C_I & 0 \end{bmatrix}
 ///     \begin{bmatrix} \hat u \\ \hat\lambda_I \end{bmatrix} =
 ///     \begin{bmatrix} \hat f \\ \hat g_I \end{bmatrix}. \f]
-/// The loop (Hintermüller–Ito–Kunisch primal–dual active set, as in Benaceur, Ern,
-/// Ehrlacher 2020) reads, starting from I = ∅ and the unconstrained û = K̂⁻¹f̂ (or
-/// from a warm start, ReducedActiveSetOptions::init):
-///  1. rebuild the contact operators at the current û from the surface rows only,
-///     exactly as rom::GreedyActiveSet does (pairing = search(Φ_s û + u_lift,s),
-///     C_s, g = assemble(pairing)), and evaluate the reduced violation of every
-///     column, \f$ v = W^T (C_s u_s - g) \f$;
-///  2. next active set = the columns of I whose multiplier stays in the cone, plus
-///     every column p ∉ I with v_p > τ — any number of columns enters or leaves at
-///     once (the non-sparse counterpart of the greedy's one change per iteration);
-///  3. converged when the set does not change, every column satisfies v_p ≤ τ at the
-///     freshly paired û (active columns included, so the returned solution honours the
-///     reduced constraint with its own pairing) and the last solve moved û by at most
-///     step_tolerance relatively; otherwise solve the saddle-point system on the new I
-///     through its Schur complement \f$ S = \hat C_I \hat K^{-1} \hat C_I^T \f$ (same
-///     factorisation of K̂ as the greedy) and repeat, at most max_iterations solves.
+/// The loop is the greedy's default fixed point (rom::GreedySchedule::FixedPoint,
+/// docs/rom.md), so the three methods are compared on the same outer iteration; only
+/// the solve on frozen operators is this method's own. Starting from I = ∅ and the
+/// unconstrained û = K̂⁻¹f̂ (or from a warm start, ReducedActiveSetOptions::init), x = û:
+///  1. rebuild the contact operators at x from the surface rows only, exactly as
+///     rom::GreedyActiveSet does (pairing = search(Φ_s x + u_lift,s), C_s, g =
+///     assemble(pairing)); when x is the û of the last solve (step 3), test û
+///     physically at this, its own, pairing (rom::SupportRows::residuals: penetration
+///     and separation under pressure within the contact tolerances): converged if it
+///     passes, or if it failed already at the previous point (a fixed point of the
+///     reduced problem; the full-order check then reports it);
+///  2. û(x): the Hintermüller–Ito–Kunisch primal–dual active set (as in Benaceur, Ern,
+///     Ehrlacher 2020) on these frozen operators — evaluate every column's violation
+///     \f$ v = W^T (C_s u_s - g) \f$ at û, next active set = the columns of I whose
+///     multiplier stays in the cone plus every column p ∉ I with v_p > τ (any number
+///     of columns enters or leaves at once: the non-sparse counterpart of the greedy's
+///     one change), solve the saddle-point system on I through its Schur complement
+///     \f$ S = \hat C_I \hat K^{-1} \hat C_I^T \f$ — until the set is stable and every
+///     column is within τ;
+///  3. if Φ_s û moved by at most surface_step · U from Φ_s x, x = û (tested in step
+///     1); else x = the Anderson extrapolation of x ↦ û(x), one history over the query.
+/// At most max_iterations rebuilds and max_solves solves.
 ///
 /// Inner solve (InnerSolve). `Equality` is the textbook PDAS: Sλ̂_I = Ĉ_I K̂⁻¹f̂ − ĝ_I
 /// (minimum-norm when S is singular), then every negative λ̂_i leaves I. With a
@@ -76,9 +82,10 @@ struct ReducedActiveSetOptions {
   double tau = -1.0;
   /// Absolute (paper, default) or relative threshold, as for the greedy.
   rom::TauScaling tau_scaling = rom::TauScaling::Absolute;
-  /// Cap on the saddle-point solves (paper's k_max). Default 50.
+  /// Cap on the operator rebuilds (k_max). Default 50.
   int max_iterations = 50;
-  /// Converged only if the last solve moved û by at most this relatively. Default 1e-5.
+  /// Unused: the loop's step test is surface_step (kept so that the generic option
+  /// step_tolerance is accepted as for every active set). Default 1e-5.
   double step_tolerance = 1e-5;
   /// Reciprocal condition estimate of the Schur complement's LDLᵀ under which the
   /// system is solved in the least-squares, minimum-norm sense (dependent rows, e.g.
@@ -103,6 +110,15 @@ struct ReducedActiveSetOptions {
   /// made offline at the nearest training snapshot), Full searches every row in full.
   /// The operators are the same either way.
   rom::OperatorRebuild rebuild = rom::OperatorRebuild::Partial;
+  /// Anderson depth of the rebuild point, one history over the query (as the greedy's
+  /// GreedyOptions::anderson_depth). Default 5.
+  int anderson_depth = 5;
+  /// û is tested at its own pairing once the contact surface moved by at most this
+  /// (units of U) from where the operators were built (GreedyOptions::surface_step).
+  /// Default 1e-3.
+  double surface_step = 1e-3;
+  /// Cap on the saddle-point solves of a query, over all rebuilds. Default 1000.
+  int max_solves = 1000;
 };
 
 /// \brief Translates the generic online options (tau, tau_scaling, max_iterations,

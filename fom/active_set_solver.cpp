@@ -162,6 +162,7 @@ bool condense(const Problem& problem, const Param& mu, Condensation& out, const 
   if (!order || cond.factor->info() == Status::InvalidInput) cond.factor->compute(kff, last);  // order of another size
   if (cond.factor->info() != Status::Success) return false;
   const Eigen::MatrixXd s_free = cond.factor->inverse_block();
+  if (s_free.rows() != static_cast<Eigen::Index>(last.size())) return false;
   const std::vector<int>& pos = cond.surface_position;
   cond.s = Eigen::MatrixXd::Zero(ns, ns);
   for (int b = 0; b < ns; ++b)

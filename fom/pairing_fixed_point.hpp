@@ -83,7 +83,9 @@ struct PairingFixedPointResult {
   int iterations = 0;  ///< solves done
   /// pairing_change() of the last iterate (0 without pairing, ∞ if a solve failed first).
   double residual = std::numeric_limits<double>::infinity();
-  Pairing pairing;           ///< the pairing the last solution was computed with
+  /// The pairing the last solution was computed with; c, g, solution and residual
+  /// all belong to it (also at the cap).
+  Pairing pairing;
   ConstraintMatrix c;        ///< its constraint operator
   Eigen::VectorXd g;         ///< its gap offsets
   PairedSolution solution;   ///< the last solve's result
@@ -143,6 +145,9 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
       out.status = Status::Success;
       return out;
     }
+    // At the cap, out keeps the last solve's pairing, operator and solution: the
+    // next pairing is not built into it.
+    if (it + 1 == options.max_iterations) break;
     if (out.solution.map_changed) mixer.clear();
     x = mixer.next(x, f);
     assembled = x == f;

@@ -3,6 +3,7 @@
 // The pure-Python package `contactrom` (python/contactrom/) re-exports it.
 #include <cmath>
 
+#include "core/blas_threads.hpp"
 #include "core/format.hpp"
 #include "core/errors.hpp"
 #include "core/version.hpp"
@@ -123,6 +124,9 @@ PYBIND11_MODULE(_contactrom, m) {
   using namespace contactrom;
   m.doc() = "contactrom: reduced-order models of contact problems (C++ core)";
   m.attr("__version__") = version();
+  // As the CLI: one BLAS thread under each of our threads, and the CLI's bits
+  // (OPENBLAS_NUM_THREADS, set before Python starts, overrides it; docs/python.md).
+  use_one_blas_thread_by_default();
 
   // Bad input → ValueError with the CLI's one-line message; anything else the C++
   // side throws (std::bad_alloc aside) is a RuntimeError, as pybind11 does by default.

@@ -330,7 +330,10 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
     m_b = orth.basis();
   }
   if (m_b.cols() == 0)
-    throw InputError("the primal dictionary of " + quoted(problem.name(), 200) + " is zero: no projection basis");
+    throw InputError(dp.norm() > 0.0 && options.basis == ProjectionBasis::Svd
+                         ? "the SVD of the primal dictionary of " + quoted(problem.name(), 200) + " keeps no mode at delta " +
+                               format_number(delta) + ": no projection basis; expected a delta below 1"
+                         : "the primal dictionary of " + quoted(problem.name(), 200) + " is zero: no projection basis");
   const std::vector<char>& dirichlet = problem.is_dirichlet();
   for (Index i = 0; i < m_b.rows(); ++i)
     if (dirichlet[static_cast<std::size_t>(i)]) m_b.row(i).setZero();

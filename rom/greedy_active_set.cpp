@@ -580,7 +580,7 @@ struct GreedyActiveSet::Nested {
   std::vector<char> in_active;
   std::vector<int> solved;
   SelectionHistory seen;  // selections met on the current operators
-  Eigen::VectorXd w_r, lambda_r;  // physically_converged: weights and pressure on the support rows
+  SupportRows::ResidualsScratch residuals_scratch;  // physically_converged
   std::vector<double> feasible;  // settle_exact: the non-negative multipliers of `cols`
   std::vector<int> blocked;      // settle_exact: columns not offered again on these operators
   fom::AndersonMixer mixer{0};
@@ -776,17 +776,9 @@ struct GreedyActiveSet::Nested {
   /// rows, the largest penetration and the separation under pressure of
   /// λ = D_d[:, I] λ̂_I, in units of U (fom/contact_residuals.hpp), within `tol`.
   bool physically_converged(const fom::ContactTolerances& tol) {
-    const SupportRows& support = g->m_support;
-    support.violation(q->ops.c, q->ops.g, u_s, gap, violation);  // gap = C_R u_s − g_R
-    const Eigen::VectorXd& w = g->m_model.problem().contact().weights();
-    w_r.resize(gap.size());
-    lambda_r.setZero(gap.size());
-    for (int i = 0; i < gap.size(); ++i) {
-      w_r(i) = w(support.rows[static_cast<size_t>(i)]);
-      for (int j = 0; j < n_lambda; ++j) lambda_r(i) += (*dr)(i, cols[j].p) * lambda_storage(j);
-    }
     const fom::ContactResiduals r =
-        fom::contact_residuals_of_gaps(gap, w_r, lambda_r, g->m_model.problem().displacement_scale());
+        g->m_support.residuals(q->ops.c, q->ops.g, u_s, solved, lambda_i(), g->m_model.problem().contact().weights(),
+                               g->m_model.problem().displacement_scale(), residuals_scratch);
     if (g->m_options.trace)
       *g->m_options.trace << "greedy physical test: penetration=" << r.penetration
                           << " U, separation under pressure=" << r.complementarity << " U\n";
@@ -838,11 +830,11 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds
   q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i(), s.solved);
 }
 
-double GreedyActiveSet::surface_step(const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x) const {
+double surface_step(const ReducedModel& model, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x) {
   thread_local Eigen::VectorXd diff, change;  // storage reused: the iterations allocate nothing
   diff = u_hat - x;
-  change.noalias() = m_model.surface_basis() * diff;
-  return (change.size() > 0 ? change.cwiseAbs().maxCoeff() : 0.0) / m_model.problem().displacement_scale();
+  change.noalias() = model.surface_basis() * diff;
+  return (change.size() > 0 ? change.cwiseAbs().maxCoeff() : 0.0) / model.problem().displacement_scale();
 }
 
 void GreedyActiveSet::solve_fixed_point(Query& q, OnlineResult& res) const {
@@ -878,7 +870,7 @@ void GreedyActiveSet::solve_fixed_point(Query& q, OnlineResult& res) const {
     // 3. The next point: û itself once the step is within the basis' resolution
     //    (then tested at its own pairing), else the Anderson extrapolation of the
     //    map x ↦ û(x), with one history over the whole query.
-    const double step = surface_step(s.u_hat, s.x);
+    const double step = surface_step(m_model, s.u_hat, s.x);
     if (m_options.trace) *m_options.trace << "greedy rebuild=" << rebuild << " surface step=" << step << " U\n";
     if (step <= m_options.surface_step) {
       s.pending = true;

@@ -212,9 +212,11 @@ class GreedyActiveSet final : public OnlineSolver {
   /// interleaved schedule left of it when it hands over on a cycle)
   void solve_nested(Query& q, OnlineResult& res, int max_rebuilds) const;
   void solve_fixed_point(Query& q, OnlineResult& res) const;
-  /// \f$ \|\Phi_s(\hat u - x)\|_\infty / U \f$: how far the contact surface moved from x.
-  double surface_step(const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x) const;
 };
+
+/// \brief \f$ \|\Phi_s(\hat u - x)\|_\infty / U \f$: how far the contact surface of û
+/// moved from x (the fixed-point schedules' step, GreedyOptions::surface_step).
+double surface_step(const ReducedModel& model, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x);
 
 /// \brief The threshold τ that GreedyActiveSet applies with `options` (defaulted to δ
 /// and scaled per TauScaling), in the units of \f$ D_d^T (Cu - g) \f$.

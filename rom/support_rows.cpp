@@ -57,6 +57,22 @@ void SupportRows::violation(const fom::ConstraintMatrix& c_r, const Eigen::Vecto
   out.noalias() = basis.transpose() * gap;
 }
 
+fom::ContactResiduals SupportRows::residuals(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
+                                             const Eigen::VectorXd& u_surface, const std::vector<int>& columns,
+                                             const Eigen::Ref<const Eigen::VectorXd>& coefficients,
+                                             const Eigen::VectorXd& contact_weights, double scale,
+                                             ResidualsScratch& s) const {
+  violation(c_r, g_r, u_surface, s.gap, s.violation);  // s.gap = C_R u_s − g_R
+  const auto nr = static_cast<Eigen::Index>(rows.size());
+  s.weights.resize(nr);
+  s.pressure.setZero(nr);
+  for (Eigen::Index i = 0; i < nr; ++i) {
+    s.weights(i) = contact_weights(rows[static_cast<size_t>(i)]);
+    for (size_t j = 0; j < columns.size(); ++j) s.pressure(i) += basis(i, columns[j]) * coefficients(static_cast<Eigen::Index>(j));
+  }
+  return fom::contact_residuals_of_gaps(s.gap, s.weights, s.pressure, scale);
+}
+
 void SupportRows::gap_operator(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
                                const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s, RowMajorMatrix& a,
                                Eigen::VectorXd& b) const {

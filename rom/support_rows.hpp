@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fom/contact_model.hpp"
+#include "fom/contact_residuals.hpp"
 
 namespace contactrom::rom {
 
@@ -31,6 +32,21 @@ struct SupportRows {
   /// \param gap work vector, left holding \f$ (C_R u_s - g_R) \f$
   void violation(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r, const Eigen::VectorXd& u_surface,
                  Eigen::VectorXd& gap, Eigen::VectorXd& out) const;
+
+  /// Work storage of residuals(), reused from one call to the next.
+  struct ResidualsScratch {
+    Eigen::VectorXd gap, violation, weights, pressure;
+  };
+  /// \brief The full-order contact residuals on the support rows
+  /// (fom::contact_residuals_of_gaps) of the surface displacement u_s and the pressure
+  /// \f$ \lambda = W[:, columns]\,c \f$, with C_R and g_R built at u_s (its own pairing).
+  /// \param columns positions in W of the `coefficients` c (one each)
+  /// \param contact_weights the contact rows' weights (ContactModel::weights(), all rows)
+  /// \param scale the displacement scale U
+  fom::ContactResiduals residuals(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
+                                  const Eigen::VectorXd& u_surface, const std::vector<int>& columns,
+                                  const Eigen::Ref<const Eigen::VectorXd>& coefficients,
+                                  const Eigen::VectorXd& contact_weights, double scale, ResidualsScratch& s) const;
 
   /// \brief \f$ A = C_R \Phi_s \f$ (|R| × r) and \f$ b = C_R u_{off,s} - g_R \f$, so that
   /// \f$ A\hat u + b \f$ is the gap on R at \f$ \hat u \f$. O(nnz(C_R) · r).

@@ -152,8 +152,8 @@ void run_online(const OnlineArgs& a) {
   rom::check_online_method(a.method);
   const rom::ReducedModelOptions model_options = a.model_options();
   const rom::ReducedModel model(*problem, db, model_options);
-  warn_if_no_primal_modes(model);
   const auto solver = rom::make_online_solver(a.method, model, options);
+  warn_if_no_primal_modes(model);  // after a method's refusal, which stays one line
   if (!a.param.empty())
     run_single(a, *problem, model, *solver);
   else

@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "core/atomic_file.hpp"
+#include "core/blas_threads.hpp"
 #include "core/errors.hpp"
 #include "core/version.hpp"
 #include "fom/input_values.hpp"
@@ -36,6 +37,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "contactrom " + version());
   // An interrupted run leaves no temporary file behind (core/atomic_file.hpp).
   remove_temporaries_on_signals();
+  // Threads (and MPI ranks) run FOMs side by side: one BLAS thread under each.
+  use_one_blas_thread_by_default();
   auto& table = cli::command_table();
   std::sort(table.begin(), table.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   for (auto& entry : table) entry.setup(app);

@@ -12,7 +12,8 @@ packages=(build-essential cmake ninja-build pkg-config libeigen3-dev libsuitespa
           coinor-libipopt-dev gmsh libgmsh-dev libboost-test-dev libhdf5-dev libcli11-dev
           nlohmann-json3-dev libtomlplusplus-dev python3 python3-numpy python3-scipy python3-matplotlib python3-h5py
           pybind11-dev python3-pybind11 python3-pytest  # the Python module (build/python) and its tests
-          doxygen libopenmpi-dev openmpi-bin)  # doxygen: docs/Doxyfile (test docs.doxygen); MPI: CONTACTROM_MPI, mpirun ... offline (tests run mpirun as root)
+          doxygen libopenmpi-dev openmpi-bin  # doxygen: docs/Doxyfile (test docs.doxygen); MPI: CONTACTROM_MPI, mpirun ... offline (tests run mpirun as root)
+          libopenblas0-pthread)  # OpenBLAS replaces the reference libblas.so.3/liblapack.so.3 under CHOLMOD, dpotri and Ipopt (docs/results.md, "BLAS")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

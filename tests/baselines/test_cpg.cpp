@@ -315,8 +315,9 @@ BOOST_AUTO_TEST_CASE(hertz_basis_and_online_solver) {
   // CPG's own solutions at the training parameters around μ (init=cell, their û
   // interpolated and their active sets joined). On every validation query both
   // converge to the cold start's solution — for a fixed pairing the reduced QP on the
-  // CPG cone has one minimiser, so they agree to a few step tolerances (each stops
-  // when its last solve moved û by ≤ 1e-5; measured up to 2.5e-5 apart: 1e-4) — and
+  // CPG cone has one minimiser, so they agree to the resolution of the fixed point's
+  // stop (each stops once the contact surface moved by ≤ 1e-3 U between the point
+  // where the operators were built and û; measured up to 3e-4 apart: 1e-3) — and
   // init=cell needs fewer solves than the cold start.
   for (const char* init : {"primal", "cell"}) {
     rom::OnlineSolverOptions warm_options;
@@ -328,7 +329,7 @@ BOOST_AUTO_TEST_CASE(hertz_basis_and_online_solver) {
       BOOST_TEST_CONTEXT("init " << init << ", d = " << mu(0)) {
         BOOST_REQUIRE(b.converged);
         BOOST_TEST(b.coefficients.minCoeff() > 0.0);
-        BOOST_TEST((b.u_hat - a.u_hat).norm() <= 1e-4 * a.u_hat.norm());
+        BOOST_TEST((b.u_hat - a.u_hat).norm() <= 1e-3 * a.u_hat.norm());
         BOOST_TEST(baselines::reduced_penetration(model, cpg.dual_columns(), b.u) <= cpg.threshold() + 1e-10);
       }
       cold_iterations += a.iterations;
@@ -351,8 +352,8 @@ BOOST_AUTO_TEST_CASE(hertz_basis_and_online_solver) {
       }
     }
   }
-  // At a training parameter init=cell starts from the solution there: one solve
-  // confirms it.
+  // At a training parameter init=cell starts from the solution there: a solve or two
+  // confirm it (the stored solution is itself converged only to the stop's resolution).
   {
     rom::OnlineSolverOptions warm_options;
     warm_options.extra["init"] = "cell";
@@ -361,8 +362,8 @@ BOOST_AUTO_TEST_CASE(hertz_basis_and_online_solver) {
       const fom::Param& mu = model.dictionary_parameters()[static_cast<size_t>(c)];
       const rom::OnlineResult a = plain->solve(mu), b = warm->solve(mu);
       BOOST_TEST(b.converged);
-      BOOST_TEST(b.iterations <= 2, "column " << c);
-      BOOST_TEST((b.u_hat - a.u_hat).norm() <= 1e-4 * a.u_hat.norm(), "column " << c);
+      BOOST_TEST(b.iterations <= 3, "column " << c << ": " << b.iterations << " solves");
+      BOOST_TEST((b.u_hat - a.u_hat).norm() <= 1e-3 * a.u_hat.norm(), "column " << c);
     }
   }
   // init=nearest (a greedy setting) and nonsense are refused.

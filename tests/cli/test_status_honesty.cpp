@@ -2,6 +2,7 @@
 // convex-hull ROM below the training range, Ipopt at a vanishing load.
 #define BOOST_TEST_MODULE cli_status_honesty
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -124,4 +125,88 @@ BOOST_AUTO_TEST_CASE(no_reduced_answer_is_a_success_with_large_contact_residuals
       BOOST_TEST_MESSAGE(method << ": " << successes << " successes of " << rows);
     }
   }
+}
+
+namespace {
+
+/// The worst of the residuals a query reports (its JSON "kkt").
+double worst_residual(const nlohmann::json& j) {
+  const auto& k = j["kkt"];
+  return std::max({k["stationarity"].get<double>(), k["penetration"].get<double>(),
+                   k["negative_pressure"].get<double>()});
+}
+
+/// Exit 2 with one line on stderr containing `expected`, nothing on stdout.
+void check_refused(const contactrom::test::CommandResult& r, const std::string& expected) {
+  BOOST_TEST(r.exit_code == 2, r.err);
+  BOOST_TEST(r.out.empty(), r.out);
+  BOOST_TEST(std::count(r.err.begin(), r.err.end(), '\n') == 1, r.err);
+  BOOST_TEST(r.err.find(expected) != std::string::npos, r.err);
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(a_delta_that_keeps_no_mode_gives_an_empty_basis_or_a_clear_refusal_everywhere) {
+  // δ = 1 is inside the documented range [0, 1] and keeps no POD mode: every command
+  // that builds a reduced model either answers on the empty basis (the lifting alone,
+  // which enforces no contact: never a success at a load that presses) or refuses in
+  // one line naming delta. Under the sanitizers (CONTACTROM_SANITIZE) undefined
+  // behaviour on the empty basis fails the command.
+  const std::string dir = contactrom::test::temp_dir();
+  const std::string db = dir + "/h6.h5", rom = dir + "/r.h5";
+  BOOST_REQUIRE(run_command(kExe + " offline --problem hertz --train 6 --out " + db).exit_code == 0);
+  for (const char* method : {"greedy", "greedy-nested", "cpg", "full-dictionary"}) {
+    BOOST_TEST_CONTEXT("online " << method) {
+      const auto r = run_command(kExe + " online --db " + db + " --method " + method + " --param 0.1 --delta 1 --json");
+      BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+      BOOST_TEST(r.err.find("keeps no POD mode") != std::string::npos, r.err);
+      const auto j = nlohmann::json::parse(r.out);
+      BOOST_TEST(j["primal_rank"].get<int>() == 0);
+      BOOST_TEST(j["status"].get<std::string>() != "success");
+      BOOST_TEST(j["kkt"]["penetration"].get<double>() > 0.05);  // the lifting alone penetrates
+    }
+    BOOST_TEST_CONTEXT("reduce and query " << method) {
+      const auto r = run_command(kExe + " reduce --db " + db + " --method " + method + " --delta 1 --out " + rom);
+      BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+      const auto q = run_command(kExe + " query --rom " + rom + " --param 0.1 --json");
+      BOOST_TEST_REQUIRE(q.exit_code == 0, q.err);
+      const auto j = nlohmann::json::parse(q.out);
+      BOOST_TEST(j["primal_rank"].get<int>() == 0);
+      BOOST_TEST(j["queries"][0]["status"].get<std::string>() != "success");
+    }
+  }
+  // The convex hull needs a projection basis from the same δ: refused, naming it.
+  check_refused(run_command(kExe + " online --db " + db + " --method convex-hull --param 0.1 --delta 1"),
+                "keeps no mode at delta 1");
+  check_refused(run_command(kExe + " reduce --db " + db + " --method convex-hull --delta 1 --out " + rom),
+                "keeps no mode at delta 1");
+  check_refused(run_command(kExe + " hull-report --db " + db + " --delta 1"), "keeps no mode at delta 1");
+  // verify and bench run every method on the empty basis.
+  const auto v = run_command(kExe + " verify --db " + db + " --method greedy,cpg --delta 1 --limit 5 --json");
+  BOOST_TEST_REQUIRE(v.exit_code == 0, v.err);
+  const auto vj = nlohmann::json::parse(v.out);
+  for (const char* method : {"greedy", "cpg"}) BOOST_TEST(vj["methods"][method]["inaccurate"].get<int>() > 0, method);
+  const auto b = run_command(kExe + " bench --db " + db + " --delta 1 --repeats 1 --json");
+  BOOST_TEST(b.exit_code == 0, b.err);
+  std::filesystem::remove_all(dir);
+}
+
+BOOST_AUTO_TEST_CASE(subnormal_parameters_give_honest_statuses_in_every_reduced_model) {
+  // d = 5e-324 carries one bit: a reduced answer that says success must carry small
+  // residuals, as the FOM's (relative stationarity was 0.95 with success).
+  const std::string dir = contactrom::test::temp_dir();
+  const std::string db = dir + "/h12.h5";
+  BOOST_REQUIRE(run_command(kExe + " offline --problem hertz --train 12 --out " + db).exit_code == 0);
+  for (const char* method : {"greedy", "greedy-nested", "cpg", "full-dictionary", "convex-hull"})
+    for (const char* d : {"5e-324", "1e-320"}) {
+      BOOST_TEST_CONTEXT(method << " at d = " << d) {
+        const auto r = run_command(kExe + " online --db " + db + " --method " + method + " --param " + d + " --json");
+        BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+        const auto j = nlohmann::json::parse(r.out);
+        const double worst = worst_residual(j);
+        BOOST_TEST(std::isfinite(worst));
+        BOOST_TEST((j["status"].get<std::string>() != "success" || worst <= 1e-6), "residuals " << j["kkt"].dump());
+      }
+    }
+  std::filesystem::remove_all(dir);
 }

@@ -63,6 +63,20 @@ BOOST_AUTO_TEST_CASE(kkt_ironing2_across_range) {
   check_kkt("ironing2", {Eigen::Vector2d(0, 0.1), Eigen::Vector2d(4, 0.3), Eigen::Vector2d(1, 0.2),
                          Eigen::Vector2d(2.5, 0.15), Eigen::Vector2d(4, 0.1), Eigen::Vector2d(0, 0.3)});
 }
+// ironing3d2 (3D, hexahedra under a tetrahedral punch, two parameters): KKT at the
+// corners and inside, and a deeper indentation pressing harder at every slide.
+BOOST_AUTO_TEST_CASE(kkt_ironing3d2_across_range_and_force_grows_with_the_indentation) {
+  check_kkt("ironing3d2", {Eigen::Vector2d(0, 0.05), Eigen::Vector2d(4, 0.15), Eigen::Vector2d(2.5, 0.1)});
+  ActiveSetSolver& s = fixture().solver("ironing3d2");
+  for (double dx : {0.0, 2.5}) {
+    double previous = 0.0;
+    for (double dz : {0.05, 0.1, 0.15}) {
+      const double force = contact_force(s.problem(), s.solve(Eigen::Vector2d(dx, dz)).lambda);
+      BOOST_TEST(force > previous, "d_x " << dx << ", d_z " << dz);
+      previous = force;
+    }
+  }
+}
 
 // Two-cylinder plane-strain Hertz theory: with P the FOM's contact force,
 // a = sqrt(4 P R / (π E*)), p0 = 2P/(π a), p(x) = p0 sqrt(1 − x²/a²),

@@ -452,6 +452,36 @@ BOOST_AUTO_TEST_CASE(garbage_msh_is_an_input_error_naming_it) {
   BOOST_TEST(contains(msg, garbage.path.string()));
 }
 
+BOOST_AUTO_TEST_CASE(a_msh_that_is_a_geo_program_is_refused_without_running_it) {
+  // gmsh parses a .msh without the MSH header as a .geo script, whose System
+  // command runs a shell: a .msh is data, refused before gmsh sees it.
+  const std::filesystem::path marker =
+      std::filesystem::temp_directory_path() / ("contactrom_test_mesh_ran_" + std::to_string(::getpid()));
+  std::filesystem::remove(marker);
+  const std::string program = "System \"touch '" + marker.string() + "'\";\n" +
+                              "Point(1) = {0, 0, 0, 0.5}; Point(2) = {1, 0, 0, 0.5}; Point(3) = {1, 1, 0, 0.5};\n"
+                              "Point(4) = {0, 1, 0, 0.5}; Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4};\n"
+                              "Line(4) = {4, 1}; Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};\n"
+                              "Recombine Surface{1}; Physical Surface(\"body\") = {1};\n";
+  {
+    const TempFile msh("program.msh", program);
+    const std::string msg = input_error_of([&] { load_mesh(msh.path.string()); });
+    BOOST_TEST(contains(msg, "$MeshFormat"), msg);
+    BOOST_TEST(contains(msg, msh.path.string()), msg);
+    BOOST_TEST(!std::filesystem::exists(marker), "the .msh ran as a program");
+  }
+  // The same text as a .geo is a program, and runs: the check above is not vacuous.
+  {
+    const TempFile geo("program.geo", program);
+    try {
+      load_mesh(geo.path.string());
+    } catch (const InputError&) {  // whatever the mesh lacks, the script ran first
+    }
+    BOOST_TEST(std::filesystem::exists(marker));
+  }
+  std::filesystem::remove(marker);
+}
+
 BOOST_AUTO_TEST_CASE(triangles_are_rejected) {
   const TempFile tri("tri.geo",
                      "Point(1) = {0, 0, 0, 0.3}; Point(2) = {1, 0, 0, 0.3}; Point(3) = {0, 1, 0, 0.3};\n"

@@ -4,7 +4,9 @@
 // solution passes the stopping test it reports (re-pairing at it changes nothing
 // beyond the tolerance), the cap gives no_convergence with the last change in the
 // message, and Anderson acceleration reaches the same solution as the plain
-// iteration in fewer pairing iterations.
+// iteration in fewer pairing iterations; at every cap, with and without Anderson,
+// the result's pairing, operator, gap offsets, solution and change all belong to
+// the last solve (and the FOM's u to its pairing).
 #define BOOST_TEST_MODULE fom_pairing_fixed_point
 #include <boost/test/unit_test.hpp>
 #include <cmath>
@@ -111,4 +113,95 @@ BOOST_AUTO_TEST_CASE(anderson_reaches_the_plain_iterations_solution_in_fewer_ite
   BOOST_TEST(anderson.pairing_iterations < plain.pairing_iterations);
   BOOST_TEST_MESSAGE("pairing iterations: plain " << plain.pairing_iterations << ", Anderson "
                                                   << anderson.pairing_iterations);
+}
+
+BOOST_AUTO_TEST_CASE(at_the_cap_the_result_belongs_to_the_last_solve) {
+  // Solve k returns the FOM's solution at the k-th of five loads (so the pairing
+  // moves at every step and never settles), whatever pairing it is given: what
+  // matters here is that the result hands back exactly the operator the last call
+  // received and the solution it returned.
+  const Problem& p = hertz();
+  const ContactModel& contact = p.contact();
+  const ActiveSetSolver solver(p);
+  std::vector<FomSolution> answers;
+  for (const double d : {0.05, 0.3, 0.1, 0.25, 0.15}) answers.push_back(solver.solve(p1(d)));
+  for (const auto& a : answers) BOOST_TEST_REQUIRE(a.status == Status::Success, a.message);
+  for (const int depth : {0, 10}) {
+    for (int cap = 1; cap <= 4; ++cap) {
+      std::vector<ConstraintMatrix> cs;
+      std::vector<Eigen::VectorXd> gs;
+      std::vector<Pairing> pairings;
+      std::vector<PairedSolution> solutions;
+      auto solve_at = [&](const Pairing& pairing, const ConstraintMatrix& c, const Eigen::VectorXd& g,
+                          const Eigen::VectorXd&) {
+        const FomSolution& a = answers[solutions.size() % answers.size()];
+        PairedSolution s;
+        s.surface_displacement = contact.restrict_to_surface(a.u);
+        s.lambda = a.lambda;
+        cs.push_back(c);
+        gs.push_back(g);
+        pairings.push_back(pairing);
+        solutions.push_back(s);
+        return s;
+      };
+      PairingFixedPointOptions options;
+      options.max_iterations = cap;
+      options.anderson_depth = depth;
+      const Eigen::VectorXd x = contact.restrict_to_surface(answers.back().u);
+      const PairingFixedPointResult r =
+          solve_pairing_fixed_point(contact, p.displacement_scale(), x, contact.search(x), options, solve_at);
+      BOOST_TEST_CONTEXT("Anderson depth " << depth << ", cap " << cap) {
+        BOOST_TEST_REQUIRE(r.status == Status::NoConvergence);
+        BOOST_TEST_REQUIRE(r.iterations == cap);
+        BOOST_TEST_REQUIRE(static_cast<int>(solutions.size()) == cap);
+        BOOST_TEST(r.pairing.same_as(pairings.back(), 0.0));
+        BOOST_TEST(Eigen::MatrixXd(r.c - cs.back()).norm() == 0.0);
+        BOOST_TEST((r.g - gs.back()).norm() == 0.0);
+        BOOST_TEST((r.solution.lambda - solutions.back().lambda).norm() == 0.0);
+        // The operator is the one of the returned pairing, and the change is the
+        // stopping test of the returned solution at it.
+        ConstraintMatrix c_own, c_next;
+        Eigen::VectorXd g_own, g_next;
+        contact.assemble(r.pairing, c_own, g_own);
+        BOOST_TEST(Eigen::MatrixXd(r.c - c_own).norm() == 0.0);
+        BOOST_TEST((r.g - g_own).norm() == 0.0);
+        const Eigen::VectorXd& f = r.solution.surface_displacement;
+        contact.assemble(contact.search_rows(f, nullptr, &r.pairing), c_next, g_next);
+        const double change = pairing_change(r.c, r.g, c_next, g_next, f, r.solution.lambda, contact.weights(),
+                                             p.displacement_scale(), options.tolerance);
+        BOOST_TEST(r.residual > options.tolerance);
+        BOOST_TEST(std::abs(r.residual - change) <= 1e-12 * change);
+      }
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(at_the_cap_the_fom_displacement_belongs_to_the_returned_pairing) {
+  // u = u0 − K⁻¹ E_s C(pairing)ᵀ λ: with the FOM's own pairing and λ, K u − f + Cᵀλ = 0
+  // holds to rounding whatever the cap (while the pairing recomputed from u differs).
+  const Problem& p = hertz();
+  for (int cap = 1; cap <= 3; ++cap) {
+    ActiveSetOptions options;
+    options.max_pairing_iterations = cap;
+    const FomSolution sol = ActiveSetSolver(p, options).solve(p1(0.3));
+    BOOST_TEST_CONTEXT("cap " << cap) {
+      BOOST_TEST_REQUIRE(sol.status == Status::NoConvergence);
+      ConstraintMatrix c;
+      Eigen::VectorXd g;
+      p.contact().assemble(sol.pairing, c, g);
+      const Eigen::VectorXd ctl = c.transpose() * sol.lambda;
+      Eigen::VectorXd force = Eigen::VectorXd::Zero(p.num_dofs());
+      const std::vector<int>& surf = p.contact().surface_dofs();
+      for (size_t j = 0; j < surf.size(); ++j) force(surf[j]) += ctl(static_cast<Eigen::Index>(j));
+      const Eigen::VectorXd ku_all = p.stiffness(sol.mu) * (sol.u - p.lifting(sol.mu)), f_all = p.rhs(sol.mu);
+      const auto n_free = static_cast<Eigen::Index>(p.free_dofs().size());
+      Eigen::VectorXd ku(n_free), f(n_free), ct(n_free);
+      for (Eigen::Index j = 0; j < n_free; ++j) {
+        const int i = p.free_dofs()[static_cast<size_t>(j)];
+        ku(j) = ku_all(i), f(j) = f_all(i), ct(j) = force(i);
+      }
+      const double scale = std::max({ku.norm(), f.norm(), ct.norm()});
+      BOOST_TEST((ku - f + ct).norm() <= 1e-9 * scale);
+    }
+  }
 }

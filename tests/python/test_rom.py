@@ -190,3 +190,17 @@ def test_cli_reduced_model_loads_in_python(tmp_path, hertz_db_path):
         loaded.evaluate()
     report = loaded.evaluate(QUERY_PARAMS, threads=1)
     assert report["validation_size"] == len(QUERY_PARAMS)
+
+
+def test_delta_one_gives_the_empty_basis_and_no_success(db):
+    # delta = 1 keeps no POD mode: the answer is the lifting alone (no contact
+    # enforced), never a success at a pressing load; the convex hull refuses.
+    with pytest.warns(RuntimeWarning, match="keeps no POD mode"):
+        empty = contactrom.ReducedModel(db, delta=1.0, method="greedy")
+    assert empty.primal_rank == 0
+    r = empty.solve(0.1)
+    assert r.u_hat.shape == (0,)
+    assert np.all(np.isfinite(r.u)) and np.all(np.isfinite(r.lam))
+    assert r.status != "success" and r.penetration > 0.05
+    with pytest.raises(ValueError, match="keeps no mode at delta 1"):
+        contactrom.ReducedModel(db, delta=1.0, method="convex-hull")

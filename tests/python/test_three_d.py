@@ -1,13 +1,15 @@
 """A 3D problem written by a user, end to end: a gmsh .geo of two bodies (physical
 volumes and surfaces), a problem file with formulation = "3d", Young's modulus a
 parameter and a Dirichlet condition with "free" components; `fom`, `offline`,
-`online --validation`, `reduce`, `query` (VTU with tetrahedra, surface CSV with z)
-and the Python FOM, which agrees with the CLI."""
+`online --validation`, `reduce`, `query` (VTU with tetrahedra, surface CSV with z),
+`chls` (against SciPy) and the Python FOM, which agrees with the CLI."""
 import csv
 import os
 
+import h5py
 import numpy as np
 import pytest
+from scipy.optimize import nnls
 
 import contactrom
 from conftest import run_cli, run_cli_json
@@ -111,9 +113,16 @@ def test_fom_cli_and_python_agree(case):
     assert sol.kkt["max"] <= 1e-10
 
 
-def test_offline_online_reduce_query(case):
-    path, db, rom = str(case / "user3d.toml"), str(case / "user3d.h5"), str(case / "user3d_rom.h5")
-    run_cli("offline", "--problem", path, "--level", "2", "--out", db)
+@pytest.fixture(scope="module")
+def database(case):
+    """The user problem's level-2 database (5 x 5 tensor grid) written by `offline`."""
+    db = str(case / "user3d.h5")
+    run_cli("offline", "--problem", str(case / "user3d.toml"), "--level", "2", "--out", db)
+    return db
+
+
+def test_offline_online_reduce_query(case, database):
+    db, rom = database, str(case / "user3d_rom.h5")
     online = run_cli_json("online", "--db", db, "--method", "greedy", "--validation")
     assert online["nonconverged"] == 0
     assert online["validation_size"] > 0
@@ -129,6 +138,27 @@ def test_offline_online_reduce_query(case):
         rows = list(csv.DictReader(f))
     assert list(rows[0].keys()) == ["x", "y", "z", "gap", "pressure", "u_x", "u_y", "u_z"]
     assert max(float(r["pressure"]) for r in rows) > 0.0
+
+
+def test_chls_of_the_3d_database_matches_an_independent_solve(database):
+    # Leave-one-out convex-hull least squares of the 3D primal snapshots; the centre
+    # of the 5 x 5 grid is checked against SciPy's NNLS with the constraint
+    # sum(alpha) = 1 as a heavily weighted extra row.
+    result = run_cli_json("chls", "--db", database)
+    errors = np.array(result["chls_error"])
+    with h5py.File(database) as f:
+        primal = f["primal"][()]  # one row per snapshot
+    assert primal.shape[0] == len(errors) == 25 and primal.shape[1] % 3 == 0
+    assert np.all(np.isfinite(errors)) and np.all(errors >= 0.0)
+    k = 12
+    others = np.delete(primal, k, axis=0).T
+    target = primal[k]
+    weight = 1e4 * np.linalg.norm(target)
+    alpha, _ = nnls(np.vstack([others, weight * np.ones(others.shape[1])]), np.append(target, weight))
+    reference = np.linalg.norm(others @ alpha - target) / np.linalg.norm(target)
+    assert abs(alpha.sum() - 1.0) <= 1e-6
+    assert errors[k] == pytest.approx(reference, rel=1e-4, abs=1e-10)
+    assert 1e-6 < errors[k] < 0.5  # an interior point of the grid is close to its neighbours' hull
 
 
 @pytest.mark.parametrize("edit,key,words", [

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "common/cli_blas_threads.hpp"
 #include "common/database_checks.hpp"
 #include "fom/active_set_solver.hpp"
 #include "fom/problem.hpp"

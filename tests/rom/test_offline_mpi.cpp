@@ -1,5 +1,5 @@
 // Tests of the MPI offline stage (built with CONTACTROM_MPI): mpirun -np 2 and 3
-// write a database whose arrays are bit-identical to the serial run's; bad input
+// write a database whose arrays are bit-identical to the serial run's (2D and 3D); bad input
 // and I/O errors end every rank with a non-zero code, one message and no file;
 // `mpirun -np 2 reduce` shares the POD and gives the serial basis to rounding.
 #define BOOST_TEST_MODULE rom_offline_mpi
@@ -56,6 +56,21 @@ BOOST_AUTO_TEST_CASE(mpi_offline_is_bit_identical_to_serial) {
       BOOST_TEST(b.threads == ranks);
     }
   }
+}
+
+BOOST_AUTO_TEST_CASE(mpi_offline_of_a_3d_problem_is_bit_identical_to_serial) {
+  // hertz3d (tetrahedra, node-to-face contact): each rank meshes and factorises on
+  // its own, rank 0 gathers; the snapshots are those of one serial run.
+  const std::string serial = work_dir() + "/serial3d.h5", path = work_dir() + "/mpi3d.h5";
+  auto r = run_command(exe + " offline --problem hertz3d --train 4 --threads 1 --out " + serial);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  r = run_command(mpirun(2) + exe + " offline --problem hertz3d --train 4 --threads 1 --out " + path);
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  const SnapshotDatabase a = read_database(serial), b = read_database(path);
+  BOOST_TEST(a.num_dofs() > 10000);  // 3D: three dofs per node
+  BOOST_TEST(a.successful_snapshots().size() == 4u);
+  check_same_snapshots(a, b);
+  BOOST_TEST(b.threads == 2);
 }
 
 BOOST_AUTO_TEST_CASE(mpi_offline_append_completes_a_serial_part) {

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/cli_blas_threads.hpp"
 #include "common/database_checks.hpp"
 #include "common/run_command.hpp"
 #include "fom/kkt.hpp"
