@@ -1,4 +1,4 @@
-// contactrom online --db DB.h5 --method greedy [--delta D] [--tau T] [--validation] [--param V]
+// contactrom online --db DB.h5 --method greedy [--delta D] [--tau T] [--validation [--params FILE.csv]] [--param V]
 //                   [--out FILE.csv|DIR] [--json] [--threads T] [--kkt] [--lifting harmonic|dirichlet]
 //                   [--tau-scaling absolute|relative] [--max-iterations K] [--option KEY=VALUE]...
 // Builds the reduced model (POD basis with tolerance δ, dual dictionary) from a
@@ -6,7 +6,8 @@
 //  - --validation (default without --param): at every validation parameter of the
 //    problem (validation_set(n), n = the database's training size/level), against
 //    the FOM; --out FILE.csv gets one row per parameter; prints a summary (or the
-//    JSON object with --json, keys in docs/rom.md).
+//    JSON object with --json, keys in docs/rom.md). --params FILE.csv replaces the
+//    validation set by the parameters listed in FILE (one per line, --param order).
 //  - --param V: one query, compared with the FOM; --out DIR writes
 //    DIR/<problem>_<method>.vtu and DIR/<problem>_<method>_surface.csv.
 #include <algorithm>
@@ -24,6 +25,7 @@
 #include "rom/online_evaluation.hpp"
 #include "rom/online_methods.hpp"
 #include "rom/reduced_model.hpp"
+#include "rom/reduced_model_file.hpp"
 #include "rom/snapshot_database.hpp"
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
@@ -32,7 +34,7 @@ namespace contactrom::cli {
 namespace {
 
 struct OnlineArgs : MethodArgs {
-  std::string db, param, out;
+  std::string db, param, params, out;
   int threads = 0;
   bool validation = false, json = false, kkt = false;
 };
@@ -100,7 +102,8 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
 
 void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom::SnapshotDatabase& db,
                     const rom::OnlineSolver& solver) {
-  const std::vector<fom::Param> params = rom::database_validation_set(db, problem);
+  const std::vector<fom::Param> params =
+      a.params.empty() ? rom::database_validation_set(db, problem) : rom::read_parameter_csv(a.params, problem);
   const fom::ActiveSetSolver fom_solver(problem);
   const std::vector<fom::FomSolution> refs = rom::compute_references(fom_solver, params, a.threads);
   rom::EvaluationOptions options;
@@ -115,7 +118,8 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
     return;
   }
   std::cout << "online " << s.method << " on " << problem.name() << " (" << db.training_kind << " "
-            << db.training_size << "): " << s.rows.size() << " validation parameters\n"
+            << db.training_size << "): " << s.rows.size()
+            << (a.params.empty() ? " validation parameters\n" : " parameters of " + a.params + "\n")
             << "dictionary " << s.dictionary_size << " columns (dual basis " << s.dual_basis_size
             << "), primal rank " << s.primal_rank << " (delta "
             << s.delta << ")\n"
@@ -139,9 +143,11 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
 }
 
 void run_online(const OnlineArgs& a) {
-  if (!a.out.empty() && a.param.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.db});
+  if (!a.out.empty() && a.param.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.db, a.params});
   if (!a.param.empty() && a.validation)
     throw InputError("--param and --validation exclude each other; give one");
+  if (!a.param.empty() && !a.params.empty())
+    throw InputError("--param and --params exclude each other; give one (--params FILE.csv evaluates a parameter list)");
   if (!a.param.empty() && a.out.size() >= 4 && a.out.compare(a.out.size() - 4, 4, ".csv") == 0)
     throw InputError("--out " + quoted(a.out, 200) + " with --param names the folder of the VTU/CSV fields, not a CSV file; "
                      "expected a folder name (a CSV of results comes from --validation or contactrom query --out)");
@@ -168,6 +174,10 @@ CommandRegistrar reg("online", [](CLI::App& app) {
   add_method_options(sub, *args);
   sub->add_flag("--validation", args->validation, "evaluate on the validation set (default without --param)");
   sub->add_option("--param", args->param, "one query V or V1,V2");
+  sub->add_option("--params", args->params,
+                  "validation on the parameters of a CSV file (one per line, the --param order) instead of the "
+                  "database's validation set")
+      ->check(non_empty_path());
   sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)")
       ->check(non_empty_path());
   add_integer(sub, "--threads", args->threads, "threads for the FOM references (default: hardware concurrency)", 1, 1024);

@@ -1,0 +1,73 @@
+// `online --validation --params FILE.csv`: a database evaluated against the FOM on a
+// user-given parameter list gives, row by row, the errors of single queries at the
+// same parameters; bad lists are refused with the file and line named.
+#define BOOST_TEST_MODULE cli_online_params
+#include <boost/test/unit_test.hpp>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/run_command.hpp"
+
+using contactrom::test::run_command;
+
+namespace {
+const std::string kExe = CONTACTROM_EXE;
+
+std::vector<std::vector<std::string>> csv_rows(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells;
+    std::stringstream fields(line);
+    for (std::string x; std::getline(fields, x, ',');) cells.push_back(x);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(parameter_list_rows_equal_single_queries) {
+  const std::string dir = contactrom::test::temp_dir();
+  const std::string db = dir + "/h12.h5", list = dir + "/points.csv", out = dir + "/rows.csv";
+  BOOST_REQUIRE(run_command(kExe + " offline --problem hertz --train 12 --out " + db).exit_code == 0);
+  const std::vector<std::string> points{"0.0625", "0.17", "0.2913"};
+  {
+    std::ofstream f(list);
+    f << "d\n# three points off the training grid\n";
+    for (const std::string& p : points) f << p << "\n";
+  }
+  const auto r = run_command(kExe + " online --db " + db + " --method greedy --validation --params " + list +
+                             " --out " + out + " --json");
+  BOOST_REQUIRE_MESSAGE(r.exit_code == 0, r.err);
+  const auto j = nlohmann::json::parse(r.out);
+  BOOST_TEST(j["validation_size"].get<int>() == 3);
+  const auto rows = csv_rows(out);
+  BOOST_REQUIRE(rows.size() == 4u);
+  for (size_t i = 0; i < points.size(); ++i) {
+    BOOST_TEST(std::stod(rows[i + 1][0]) == std::stod(points[i]));
+    const auto single = run_command(kExe + " online --db " + db + " --method greedy --param " + points[i] + " --json");
+    BOOST_REQUIRE(single.exit_code == 0);
+    const auto s = nlohmann::json::parse(single.out);
+    BOOST_TEST(std::stod(rows[i + 1][1]) == s["primal_error"].get<double>(), boost::test_tools::tolerance(1e-9));
+    BOOST_TEST(std::stod(rows[i + 1][2]) == s["dual_error"].get<double>(), boost::test_tools::tolerance(1e-9));
+  }
+}
+
+BOOST_AUTO_TEST_CASE(bad_parameter_lists_are_refused) {
+  const std::string dir = contactrom::test::temp_dir();
+  const std::string db = dir + "/h12.h5", list = dir + "/bad.csv";
+  BOOST_REQUIRE(run_command(kExe + " offline --problem hertz --train 12 --out " + db).exit_code == 0);
+  {
+    std::ofstream f(list);
+    f << "0.1\n0.7\n";  // 0.7 is outside d in (0, 0.3]
+  }
+  const auto r = run_command(kExe + " online --db " + db + " --validation --params " + list);
+  BOOST_TEST(r.exit_code == 2);
+  BOOST_TEST(r.err.find("bad.csv") != std::string::npos);
+  BOOST_TEST(r.err.find("0.7") != std::string::npos);
+  const auto both = run_command(kExe + " online --db " + db + " --param 0.1 --params " + list);
+  BOOST_TEST(both.exit_code == 2);
+}
