@@ -279,15 +279,20 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
   return out;
 }
 
-void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results) {
-  write_file_atomically(path, query_csv_writer(rom, results));
+void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results,
+                     const std::vector<std::string>& sources) {
+  write_file_atomically(path, query_csv_writer(rom, results, sources));
 }
 
-FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResult>& results) {
-  return [&rom, &results](std::ostream& out) {
+FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResult>& results,
+                            const std::vector<std::string>& sources) {
+  return [&rom, &results, &sources](std::ostream& out) {
+    const bool with_source = sources.size() == results.size() && !sources.empty();
     for (const std::string& name : rom.problem().param_names()) out << name << ',';
-    out << "status,converged,iterations,sparsity,contact_force,time_s,selected,coefficients,penetration,separation,primal_estimate,dual_estimate\n";
-    for (const OnlineResult& res : results) {
+    out << "status,converged,iterations,sparsity,contact_force,time_s,selected,coefficients,penetration,separation,primal_estimate,dual_estimate"
+        << (with_source ? ",source\n" : "\n");
+    for (size_t i = 0; i < results.size(); ++i) {
+      const OnlineResult& res = results[i];
       for (int k = 0; k < res.mu.size(); ++k) out << fom::format_number(res.mu(k)) << ',';
       out << to_string(res.status) << ',' << (res.converged ? 1 : 0) << ',' << res.iterations << ','
           << res.selected.size() << ',' << fom::format_number(fom::contact_force(rom.problem(), res.lambda)) << ','
@@ -297,7 +302,9 @@ FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResu
       out << ',';
       for (Eigen::Index j = 0; j < res.coefficients.size(); ++j) out << (j ? " " : "") << fom::format_number(res.coefficients(j));
       out << ',' << fom::format_number(res.contact.penetration) << ',' << fom::format_number(res.contact.complementarity)
-          << ',' << fom::format_number(res.primal_estimate) << ',' << fom::format_number(res.dual_estimate) << '\n';
+          << ',' << fom::format_number(res.primal_estimate) << ',' << fom::format_number(res.dual_estimate);
+      if (with_source) out << ',' << sources[i];
+      out << '\n';
     }
   };
 }

@@ -90,9 +90,13 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
 /// after it), then status, converged (0/1), iterations, sparsity, contact_force
 /// (Σ weights · pressure), time_s (online core), selected (space-separated database
 /// snapshot indices) and coefficients (space-separated, in the order of `selected`).
-void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results);
+/// With `sources` (one word per result, e.g. "rom" or "fom" from `query --fallback fom`)
+/// a last column `source` names where each answer came from.
+void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results,
+                     const std::vector<std::string>& sources = {});
 
 /// \brief The content of write_query_csv() (for a set of files published together).
-FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResult>& results);
+FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResult>& results,
+                            const std::vector<std::string>& sources = {});
 
 }  // namespace contactrom::rom

@@ -1,7 +1,11 @@
 // contactrom query --rom ROM.h5 (--param V | --params FILE.csv) [--out FILE.csv] [--fields DIR] [--json]
+//                  [--fallback none|fom [--primal-tolerance P] [--dual-tolerance D]]
 // Answers queries from a reduced-model file written by `contactrom reduce`: no
-// FOM, no meshing, no factorisation. Prints the load time and, per query, the
-// status, iterations, selected snapshots, contact force and online time.
+// FOM, no meshing. Prints the load time and, per query, the status, iterations,
+// selected snapshots, contact force and online time. With --fallback fom a query
+// whose reduced answer is not success or whose error estimates (× 3) exceed the
+// tolerances is answered by the FOM, built from the file's problem and mesh
+// (rom/fallback.hpp); the output says which answers came from where.
 #include <chrono>
 #include <iomanip>
 #include <iostream>
@@ -10,6 +14,7 @@
 #include "core/atomic_file.hpp"
 #include "fom/field_output.hpp"
 #include "fom/kkt.hpp"
+#include "rom/fallback.hpp"
 #include "rom/online_timing.hpp"
 #include "rom/reduced_model_file.hpp"
 #include "tools/cli.hpp"
@@ -19,7 +24,8 @@ namespace contactrom::cli {
 namespace {
 
 struct QueryArgs {
-  std::string rom, param, params, out, fields;
+  std::string rom, param, params, out, fields, fallback = "none";
+  double primal_tolerance = rom::FallbackOptions().primal_tolerance, dual_tolerance = rom::FallbackOptions().dual_tolerance;
   bool json = false;
 };
 
@@ -53,11 +59,25 @@ void run_query(const QueryArgs& a) {
   const fom::Problem& problem = rom.problem();
   const std::vector<fom::Param> params =
       a.param.empty() ? rom::read_parameter_csv(a.params, problem) : std::vector<fom::Param>{parse_problem_param(problem, a.param)};
+  rom::FallbackOptions fallback_options;
+  fallback_options.primal_tolerance = a.primal_tolerance;
+  fallback_options.dual_tolerance = a.dual_tolerance;
+  const rom::FallbackSolver fallback(rom.solver(), fallback_options);
+  const bool use_fom = a.fallback == "fom";
   std::vector<rom::OnlineResult> results;
+  std::vector<rom::FallbackAnswer> answers;
+  std::vector<std::string> sources;
   std::vector<double> times;
-  int failed = 0;
+  int failed = 0, from_fom = 0;
   for (const fom::Param& mu : params) {
-    results.push_back(rom.solve(mu));
+    if (use_fom) {
+      answers.push_back(fallback.solve(mu));
+      results.push_back(answers.back().result);
+      sources.push_back(answers.back().from_fom ? "fom" : "rom");
+      from_fom += answers.back().from_fom ? 1 : 0;
+    } else {
+      results.push_back(rom.solve(mu));
+    }
     times.push_back(results.back().time_s);
     if (results.back().status != Status::Success) ++failed;
   }
@@ -69,10 +89,10 @@ void run_query(const QueryArgs& a) {
       sets.push_back({results.size() == 1 ? stem : stem + "_" + std::to_string(i), results[i].mu, &results[i].u,
                       &results[i].lambda});
     std::vector<std::pair<std::string, FileWriter>> csv;
-    if (!a.out.empty()) csv.emplace_back(a.out, rom::query_csv_writer(rom, results));
+    if (!a.out.empty()) csv.emplace_back(a.out, rom::query_csv_writer(rom, results, sources));
     fom::write_field_sets(a.fields, problem, sets, csv);
   } else if (!a.out.empty()) {
-    rom::write_query_csv(a.out, rom, results);
+    rom::write_query_csv(a.out, rom, results, sources);
   }
   nlohmann::json j;
   j["problem"] = problem.name();
@@ -82,8 +102,30 @@ void run_query(const QueryArgs& a) {
   j["load_time_s"] = load_s;
   j["median_time_s"] = rom::median(times);
   j["not_success"] = failed;
+  double mean_time = 0.0;
+  for (double t : times) mean_time += t / static_cast<double>(std::max<size_t>(1, times.size()));
+  j["mean_time_s"] = mean_time;
+  if (use_fom) {
+    j["fallbacks"] = from_fom;
+    j["fom_setup_time_s"] = fallback.fom_setup_time();
+  }
   j["queries"] = nlohmann::json::array();
-  for (const rom::OnlineResult& res : results) j["queries"].push_back(result_json(rom, res));
+  for (size_t i = 0; i < results.size(); ++i) {
+    nlohmann::json q = result_json(rom, results[i]);
+    if (use_fom) {
+      const rom::FallbackAnswer& f = answers[i];
+      q["source"] = f.from_fom ? "fom" : "rom";
+      if (f.from_fom) {
+        q["fallback_reason"] = f.reason;
+        q["rom_status"] = to_string(f.rom_status);
+        q["rom_primal_estimate"] = f.rom_primal_estimate;
+        q["rom_dual_estimate"] = f.rom_dual_estimate;
+      }
+      q["rom_time_s"] = f.rom_time_s;
+      q["fom_time_s"] = f.fom_time_s;
+    }
+    j["queries"].push_back(q);
+  }
   if (a.json) {
     std::cout << j.dump() << std::endl;
     return;
@@ -102,6 +144,10 @@ void run_query(const QueryArgs& a) {
     std::cout << results.size() << " queries, " << failed << " not successful, median time " << rom::median(times) * 1e6
               << " us per query\n";
   }
+  if (use_fom) {
+    std::cout << from_fom << " of " << results.size() << " answered by the FOM (reduced status not success or error "
+              << "estimates above tolerance), mean time " << mean_time * 1e6 << " us per query\n";
+  }
   if (!a.out.empty()) std::cout << "per-query results written to " << a.out << "\n";
   if (!a.fields.empty()) std::cout << "fields written to " << a.fields << "/\n";
 }
@@ -116,6 +162,16 @@ CommandRegistrar reg("query", [](CLI::App& app) {
       ->check(non_empty_path());
   sub->add_option("--out", args->out, "CSV file of the per-query results")->check(non_empty_path());
   sub->add_option("--fields", args->fields, "folder for the VTU/CSV fields of every query")->check(non_empty_path());
+  sub->add_option("--fallback", args->fallback,
+                  "fom: answer by the FOM a query whose reduced answer is not success or whose error estimates (x 3) "
+                  "exceed the tolerances; none (default): the reduced answer always")
+      ->check(CLI::IsMember({"none", "fom"}));
+  add_number(sub, "--primal-tolerance", args->primal_tolerance,
+             "--fallback fom: largest relative H1 error of an answer kept from the ROM (default 0.05)",
+             Interval::greater_than(0));
+  add_number(sub, "--dual-tolerance", args->dual_tolerance,
+             "--fallback fom: largest relative L2 pressure error of an answer kept from the ROM (default 0.2)",
+             Interval::greater_than(0));
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_query(*args); });
 });

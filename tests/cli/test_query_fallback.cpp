@@ -1,0 +1,50 @@
+// `query --fallback fom`: answers come from the ROM or the FOM as the tolerances
+// decide, and the output says which and how long each took.
+#define BOOST_TEST_MODULE cli_query_fallback
+#include <boost/test/unit_test.hpp>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "common/run_command.hpp"
+
+using contactrom::test::run_command;
+
+namespace {
+const std::string kExe = CONTACTROM_EXE;
+}
+
+BOOST_AUTO_TEST_CASE(fallback_answers_are_labelled_and_timed) {
+  const std::string dir = contactrom::test::temp_dir();
+  const std::string db = dir + "/h12.h5", rom = dir + "/h12_greedy.h5", list = dir + "/q.csv", out = dir + "/a.csv";
+  BOOST_REQUIRE(run_command(kExe + " offline --problem hertz --train 12 --out " + db).exit_code == 0);
+  BOOST_REQUIRE(run_command(kExe + " reduce --db " + db + " --method greedy --out " + rom).exit_code == 0);
+  {
+    std::ofstream f(list);
+    f << "0.1\n0.2\n";
+  }
+  // Tolerances no answer meets: every answer is the FOM's.
+  const auto all = run_command(kExe + " query --rom " + rom + " --params " + list +
+                               " --fallback fom --primal-tolerance 1e-12 --dual-tolerance 1e-12 --json --out " + out);
+  BOOST_REQUIRE_MESSAGE(all.exit_code == 0, all.err);
+  const auto j = nlohmann::json::parse(all.out);
+  BOOST_TEST(j["fallbacks"].get<int>() == 2);
+  for (const auto& q : j["queries"]) {
+    BOOST_TEST(q["source"].get<std::string>() == "fom");
+    BOOST_TEST(q["fom_time_s"].get<double>() > 0.0);
+    BOOST_TEST(!q["fallback_reason"].get<std::string>().empty());
+  }
+  std::ifstream csv(out);
+  std::string header;
+  std::getline(csv, header);
+  BOOST_TEST(header.substr(header.size() - 7) == ",source");
+  // Generous tolerances: the ROM answers (hertz 12 is accurate to a few per cent).
+  const auto none = run_command(kExe + " query --rom " + rom + " --params " + list +
+                                " --fallback fom --primal-tolerance 1 --dual-tolerance 1 --json");
+  BOOST_REQUIRE(none.exit_code == 0);
+  const auto k = nlohmann::json::parse(none.out);
+  BOOST_TEST(k["fallbacks"].get<int>() == 0);
+  for (const auto& q : k["queries"]) BOOST_TEST(q["source"].get<std::string>() == "rom");
+  // A bad choice is an input error.
+  BOOST_TEST(run_command(kExe + " query --rom " + rom + " --param 0.1 --fallback ipopt").exit_code != 0);
+}
