@@ -7,6 +7,7 @@
 #include "core/format.hpp"
 #include "core/errors.hpp"
 #include "python/bindings.hpp"
+#include "rom/fallback.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_methods.hpp"
 
@@ -46,6 +47,25 @@ std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, doub
                    1) != 0)
     throw py::error_already_set();  // the warning was turned into an error
   return r;
+}
+
+/// A reduced model with the FOM behind it (rom::FallbackSolver); keeps the model alive.
+struct Fallback {
+  std::shared_ptr<const rom::OnlineModel> rom;
+  std::shared_ptr<rom::FallbackSolver> solver;
+};
+
+py::dict fallback_answer(const rom::FallbackAnswer& a) {
+  py::dict d;
+  d["solution"] = a.result;
+  d["source"] = a.from_fom ? "fom" : "rom";
+  d["reason"] = a.reason;
+  d["rom_status"] = std::string(to_string(a.rom_status));
+  d["rom_primal_estimate"] = a.rom_primal_estimate;
+  d["rom_dual_estimate"] = a.rom_dual_estimate;
+  d["rom_time_s"] = a.rom_time_s;
+  d["fom_time_s"] = a.fom_time_s;
+  return d;
 }
 
 std::unique_ptr<ReducedModel> load_reduced_model(py::handle path_like) {
@@ -226,6 +246,20 @@ works in memory but is refused when read back from a file.)doc");
                " columns, " + std::to_string(r.iterations) + " iterations>";
       });
 
+  py::class_<Fallback>(m, "FallbackModel", "A reduced model that lets the FOM answer where it cannot (ReducedModel.with_fallback).")
+      .def(
+          "solve",
+          [](const Fallback& f, py::handle mu) {
+            const fom::Param p = to_param(f.rom->problem(), mu);
+            rom::FallbackAnswer a;
+            {
+              py::gil_scoped_release release;
+              a = f.solver->solve(p);
+            }
+            return fallback_answer(a);
+          },
+          py::arg("mu"), "One query: the ROM's answer if kept, else the FOM's (a dict; see ReducedModel.with_fallback).");
+
   py::class_<ReducedModel>(m, "ReducedModel", R"doc(
 POD basis, dual dictionary, reduced operators and an online method, built from a
 snapshot database or loaded from a reduced-model file (`contactrom reduce`). The
@@ -280,6 +314,25 @@ object owns the problem (and the database) it needs.)doc")
             return r.rom->solver().solve(p);
           },
           py::arg("mu"), "One online query (GIL released): a RomSolution.")
+      .def(
+          "with_fallback",
+          [](const ReducedModel& r, double primal_tolerance, double dual_tolerance) {
+            if (!(primal_tolerance > 0.0) || !(dual_tolerance > 0.0))
+              throw InputError("with_fallback: tolerances must be positive numbers, got " +
+                               fom::format_number(primal_tolerance) + " and " + fom::format_number(dual_tolerance));
+            rom::FallbackOptions o;
+            o.primal_tolerance = primal_tolerance;
+            o.dual_tolerance = dual_tolerance;
+            return Fallback{r.rom, std::make_shared<rom::FallbackSolver>(r.rom->solver(), o)};
+          },
+          py::arg("primal_tolerance") = rom::FallbackOptions().primal_tolerance,
+          py::arg("dual_tolerance") = rom::FallbackOptions().dual_tolerance, R"doc(
+The model with the FOM behind it (as `contactrom query --fallback fom`): its solve(mu)
+returns a dict with 'solution' (a RomSolution: the ROM's answer, or the FOM's u, lam
+and status), 'source' ('rom' or 'fom'), 'reason', 'rom_status',
+'rom_primal_estimate', 'rom_dual_estimate', 'rom_time_s' and 'fom_time_s'. An answer
+is kept from the ROM when its status is success and 3 x its estimates are within the
+tolerances.)doc")
       .def(
           "solve_all",
           [](const ReducedModel& r, py::handle params) {

@@ -95,11 +95,13 @@ BOOST_AUTO_TEST_CASE(option_text_round_trips) {
   BOOST_TEST(back.step_tolerance == o.step_tolerance);
   BOOST_TEST(back.tau_scaling == o.tau_scaling);
   BOOST_TEST(back.time_operators == o.time_operators);
+  BOOST_TEST(back.estimate == o.estimate);
   BOOST_TEST((back.extra == o.extra));
   // A method stores only the named fields it reads: the convex hull, only the
-  // tolerances of the contact check that every method runs.
+  // tolerances of the contact check and the error estimate that every method runs.
   const auto hull = rom::options_to_map("convex-hull", rom::OnlineSolverOptions{});
-  BOOST_TEST(hull.size() == 2u);
+  BOOST_TEST(hull.size() == 3u);
+  BOOST_TEST(hull.count("estimate") == 1u);
   BOOST_TEST(hull.count("penetration_tolerance") == 1u);
   BOOST_TEST(hull.count("complementarity_tolerance") == 1u);
 }
