@@ -30,7 +30,8 @@ bool Pairing::same_as(const Pairing& other, double tol) const {
     }
     // Position along the master chain, continuous across segment ends: a slave
     // node moving from the end of segment j to the start of j+1 is no change.
-    if (std::abs(segment[s] + xi[s] - other.segment[s] - other.xi[s]) > tol) return false;
+    // (integer part first: identical pairings differ by exactly zero)
+    if (std::abs(static_cast<double>(segment[s] - other.segment[s]) + (xi[s] - other.xi[s])) > tol) return false;
     if ((normal.col(s) - other.normal.col(s)).cwiseAbs().maxCoeff() > tol) return false;
   }
   return true;
