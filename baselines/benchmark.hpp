@@ -35,6 +35,8 @@ struct BenchVariant {
 /// '_'), then the variants that make the comparison honest: the greedy schedules
 /// started as in the paper's Alg. 1 (`rom_greedy_init_empty`,
 /// `rom_greedy_nested_init_empty`) and CPG warm-started like the greedy (`rom_cpg_warm`).
+/// Every variant is timed without the error estimate of its answers (option
+/// `estimate`), except `rom_greedy_with_estimate`, the default greedy with it.
 std::vector<BenchVariant> default_bench_variants();
 
 /// \brief Settings of benchmark() (documented defaults).
