@@ -11,6 +11,7 @@
 #include "baselines/cpg.hpp"
 #include "baselines/full_dictionary.hpp"
 #include "baselines/online_methods.hpp"
+#include "rom/selection_history.hpp"
 
 namespace contactrom::baselines {
 
@@ -151,7 +152,7 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
   // training snapshot, as the greedy's does (same pairing as a full search).
   if (nearest >= 0) ops.seed(m_model.snapshot_search_memory(nearest));
   std::vector<int> active, next, solved;  // positions in W
-  std::vector<std::vector<int>> seen;     // active sets met on the current operators (sorted)
+  rom::SelectionHistory seen;             // active sets met on the current operators
   std::vector<char> in_active(mw, 0);
   rom::NnlsQp nnls(m_options.nnls);
   const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
@@ -220,8 +221,7 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
       // whose multiplier is zero leaves and is violated again); û(x) is taken as the
       // last solve and the outer loop goes on from there.
       std::sort(next.begin(), next.end());
-      if (std::find(seen.begin(), seen.end(), next) != seen.end()) break;
-      seen.push_back(next);
+      if (seen.revisits(next, [](int p) { return p; })) break;
       first = false;
       for (int p : active) in_active[p] = 0;
       active.swap(next);

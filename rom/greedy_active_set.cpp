@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "core/anderson.hpp"
+#include "rom/selection_history.hpp"
 
 namespace contactrom::rom {
 
@@ -55,30 +56,6 @@ int most_violated(const Eigen::VectorXd& violation, const std::vector<char>& in_
     if (!in_active[static_cast<size_t>(p)] && violation(p) > best) best = violation(p), at = p;
   return at;
 }
-
-/// Selections met one after the other (each stored sorted), to detect a cycle of
-/// one-change steps. Its storage only grows, so clearing it does not free.
-class SelectionHistory {
- public:
-  void clear() { m_seen.clear(), m_start.assign(1, 0); }
-  bool empty() const { return m_start.size() == 1; }
-  /// Whether `selection` (any order) was met since the last clear(); records it if not.
-  template <class Columns, class Index>
-  bool revisits(const Columns& selection, Index index) {
-    m_key.clear();
-    for (const auto& c : selection) m_key.push_back(index(c));
-    std::sort(m_key.begin(), m_key.end());
-    for (size_t e = 0; e + 1 < m_start.size(); ++e)
-      if (std::equal(m_key.begin(), m_key.end(), m_seen.begin() + m_start[e], m_seen.begin() + m_start[e + 1]))
-        return true;
-    m_seen.insert(m_seen.end(), m_key.begin(), m_key.end());
-    m_start.push_back(static_cast<int>(m_seen.size()));
-    return false;
-  }
-
- private:
-  std::vector<int> m_seen, m_start{0}, m_key;
-};
 
 /// Records a one-change step from selection `before` to `after`; true when `after`
 /// was met before (a cycle).
