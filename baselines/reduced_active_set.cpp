@@ -181,8 +181,7 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
       const fom::ContactResiduals r =
           m_support.residuals(ops.c, ops.g, u_s, solved, lambda_i, contact.weights(), scale, scratch);
       // Failing twice in a row: a fixed point of the reduced problem (see the greedy).
-      if ((r.penetration <= tolerances.penetration && r.complementarity <= tolerances.complementarity) ||
-          failed_test) {
+      if (r.gaps_within(tolerances) || failed_test) {
         res.converged = true;
         break;
       }

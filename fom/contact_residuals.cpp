@@ -8,10 +8,13 @@
 
 namespace contactrom::fom {
 
-bool ContactResiduals::within(const ContactTolerances& tol) const {
+bool ContactResiduals::gaps_within(const ContactTolerances& tol) const {
   // Written so that a NaN residual is never within.
-  return penetration <= tol.penetration && complementarity <= tol.complementarity &&
-         negative_pressure <= tol.negative_pressure;
+  return penetration <= tol.penetration && complementarity <= tol.complementarity;
+}
+
+bool ContactResiduals::within(const ContactTolerances& tol) const {
+  return gaps_within(tol) && negative_pressure <= tol.negative_pressure;
 }
 
 std::string ContactResiduals::describe(const ContactTolerances& tol) const {

@@ -46,6 +46,9 @@ struct ContactResiduals {
   int complementarity_row = -1;    ///< the row contributing most to it (−1: λ = 0)
   /// Whether every residual is finite and within `tol`.
   bool within(const ContactTolerances& tol) const;
+  /// Whether the gap conditions alone — penetration and separation under pressure —
+  /// are finite and within `tol` (the online fixed points' physical test).
+  bool gaps_within(const ContactTolerances& tol) const;
   /// One line naming each residual above its tolerance and its row, e.g.
   /// "penetration 4.65 U at contact row 12 (tolerance 0.01)"; empty when within.
   std::string describe(const ContactTolerances& tol) const;

@@ -759,7 +759,7 @@ struct GreedyActiveSet::Nested {
     if (g->m_options.trace)
       *g->m_options.trace << "greedy physical test: penetration=" << r.penetration
                           << " U, separation under pressure=" << r.complementarity << " U\n";
-    return r.penetration <= tol.penetration && r.complementarity <= tol.complementarity;
+    return r.gaps_within(tol);
   }
 
   void trace_step(int rebuild, int remove, int add, double max_violation) {
