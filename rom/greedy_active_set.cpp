@@ -550,6 +550,7 @@ struct GreedyActiveSet::Nested {
   Eigen::VectorXd b;       // C_R u_off,s − g_R: A û + b is the gap on R
   Eigen::VectorXd v_free;  // every column's violation at u_free, D_Rᵀ (A u_free + b)
   Eigen::VectorXd gap, aw, violation, rhs, x, u_hat, u_s;
+  Eigen::VectorXd u_s_hat;  // fixed-point schedule: surface displacement of û, Φ_s û + u_off,s
   // S and λ̂_I in storage that only grows: the leading |I| rows/columns are used.
   Eigen::MatrixXd schur;
   Eigen::VectorXd lambda_storage;
@@ -586,7 +587,8 @@ struct GreedyActiveSet::Nested {
     q->operators.stop();
     q->k_inv.apply(col.c_hat.transpose(), col.w);
     aw.noalias() = a * col.w.col(0);
-    col.z.noalias() = dr->transpose() * aw;
+    col.z.resize(dr->cols());
+    g->m_support.transpose_times(aw, col.z);
   }
 
   /// After a rebuild: A = C_R Φ_s, b = C_R u_off,s − g_R, every column's violation at
@@ -597,7 +599,8 @@ struct GreedyActiveSet::Nested {
     q->operators.stop();
     gap.noalias() = a * q->u_free;
     gap += b;
-    v_free.noalias() = dr->transpose() * gap;
+    v_free.resize(dr->cols());
+    g->m_support.transpose_times(gap, v_free);
     for (auto& col : cols) make_column(col, col.p);
   }
 
@@ -820,7 +823,7 @@ void GreedyActiveSet::solve_fixed_point(Query& q, OnlineResult& res) const {
   const fom::ContactTolerances tolerances = contact_tolerances();
   for (int rebuild = 0;; ++rebuild) {
     // 1. Operators at x (surface rows only); where x = û, the physical test at û's own pairing.
-    q.surface_displacement(s.x, s.u_s);
+    if (!s.pending) q.surface_displacement(s.x, s.u_s);  // else u_s is û's already
     q.rebuild(s.u_s);
     if (s.pending) {
       // A settled û that fails the physical test at its own pairing twice in a row
@@ -847,11 +850,13 @@ void GreedyActiveSet::solve_fixed_point(Query& q, OnlineResult& res) const {
     // 3. The next point: û itself once the step is within the basis' resolution
     //    (then tested at its own pairing), else the Anderson extrapolation of the
     //    map x ↦ û(x), with one history over the whole query.
-    const double step = surface_step(m_model, s.u_hat, s.x);
+    q.surface_displacement(s.u_hat, s.u_s_hat);
+    const double step = (s.u_s_hat - s.u_s).lpNorm<Eigen::Infinity>() / m_model.problem().displacement_scale();
     if (m_options.trace) *m_options.trace << "greedy rebuild=" << rebuild << " surface step=" << step << " U\n";
     if (step <= m_options.surface_step) {
       s.pending = true;
       s.x = s.u_hat;
+      s.u_s.swap(s.u_s_hat);
     } else {
       s.mixer.next(s.x, s.u_hat, s.x);
     }

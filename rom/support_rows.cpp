@@ -44,6 +44,19 @@ SupportRows::SupportRows(const Eigen::MatrixXd& w) {
   for (Eigen::Index p = 0; p < w.cols(); ++p)
     for (Eigen::Index i = 0; i < basis.rows(); ++i)
       if (basis(i, p) != 0.0) column_support[static_cast<size_t>(p)].push_back(static_cast<int>(i));
+  m_values.resize(column_support.size());
+  for (size_t p = 0; p < column_support.size(); ++p)
+    for (int i : column_support[p]) m_values[p].push_back(basis(i, static_cast<Eigen::Index>(p)));
+}
+
+void SupportRows::transpose_times(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> out) const {
+  for (size_t p = 0; p < column_support.size(); ++p) {
+    const std::vector<int>& at = column_support[p];
+    const std::vector<double>& w = m_values[p];
+    double acc = 0.0;
+    for (size_t e = 0; e < at.size(); ++e) acc += w[e] * v(at[e]);
+    out(static_cast<Eigen::Index>(p)) = acc;
+  }
 }
 
 void SupportRows::violation(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
@@ -54,7 +67,8 @@ void SupportRows::violation(const fom::ConstraintMatrix& c_r, const Eigen::Vecto
     for (fom::ConstraintMatrix::InnerIterator it(c_r, i); it; ++it) acc += it.value() * u_surface(it.col());
     gap(i) = acc;
   }
-  out.noalias() = basis.transpose() * gap;
+  out.resize(basis.cols());
+  transpose_times(gap, out);
 }
 
 fom::ContactResiduals SupportRows::residuals(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,

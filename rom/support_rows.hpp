@@ -27,6 +27,10 @@ struct SupportRows {
   Eigen::MatrixXd basis;  ///< W[rows, :] (|R| × m)
   /// Per column p, the positions i in `rows` where W[rows[i], p] is not zero.
   std::vector<std::vector<int>> column_support;
+  /// \brief out = W[rows, :]ᵀ v (size m) for v on the support rows (size |R|), over
+  /// the non-zero entries of W[rows, :] only (a dictionary's columns are local:
+  /// a few rows each).
+  void transpose_times(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> out) const;
 
   /// \brief \f$ W^T (C u_s - g) \f$ for every column of W, from C_R and g_R.
   /// \param gap work vector, left holding \f$ (C_R u_s - g_R) \f$
@@ -74,6 +78,9 @@ struct SupportRows {
   void reduced_rows(const std::vector<int>& columns, const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
                     const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s, RowMajorMatrix& c_hat,
                     Eigen::VectorXd& g_hat, RowsScratch& scratch) const;
+
+ private:
+  std::vector<std::vector<double>> m_values;  // per column p, W[rows[i], p] for i in column_support[p]
 };
 
 /// \brief Contact operators of the support rows at the current iterate, rebuilt in
