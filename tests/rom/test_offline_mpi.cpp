@@ -73,6 +73,27 @@ BOOST_AUTO_TEST_CASE(mpi_offline_of_a_3d_problem_is_bit_identical_to_serial) {
   BOOST_TEST(b.threads == 2);
 }
 
+BOOST_AUTO_TEST_CASE(parts_merge_and_append_of_a_3d_problem_equal_one_run) {
+  // hertz3d: `--part k/K` files merged (in either order) and a part completed by
+  // `--append` hold the snapshots of one serial run, bit for bit.
+  const std::string d = work_dir(), train = " offline --problem hertz3d --train 4 --threads 1";
+  auto r = run_command(exe + train + " --out " + d + "/whole3d.h5");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  for (const char* part : {"1", "2"}) {
+    r = run_command(exe + train + " --part " + part + "/2 --out " + d + "/part" + part + "_3d.h5");
+    BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  }
+  r = run_command(exe + " merge --out " + d + "/merged3d.h5 " + d + "/part2_3d.h5 " + d + "/part1_3d.h5");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  r = run_command(exe + train + " --append " + d + "/part1_3d.h5");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  const SnapshotDatabase whole = read_database(d + "/whole3d.h5");
+  BOOST_TEST(whole.num_dofs() > 10000);
+  BOOST_TEST(whole.successful_snapshots().size() == 4u);
+  check_same_snapshots(whole, read_database(d + "/merged3d.h5"));
+  check_same_snapshots(whole, read_database(d + "/part1_3d.h5"));
+}
+
 BOOST_AUTO_TEST_CASE(mpi_offline_append_completes_a_serial_part) {
   const std::string serial = work_dir() + "/serial11.h5", db = work_dir() + "/append.h5";
   auto r = run_command(exe + " offline --problem hertz --train 11 --threads 1 --out " + serial);
