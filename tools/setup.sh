@@ -2,7 +2,8 @@
 # Sets contactrom up on a Debian 12 machine: installs the Debian packages it
 # needs (only those missing), configures and builds into ./build (Release,
 # Ninja, tests on). Idempotent; safe to re-run.
-#   tools/setup.sh            # install + configure + build
+#   tools/setup.sh            # install + configure + build everything (library, CLI, Python, tests)
+#   tools/setup.sh contactrom # ... but build only the named targets (here the CLI and its libraries)
 #   BUILD_DIR=b tools/setup.sh
 #   CONTACTROM_SANITIZE=ON BUILD_DIR=build-asan tools/setup.sh   # ASan/UBSan build
 set -euo pipefail
@@ -29,4 +30,6 @@ fi
 build="${BUILD_DIR:-build}"
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
       -DCONTACTROM_SANITIZE="${CONTACTROM_SANITIZE:-OFF}" >/dev/null
-cmake --build "$build" -j"$(nproc)"
+targets=()
+for t in "$@"; do targets+=(--target "$t"); done
+cmake --build "$build" -j"$(nproc)" "${targets[@]}"
