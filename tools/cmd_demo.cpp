@@ -58,6 +58,29 @@ double half_width(const fom::Problem& problem, const Eigen::VectorXd& lambda) {
   return half;
 }
 
+/// Where the largest primal error of the validation set lies with respect to the
+/// training parameters (one parameter, d).
+void worst_error_line(const rom::EvaluationSummary& s, const rom::SnapshotDatabase& db) {
+  const rom::EvaluationRow* worst = nullptr;
+  for (const rom::EvaluationRow& row : s.rows)
+    if (!worst || row.primal_error > worst->primal_error) worst = &row;
+  if (!worst || db.num_snapshots() == 0) return;
+  const double d = worst->mu(0), lowest = db.parameters.row(0).minCoeff(), highest = db.parameters.row(0).maxCoeff();
+  double below = lowest, above = highest;
+  for (Eigen::Index k = 0; k < db.parameters.cols(); ++k) {
+    const double t = db.parameters(0, k);
+    if (t <= d) below = std::max(below, t);
+    if (t >= d) above = std::min(above, t);
+  }
+  if (d < lowest || d > highest)
+    std::printf("   largest primal error %.2e at d = %g: outside the training range [%g, %g], an extrapolation\n"
+                "   (no snapshot beyond it: its contact zone is %s than every column's).\n",
+                worst->primal_error, d, lowest, highest, d < lowest ? "narrower" : "wider");
+  else
+    std::printf("   largest primal error %.2e at d = %g, between the training points %g and %g.\n",
+                worst->primal_error, d, below, above);
+}
+
 void fom_table(const fom::Problem& problem, const fom::ActiveSetSolver& solver) {
   // Plane-strain two-cylinder Hertz theory for the FOM's force P:
   // a = sqrt(4PR/(πE*)), p0 = 2P/(πa), R = 0.5, 1/E* = 2(1 − ν²)/E.
@@ -158,7 +181,11 @@ void run_demo(const DemoArgs& a) {
   std::printf("   %-36s %10.1f us\n", "FOM time per query (median)", fom_median * 1e6);
   std::printf("   %-36s %10.1f x %8s   %10.1f x\n", "speedup", t.median_core_s > 0 ? fom_median / t.median_core_s : 0.0,
               "", tn.median_core_s > 0 ? fom_median / tn.median_core_s : 0.0);
-  std::printf("\n   ROM time includes the contact search and the reduced constraint operators of every iteration.\n"
+  std::printf("\n   delta: the share of the snapshots' energy the POD may drop; primal rank: the number of POD\n"
+              "   modes kept for the displacement; dictionary columns: the training snapshots' contact pressures,\n"
+              "   from which each answer selects a few (|I|) and combines them with non-negative weights.\n");
+  worst_error_line(s, db);
+  std::printf("   ROM time includes the contact search and the reduced constraint operators of every iteration.\n"
               "   warm start: from the columns and coordinates of the bracketing snapshots (docs/rom.md).\n"
               "   demo finished in %.1f s\n",
               seconds_since(t_start));

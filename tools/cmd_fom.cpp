@@ -2,6 +2,7 @@
 // Solves one FOM query and prints a summary (or one JSON object with --json);
 // --out DIR writes DIR/<problem>.vtu (displacement, stress, pressure) and
 // DIR/<problem>_surface.csv (x, y, gap, pressure, u_x, u_y).
+#include <algorithm>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -65,6 +66,15 @@ void run_fom(const FomArgs& a) {
   j["time_s"] = sol.time_s;
   j["setup_time_s"] = setup;
   j["contact_force"] = fom::contact_force(*problem, sol.lambda);
+  // The contact zone: its peak pressure and its size, the tributary lengths (2D) or
+  // areas (3D) of the rows that carry pressure.
+  const Eigen::VectorXd& weights = problem->contact().weights();
+  double extent = 0.0;
+  for (Eigen::Index k = 0; k < sol.lambda.size(); ++k)
+    if (sol.lambda(k) > 0.0) extent += weights(k);
+  const bool three_d = problem->dofs_per_node() == 3;
+  j["peak_pressure"] = sol.lambda.size() > 0 ? std::max(0.0, sol.lambda.maxCoeff()) : 0.0;
+  j[three_d ? "contact_area" : "contact_length"] = extent;
   j["kkt"] = kkt_json(kkt);
   j["warnings"] = warnings;
   if (a.json) {
@@ -76,8 +86,11 @@ void run_fom(const FomArgs& a) {
             << (sol.message.empty() ? "" : " (" + sol.message + ")") << "\n"
             << "active contact rows " << sol.active << " of " << problem->contact().num_constraints()
             << ", active-set iterations " << sol.iterations << ", pairing iterations " << sol.pairing_iterations << "\n"
-            << std::setprecision(3) << "contact force " << j["contact_force"].get<double>() << ", time "
-            << sol.time_s * 1e3 << " ms (setup " << setup * 1e3 << " ms)\n"
+            << std::setprecision(3) << "contact force " << j["contact_force"].get<double>()
+            << (three_d ? "" : " per unit thickness") << ", peak pressure " << j["peak_pressure"].get<double>()
+            << (three_d ? ", contact area " : ", contact length ") << extent << "\n"
+            << "  (consistent units: lengths in the mesh's unit, pressures and stresses in the unit of E)\n"
+            << "time " << sol.time_s * 1e3 << " ms (setup " << setup * 1e3 << " ms)\n"
             << "KKT (relative): stationarity " << kkt.stationarity << ", penetration " << kkt.penetration
             << ", negative pressure " << kkt.negative_pressure << ", complementarity " << kkt.complementarity << "\n";
   if (!a.out.empty()) std::cout << "fields written to " << a.out << "/\n";

@@ -30,6 +30,29 @@ BOOST_AUTO_TEST_CASE(json_summary_has_contract_keys) {
   BOOST_TEST(j["active"].get<int>() > 0);
 }
 
+BOOST_AUTO_TEST_CASE(peak_pressure_and_contact_length_follow_hertz_theory) {
+  // hertz (two cylinders of radius 0.5, E = 1, ν = 0.3, plane strain): from the FOM's
+  // force P, Hertz's half-width a = sqrt(4PR/(πE*)) and peak p0 = 2P/(πa). The
+  // printed peak pressure is the nodal maximum (within 5 % of p0 here) and the contact
+  // length the active nodes' tributary lengths (2a to within 10 %: one node spacing).
+  for (const double d : {0.05, 0.1, 0.2}) {
+    const auto r = run_command(exe + " fom --problem hertz --param " + std::to_string(d) + " --json");
+    BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+    const auto j = nlohmann::json::parse(r.out);
+    const double force = j["contact_force"].get<double>(), e_star = 1.0 / (2.0 * (1.0 - 0.3 * 0.3));
+    const double a = std::sqrt(4.0 * force * 0.5 / (M_PI * e_star)), p0 = 2.0 * force / (M_PI * a);
+    BOOST_TEST_CONTEXT("d = " << d) {
+      BOOST_TEST(std::abs(j["peak_pressure"].get<double>() / p0 - 1.0) < 0.05);
+      BOOST_TEST(std::abs(j["contact_length"].get<double>() / (2.0 * a) - 1.0) < 0.10);
+      BOOST_TEST(!j.contains("contact_area"));
+    }
+  }
+  const auto r = run_command(exe + " fom --problem hertz --param 0.1");
+  BOOST_TEST_REQUIRE(r.exit_code == 0, r.err);
+  BOOST_TEST(r.out.find("peak pressure") != std::string::npos, r.out);
+  BOOST_TEST(r.out.find("consistent units") != std::string::npos, r.out);
+}
+
 BOOST_AUTO_TEST_CASE(out_writes_vtu_and_surface_csv) {
   const std::string dir = contactrom::test::temp_dir() + "/fields";
   const auto r = run_command(exe + " fom --problem ironing --param 2 --json --out " + dir);
