@@ -225,7 +225,10 @@ here when it does not depend on mu) or Ipopt (solver="ipopt").)doc")
                s->active_set = std::make_unique<fom::ActiveSetSolver>(*problem);
              return s;
            }),
-           py::arg("problem"), py::arg("solver") = "active-set")
+           py::arg("problem"), py::arg("solver") = "active-set", R"doc(
+The FOM solver of `problem` (a contactrom.Problem): solver="active-set" (default:
+contactrom's dual active set, K factorised here once when no Young's modulus depends
+on mu) or "ipopt" (the interior-point reference). ValueError for another name.)doc")
       .def_property_readonly("problem", [](const FullOrderSolver& s) { return std::const_pointer_cast<fom::Problem>(s.problem); })
       .def_property_readonly("solver", [](const FullOrderSolver& s) { return s.kind; })
       .def_property_readonly("setup_time_s", [](const FullOrderSolver& s) {

@@ -221,8 +221,14 @@ works in memory but is refused when read back from a file.)doc");
       .def_property_readonly(
           "lam", [](py::object self) { return vector_view(self.cast<const rom::OnlineResult&>().lambda, self); },
           "Full contact pressure D[:, selected] @ coefficients (n_c).")
-      .def_property_readonly("selected", [](const rom::OnlineResult& r) { return r.selected; },
-                             "Selected dictionary columns (indices into ReducedModel.dictionary columns).")
+      .def_property_readonly(
+          "selected",
+          [](const rom::OnlineResult& r) {
+            return py::array_t<int>(static_cast<py::ssize_t>(r.selected.size()), r.selected.data());
+          },
+          "Selected dictionary columns (int array: indices into ReducedModel.dictionary columns).")
+      .def_readonly("contact_force", &rom::OnlineResult::contact_force,
+                    "Total contact force sum_s w_s lam_s (per unit thickness in 2D), as FomSolution.contact_force.")
       .def_property_readonly(
           "coefficients", [](py::object self) { return vector_view(self.cast<const rom::OnlineResult&>().coefficients, self); },
           "Coefficients of the selected columns, in the same order.")
@@ -266,7 +272,13 @@ snapshot database or loaded from a reduced-model file (`contactrom reduce`). The
 object owns the problem (and the database) it needs.)doc")
       .def(py::init(&build_reduced_model), py::arg("db"), py::arg("delta") = 1e-8, py::arg("method") = "greedy",
            py::arg("options") = py::dict(), py::arg("lifting") = "harmonic",
-           py::arg("include_failed_snapshots") = false)
+           py::arg("include_failed_snapshots") = false, R"doc(
+Builds the reduced model of a SnapshotDatabase: the POD of its primal snapshots
+truncated at `delta` (energy share dropped), the dual dictionary of its pressures,
+the reduced operators, and the online `method` (contactrom.online_methods()) with its
+`options` (a dict of the method's keys, numbers as numbers). `lifting`: harmonic
+(default) or zero. `include_failed_snapshots`: also use snapshots whose FOM solve did
+not succeed. ValueError names the argument for a bad value.)doc")
       .def_static("load", &load_reduced_model, py::arg("path"),
                   "Reads a reduced-model file (`contactrom reduce` or ReducedModel.save): no FOM, no meshing.")
       .def(

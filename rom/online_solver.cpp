@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "fom/kkt.hpp"
 #include "rom/error_indicator.hpp"
 
 namespace contactrom::rom {
@@ -30,6 +31,7 @@ void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairin
 const fom::Pairing* check_contact(const ReducedModel& model, const fom::ContactTolerances& tolerances, OnlineResult& res) {
   const fom::Problem& problem = model.problem();
   if (res.u.size() != problem.num_dofs() || res.lambda.size() != problem.contact().num_constraints()) return nullptr;
+  res.contact_force = fom::contact_force(problem, res.lambda);
   const auto t0 = std::chrono::steady_clock::now();
   // The search starts from the memory of the one made offline at the nearest
   // training snapshot: same pairing as a full search, most rows settled at once.

@@ -36,6 +36,9 @@ struct OnlineResult {
   Eigen::VectorXd lambda;        ///< full contact pressure D_d[:, I] λ̂_I (n_c)
   std::vector<int> selected;     ///< selected dictionary columns I (indices into ReducedModel::dictionary())
   Eigen::VectorXd coefficients;  ///< λ̂_I, in the order of `selected`
+  /// Total contact force Σ_s w_s λ_s (fom::contact_force; per unit thickness in 2D),
+  /// set with the full-order check; NaN when the answer has no pressure field.
+  double contact_force = std::numeric_limits<double>::quiet_NaN();
   int iterations = 0;            ///< iterations of the method (one reduced solve each for greedy)
   bool converged = false;        ///< stopping criterion met before the iteration cap
   /// NoConvergence when !converged; NumericalIssue on a failed solve; Inaccurate when

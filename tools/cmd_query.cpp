@@ -41,7 +41,7 @@ nlohmann::json result_json(const rom::OnlineModel& rom, const rom::OnlineResult&
   j["sparsity"] = res.selected.size();
   j["selected"] = snapshots;
   j["coefficients"] = std::vector<double>(res.coefficients.data(), res.coefficients.data() + res.coefficients.size());
-  j["contact_force"] = fom::contact_force(rom.problem(), res.lambda);
+  j["contact_force"] = res.contact_force;
   j["time_s"] = res.time_s;
   j["penetration"] = res.contact.penetration;
   j["separation"] = res.contact.complementarity;

@@ -269,10 +269,11 @@ def evolution_figure(records, deltas, xlabel, path, n_contact, title, fom_time=N
         a.minorticks_off()
         if logy:
             a.set_yscale("log")
-            if key2:  # times: label 1, 2, 5 × 10^k, since they span few decades
-                a.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
-                a.yaxis.set_major_formatter(FormatStrFormatter("%g"))
-                a.yaxis.set_minor_formatter(NullFormatter())
+            # Label 1, 2, 5 × 10^k: errors and times span few decades, and a single
+            # power of ten would leave an axis with one tick.
+            a.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+            a.yaxis.set_major_formatter(FormatStrFormatter("%g"))
+            a.yaxis.set_minor_formatter(NullFormatter())
         else:
             a.set_ylim(bottom=0)
         a.set_title(ttl, fontsize=10)
@@ -287,7 +288,8 @@ def evolution_figure(records, deltas, xlabel, path, n_contact, title, fom_time=N
         handles.append(Line2D([], [], color="k", ls="--", label=f"FOM solve, offline-stage mean ({1e6 * fom_time:.0f} µs)"))
     if n_contact <= max(snaps):
         handles.append(Line2D([], [], color="0.6", ls="-.", label=f"snapshots = contact dofs ({n_contact})"))
-    fig.suptitle(f"{title}: greedy ROM against the training set", fontsize=11)
+    fig.suptitle(f"{title}: the greedy ROM's errors, rank, iterations and times against the number of training snapshots",
+                 fontsize=11)
     fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=8, frameon=False)
     fig.tight_layout(rect=(0, 0.08, 1, 1))
     fig.savefig(path, dpi=DPI)
@@ -350,7 +352,7 @@ def spy_figure(db, path, title):
         dual = np.array(f["dual"])  # n_snap x n_c
     fig, a = plt.subplots(figsize=(4, 5.5))
     a.spy(dual.T, markersize=2.5, aspect="auto", precision=0.0)
-    a.set_xlabel(f"dictionary column (snapshot index, {dual.shape[0]}, in increasing d)")
+    a.set_xlabel(f"dictionary column\n(snapshot index of {dual.shape[0]}, in increasing d)")
     a.set_ylabel(f"contact dof (slave node index, {dual.shape[1]})")
     a.xaxis.set_ticks_position("bottom")
     a.xaxis.set_label_position("bottom")

@@ -86,6 +86,12 @@ def test_solution_is_the_dictionary_combination(rom):
     D = rom.dictionary
     assert D.shape == (rom.problem.num_constraints, rom.dictionary_size)
     assert np.allclose(r.lam, D[:, r.selected] @ r.coefficients, rtol=1e-13, atol=1e-14 * abs(D).max())
+    # Python that reads like the FOM's: selected is an int array like coefficients, and
+    # the total force is the problem's, as FomSolution.contact_force.
+    assert isinstance(r.selected, np.ndarray) and r.selected.dtype.kind == "i"
+    assert r.contact_force == pytest.approx(rom.problem.contact_force(r.lam), rel=1e-14)
+    fom = contactrom.FullOrderSolver(rom.problem).solve(0.17)
+    assert r.contact_force == pytest.approx(fom.contact_force, rel=0.05)
     # u = Phi u_hat + offset(mu): the offset does not depend on u_hat.
     other = rom.solve(0.17)
     assert np.array_equal(r.u, other.u)
@@ -144,7 +150,7 @@ def test_solve_all_equals_single_solves(rom):
     params = np.linspace(0.01, 0.3, 5)
     results = rom.solve_all(params)
     for mu, r in zip(params, results):
-        assert r.selected == rom.solve(mu).selected
+        assert np.array_equal(r.selected, rom.solve(mu).selected)
 
 
 QUERY_PARAMS = [0.0137, 0.1, 0.2999]
@@ -215,3 +221,16 @@ def test_fallback_answers_from_the_fom_when_the_tolerances_are_not_met(rom):
     b = lenient.solve(0.1)
     assert b["source"] == "rom" and b["fom_time_s"] == 0
     assert b["solution"].primal_estimate == pytest.approx(rom.solve(0.1).primal_estimate, rel=1e-12)
+
+
+def test_every_class_and_constructor_has_a_docstring():
+    classes = [getattr(contactrom, n) for n in dir(contactrom) if isinstance(getattr(contactrom, n), type)]
+    assert len(classes) >= 6
+    for cls in classes:
+        assert (cls.__doc__ or "").strip(), cls.__name__
+        init_doc = cls.__init__.__doc__ or ""
+        if "No constructor defined" in init_doc or "Initialize self" in init_doc:
+            continue  # made by a function or a method (contactrom.problem, ReducedModel.solve), not constructed
+        # pybind11 puts the signature on the first line; a description must follow it.
+        described = [line for line in init_doc.splitlines()[1:] if line.strip()]
+        assert described, f"{cls.__name__}.__init__ has no description"
