@@ -70,6 +70,7 @@ void run_bench(const BenchArgs& a) {
 
   nlohmann::json j;
   j["problem"] = problem->name();
+  j["dofs"] = problem->num_dofs();
   j["training"] = n;
   j["delta"] = a.delta;
   j["repeats"] = a.repeats;

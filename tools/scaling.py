@@ -109,7 +109,7 @@ def stage_bench(exe, refines, dofs_of):
         cmd = [exe, "bench", "--problem", "hertz", "--refine", str(k), "--ipopt-queries", "1", "--json"]
         out, _, _ = run(cmd)
         j = json.loads(out)
-        row = {"refine": k, "dofs": dofs_of.get(k), "command": display(cmd)}
+        row = {"refine": k, "dofs": j.get("dofs", dofs_of.get(k)), "command": display(cmd)}
         row.update({key: j[key] for key, _ in BENCH_METHODS if key in j})
         row["fom_ipopt"] = j.get("fom_ipopt")
         rows.append(row)
