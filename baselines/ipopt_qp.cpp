@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.hpp"
+#include "core/format.hpp"
 #include "core/stopwatch.hpp"
 #include "fom/kkt.hpp"
 #include "fom/rigid_bodies.hpp"
@@ -468,6 +470,12 @@ FomSolution IpoptQpSolver::solve(const Param& mu, const FomSolution* warm) const
   }
   sol.time_s = seconds_since(t0);
   return sol;
+}
+
+std::unique_ptr<fom::FullOrderSolver> make_fom_solver(const fom::Problem& problem, const std::string& name) {
+  if (name == "active-set") return std::make_unique<fom::ActiveSetSolver>(problem);
+  if (name == "ipopt") return std::make_unique<IpoptQpSolver>(problem);
+  throw InputError("solver " + quoted(name, 200) + " unknown; expected active-set or ipopt");
 }
 
 }  // namespace contactrom::baselines

@@ -69,20 +69,25 @@ struct IpoptOptions {
 /// rows touching a free dof; other rows are dropped and get \f$ \lambda_s = 0 \f$. The pairing
 /// fixed point is the active-set solver's (fom/pairing_fixed_point.hpp: Anderson-accelerated,
 /// one stopping test); it starts from the unconstrained solution (or from `warm`).
-class IpoptQpSolver {
+class IpoptQpSolver final : public fom::FullOrderSolver {
  public:
   explicit IpoptQpSolver(const fom::Problem& problem, IpoptOptions options = {});
-  ~IpoptQpSolver();
+  ~IpoptQpSolver() override;
   /// \brief Solves at `mu` (range-checked). Never throws on numerical failure:
   /// the status and message of the returned solution say what happened.
-  fom::FomSolution solve(const fom::Param& mu, const fom::FomSolution* warm = nullptr) const;
+  fom::FomSolution solve(const fom::Param& mu, const fom::FomSolution* warm = nullptr) const override;
   /// Time spent in the constructor extracting the constant \f$ K_{ff} \f$ (0 for rope's μ-dependent K).
-  double setup_time() const;
+  double setup_time() const override;
   const IpoptOptions& options() const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> m_impl;
 };
+
+/// \brief The full-order solver `name` of `problem`: "active-set" (fom::ActiveSetSolver,
+/// contactrom's own) or "ipopt" (IpoptQpSolver, the reference).
+/// \throws InputError "solver '<name>' unknown; expected active-set or ipopt" otherwise.
+std::unique_ptr<fom::FullOrderSolver> make_fom_solver(const fom::Problem& problem, const std::string& name);
 
 }  // namespace contactrom::baselines

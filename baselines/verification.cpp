@@ -51,8 +51,8 @@ void describe_constraint(const rom::OnlineSolver& solver, const rom::OnlineSolve
 }
 
 /// Reference solutions and their KKT residuals, in parallel.
-template <typename Solver>
-void solve_references(const Solver& solver, const fom::Problem& problem, const VerifyOptions& o, VerifyReport& r) {
+void solve_references(const fom::FullOrderSolver& solver, const fom::Problem& problem, const VerifyOptions& o,
+                      VerifyReport& r) {
   const int n = static_cast<int>(r.params.size());
   rom::parallel_for(
       n, o.threads,
@@ -137,10 +137,7 @@ VerifyReport reference_report(const fom::Problem& problem, const std::vector<fom
   // process-wide mutex, so threads overlap only the pairing loop, assembly and
   // residual work around them.
   const auto t_ref = std::chrono::steady_clock::now();
-  if (o.reference == "ipopt")
-    solve_references(IpoptQpSolver(problem), problem, o, r);
-  else
-    solve_references(fom::ActiveSetSolver(problem), problem, o, r);
+  solve_references(*make_fom_solver(problem, o.reference == "ipopt" ? "ipopt" : "active-set"), problem, o, r);
   r.reference_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ref).count();
   r.reference_summary = summarize(r.reference_reports);
   for (const fom::FomSolution& ref : r.references)

@@ -53,12 +53,12 @@ struct FomSolution {
   KktResiduals kkt;
 };
 
-/// rief Largest relative KKT residual (fom/kkt.hpp) of a FOM solution reported as
+/// \brief Largest relative KKT residual (fom/kkt.hpp) of a FOM solution reported as
 /// success: stationarity, penetration, negative pressure and (active-set solver)
 /// complementarity. Converged solves stay below 1e-10.
 constexpr double kFomKktTolerance = 1e-6;
 
-/// rief The FOM's promise on its status: computes `sol.kkt` with
+/// \brief The FOM's promise on its status: computes `sol.kkt` with
 /// fom::kkt_residuals(), which re-pairs at `sol.u` as a user checking the answer
 /// would, and turns a Success whose stationarity, penetration or negative-pressure
 /// residual (and complementarity, when `complementarity`) is above `tolerance` or not
@@ -66,6 +66,20 @@ constexpr double kFomKktTolerance = 1e-6;
 /// without fields (failed solve) is left as it is.
 void certify_fom_solution(const Problem& problem, FomSolution& sol, double tolerance = kFomKktTolerance,
                           bool complementarity = true);
+
+/// \brief A full-order solver of a problem: contactrom's active set (ActiveSetSolver)
+/// or the Ipopt reference (baselines::IpoptQpSolver; baselines::make_fom_solver builds
+/// either by name). solve() is const and thread-safe.
+class FullOrderSolver {
+ public:
+  virtual ~FullOrderSolver() = default;
+  /// \brief Solves the contact problem at `mu` (checked against the range); never
+  /// throws on a numerical failure: the status and message say what happened.
+  /// \param warm optional previous solution that may seed the iteration
+  virtual FomSolution solve(const Param& mu, const FomSolution* warm = nullptr) const = 0;
+  /// Time spent in the constructor (factorisation, condensation, extraction of K).
+  virtual double setup_time() const = 0;
+};
 
 /// \brief Options of ActiveSetSolver (documented defaults).
 struct ActiveSetOptions {
@@ -127,17 +141,17 @@ PairedSolution solve_at_pairing(const Problem& problem, const Condensation& cond
                                 const Eigen::VectorXd& lambda_start, int& iterations);
 
 /// \brief Custom active-set FOM solver; see the file comment.
-class ActiveSetSolver {
+class ActiveSetSolver final : public FullOrderSolver {
  public:
   explicit ActiveSetSolver(const Problem& problem, ActiveSetOptions options = {});
 
   /// \brief Solves the contact problem at `mu` (checked against the range).
   /// \param warm optional previous solution: its multipliers and pairing seed the iteration.
-  FomSolution solve(const Param& mu, const FomSolution* warm = nullptr) const;
+  FomSolution solve(const Param& mu, const FomSolution* warm = nullptr) const override;
 
   /// Time spent in the constructor: factorising and condensing when K is constant,
   /// ordering the dofs for the per-query factorisations otherwise (rope).
-  double setup_time() const { return m_setup_time; }
+  double setup_time() const override { return m_setup_time; }
   const Problem& problem() const { return m_problem; }
 
  private:

@@ -8,10 +8,6 @@
 
 namespace contactrom::python {
 
-fom::FomSolution FullOrderSolver::solve(const fom::Param& mu) const {
-  return active_set ? active_set->solve(mu) : ipopt->solve(mu);
-}
-
 namespace {
 
 /// Pairing and constraint operator at u, with the columns in full dof numbering.
@@ -213,16 +209,11 @@ with u = u_lift(mu) + u0 on all dofs (Dirichlet dofs kept).)doc");
 The FOM solver of a problem: the active-set solver (default; K factorised once
 here when it does not depend on mu) or Ipopt (solver="ipopt").)doc")
       .def(py::init([](std::shared_ptr<fom::Problem> problem, const std::string& solver) {
-             if (solver != "active-set" && solver != "ipopt")
-               throw InputError("solver " + quoted(solver, 200) + " unknown; expected active-set or ipopt");
              auto s = std::make_unique<FullOrderSolver>();
              s->problem = problem;
              s->kind = solver;
              py::gil_scoped_release release;
-             if (solver == "ipopt")
-               s->ipopt = std::make_unique<baselines::IpoptQpSolver>(*problem);
-             else
-               s->active_set = std::make_unique<fom::ActiveSetSolver>(*problem);
+             s->solver = baselines::make_fom_solver(*problem, solver);
              return s;
            }),
            py::arg("problem"), py::arg("solver") = "active-set", R"doc(
@@ -232,7 +223,7 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
       .def_property_readonly("problem", [](const FullOrderSolver& s) { return std::const_pointer_cast<fom::Problem>(s.problem); })
       .def_property_readonly("solver", [](const FullOrderSolver& s) { return s.kind; })
       .def_property_readonly("setup_time_s", [](const FullOrderSolver& s) {
-        return s.active_set ? s.active_set->setup_time() : s.ipopt->setup_time();
+        return s.solver->setup_time();
       })
       .def(
           "solve",

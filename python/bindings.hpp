@@ -51,10 +51,9 @@ struct FomResult {
 struct FullOrderSolver {
   ProblemPtr problem;
   std::string kind;  // "active-set" or "ipopt"
-  std::unique_ptr<fom::ActiveSetSolver> active_set;
-  std::unique_ptr<baselines::IpoptQpSolver> ipopt;
+  std::unique_ptr<fom::FullOrderSolver> solver;  // baselines::make_fom_solver(*problem, kind)
   /// Solves at μ (thread-safe; the caller releases the GIL).
-  fom::FomSolution solve(const fom::Param& mu) const;
+  fom::FomSolution solve(const fom::Param& mu) const { return solver->solve(mu); }
 };
 
 /// \brief A reduced model with its online method (which owns its problem), and the

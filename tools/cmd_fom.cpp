@@ -32,17 +32,9 @@ void run_fom(const FomArgs& a) {
   const fom::Param mu = parse_problem_param(*problem, a.param);
   const std::vector<std::string> warnings = fom::reference_contact_warnings(*problem);
   for (const std::string& w : warnings) std::cerr << "contactrom: warning: " << w << "\n";
-  fom::FomSolution sol;
-  double setup = 0.0;
-  if (a.solver == "active-set") {
-    fom::ActiveSetSolver solver(*problem);
-    setup = solver.setup_time();
-    sol = solver.solve(mu);
-  } else {
-    baselines::IpoptQpSolver solver(*problem);
-    setup = solver.setup_time();
-    sol = solver.solve(mu);
-  }
+  const std::unique_ptr<fom::FullOrderSolver> solver = baselines::make_fom_solver(*problem, a.solver);
+  const double setup = solver->setup_time();
+  const fom::FomSolution sol = solver->solve(mu);
   // A failed solve may carry no field at all (its status and message say why).
   const bool has_fields = sol.u.size() == problem->num_dofs() && sol.lambda.size() == problem->contact().num_constraints();
   if (!has_fields)
