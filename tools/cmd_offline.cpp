@@ -142,8 +142,12 @@ void report_round(const fom::Problem& problem, const rom::AdaptiveRound& r) {
 
 void run_adaptive(const OfflineArgs& a) {
 #ifdef CONTACTROM_HAVE_MPI
-  if (rom::mpi::active() && rom::mpi::world_size() > 1)
-    throw InputError("offline --adaptive runs on threads in one process; start it without mpirun (--threads T)");
+  // Under mpirun every rank runs the loop (the same candidates and indicators); the FOM
+  // batches are distributed over the ranks and every rank gets the whole batch.
+  const bool distributed = rom::mpi::active() && rom::mpi::world_size() > 1;
+  const Ranks ranks{rom::mpi::world_rank(), rom::mpi::world_size()};
+#else
+  const Ranks ranks;
 #endif
   if (a.out.empty() == a.append.empty()) throw InputError("offline needs one of --out DB.h5 and --append DB.h5");
   if (!a.part.empty()) throw InputError("--part does not apply to --adaptive; expected a whole adaptive run");
@@ -154,13 +158,15 @@ void run_adaptive(const OfflineArgs& a) {
   fom::ProblemOptions popt;
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);
-  for (const std::string& w : fom::reference_contact_warnings(*problem)) std::cerr << "contactrom: warning: " << w << "\n";
+  if (ranks.root())
+    for (const std::string& w : fom::reference_contact_warnings(*problem)) std::cerr << "contactrom: warning: " << w << "\n";
   std::unique_ptr<FileLock> lock;
   rom::SnapshotDatabase existing;
   if (appending) {
-    lock = std::make_unique<FileLock>(a.append, [&] {
-      std::cerr << "contactrom: waiting for another run that is updating " << quoted(a.append, 200) << "\n";
-    });
+    if (ranks.root())
+      lock = std::make_unique<FileLock>(a.append, [&] {
+        std::cerr << "contactrom: waiting for another run that is updating " << quoted(a.append, 200) << "\n";
+      });
     existing = rom::read_database(a.append);
     rom::check_database_problem(existing, *problem, a.append);
     if (existing.training_kind != "adaptive")
@@ -171,13 +177,18 @@ void run_adaptive(const OfflineArgs& a) {
   if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
   rom::AdaptiveOptions options = adaptive_options(a, appending ? &existing : nullptr);
   if (!appending && a.tolerance < 0) throw InputError("offline --adaptive needs --tolerance EPS (e.g. 0.05)");
+#ifdef CONTACTROM_HAVE_MPI
+  if (distributed) options.generate = rom::mpi::generate_snapshots_on_every_rank;
+#endif
   options.on_round = [&](const rom::AdaptiveRound& r, const rom::SnapshotDatabase& db) {
-    rom::write_database(out, db);  // atomically: the file always holds whole rounds
-    report_round(*problem, r);
+    // atomically, on rank 0: the file always holds whole rounds
+    write_on_root(out, [&]() -> const rom::SnapshotDatabase& { return db; }, ranks);
+    if (ranks.root()) report_round(*problem, r);
   };
   const rom::AdaptiveTrainer trainer(*problem, options);
   const int before = appending ? existing.num_snapshots() : 0;
   const rom::SnapshotDatabase db = appending ? trainer.resume(std::move(existing), a.append) : trainer.run();
+  if (!ranks.root()) return;
   const rom::AdaptiveRecord& rec = db.adaptive;
   const double worst = rec.round_max_indicator.back();
   const bool converged = worst < rec.tolerance;
@@ -194,6 +205,7 @@ void run_adaptive(const OfflineArgs& a) {
     j["converged"] = converged;
     j["indicator"] = rec.indicator;
     j["threads"] = db.threads;
+    j["ranks"] = ranks.size;
     j["wall_time_s"] = db.wall_time_s;
     j["out"] = out;
     std::cout << j.dump() << std::endl;
