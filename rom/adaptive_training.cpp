@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <numeric>
 
 #include "core/format.hpp"
 #include "fom/sampling.hpp"
@@ -26,6 +25,15 @@ bool holds(const SnapshotDatabase& db, const fom::Param& mu) {
   for (int j = 0; j < db.num_snapshots(); ++j)
     if (db.parameters.col(j) == mu) return true;
   return false;
+}
+
+/// Appends `round` to the database's record.
+void record_round(AdaptiveRecord& record, const AdaptiveRound& round) {
+  record.round_snapshots.push_back(round.snapshots);
+  record.round_added.push_back(static_cast<int>(round.added.size()));
+  record.round_max_indicator.push_back(round.max_indicator);
+  record.round_mean_indicator.push_back(round.mean_indicator);
+  record.round_time_s.push_back(round.time_s);
 }
 
 void check_same(const std::string& path, const std::string& what, const std::string& stored, const std::string& given) {
@@ -148,7 +156,27 @@ SnapshotDatabase AdaptiveTrainer::resume(SnapshotDatabase db, const std::string&
 }
 
 SnapshotDatabase AdaptiveTrainer::loop(SnapshotDatabase db) const {
-  AdaptiveRecord& record = db.adaptive;
+  record_settings(db.adaptive);
+  for (;;) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<double> indicators;
+    AdaptiveRound round = evaluate_round(db, indicators);
+    const int room = m_options.max_snapshots - db.num_snapshots();
+    for (int i : select_batch(indicators, db, room)) round.added.push_back(m_candidates[static_cast<size_t>(i)]);
+    if (round.max_indicator < m_options.tolerance) round.stop = "tolerance";
+    else if (room <= 0) round.stop = "max_snapshots";
+    else if (round.added.empty()) round.stop = "candidates";
+    add_batch(db, round.added);
+    round.time_s = seconds_since(t0);
+    db.wall_time_s += round.time_s;
+    record_round(db.adaptive, round);
+    if (m_options.on_round) m_options.on_round(round, db);
+    // A run stopped by N evaluates its last model too (a round that adds nothing).
+    if (round.added.empty()) return db;
+  }
+}
+
+void AdaptiveTrainer::record_settings(AdaptiveRecord& record) const {
   record.tolerance = m_options.tolerance;
   record.max_snapshots = m_options.max_snapshots;
   record.candidates = m_options.candidates;
@@ -157,28 +185,6 @@ SnapshotDatabase AdaptiveTrainer::loop(SnapshotDatabase db) const {
   record.indicator = m_options.indicator;
   record.method = m_options.method;
   record.delta = m_options.model.delta;
-  for (;;) {
-    const auto t0 = std::chrono::steady_clock::now();
-    std::vector<double> indicators;
-    AdaptiveRound round = evaluate_round(db, indicators);
-    const int room = m_options.max_snapshots - db.num_snapshots();
-    const std::vector<int> batch = select_batch(indicators, db, room);
-    for (int i : batch) round.added.push_back(m_candidates[static_cast<size_t>(i)]);
-    if (round.max_indicator < m_options.tolerance) round.stop = "tolerance";
-    else if (room <= 0) round.stop = "max_snapshots";
-    else if (batch.empty()) round.stop = "candidates";
-    add_batch(db, round.added);
-    round.time_s = seconds_since(t0);
-    record.round_snapshots.push_back(round.snapshots);
-    record.round_added.push_back(static_cast<int>(round.added.size()));
-    record.round_max_indicator.push_back(round.max_indicator);
-    record.round_mean_indicator.push_back(round.mean_indicator);
-    record.round_time_s.push_back(round.time_s);
-    db.wall_time_s += round.time_s;
-    if (m_options.on_round) m_options.on_round(round, db);
-    // A run stopped by N evaluates its last model too (a round that adds nothing).
-    if (round.added.empty()) return db;
-  }
 }
 
 AdaptiveRound AdaptiveTrainer::evaluate_round(const SnapshotDatabase& db, std::vector<double>& indicators) const {

@@ -149,6 +149,7 @@ class AdaptiveTrainer {
   std::vector<int> select_batch(const std::vector<double>& indicators, const SnapshotDatabase& db, int room) const;
   AdaptiveRound evaluate_round(const SnapshotDatabase& db, std::vector<double>& indicators) const;
   void add_batch(SnapshotDatabase& db, const std::vector<fom::Param>& batch) const;
+  void record_settings(AdaptiveRecord& record) const;
   int initial_size() const;
 
   const fom::Problem& m_problem;
