@@ -251,6 +251,9 @@ void run_offline(const OfflineArgs& a) {
   // against the run before any snapshot is computed.
   rom::SnapshotDatabase existing;
   if (appending) existing = rom::read_database(a.append, false);
+  if (appending && existing.training_kind == "adaptive")
+    throw InputError("database " + quoted(a.append, 200) +
+                     " was built by offline --adaptive; expected --adaptive to continue it");
   // --append without --train/--level: the database's training set.
   const bool size_from_db = appending && !a.train && !a.level && plan.selector() != "list";
   const int n = size_from_db ? existing.training_size

@@ -40,6 +40,10 @@ BOOST_AUTO_TEST_CASE(append_continues_a_stopped_run_to_the_database_of_one_run) 
                                 dir + "/part.h5");
   BOOST_REQUIRE_MESSAGE(rest.exit_code == 0, rest.err);
   const rom::SnapshotDatabase a = rom::read_database(dir + "/whole.h5"), b = rom::read_database(dir + "/part.h5");
+  // Appending grid snapshots to it is refused, naming the option that continues it.
+  const auto grid = run_command(kExe + " offline --problem hertz --train 4 --append " + dir + "/part.h5");
+  BOOST_TEST(grid.exit_code == 2);
+  BOOST_TEST(grid.err.find("--adaptive") != std::string::npos, grid.err);
   BOOST_REQUIRE_EQUAL(a.num_snapshots(), b.num_snapshots());
   BOOST_TEST((a.parameters == b.parameters));
   BOOST_TEST((a.primal == b.primal));
