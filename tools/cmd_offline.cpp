@@ -107,6 +107,32 @@ void write_on_root(const std::string& path, const std::function<const rom::Snaps
 #endif
 }
 
+/// What every offline run checks first, on every rank (all refuse alike): one of --out
+/// and --append, an output path that can be written and is not an input; then the
+/// problem, whose reference-contact warnings rank 0 prints.
+std::unique_ptr<fom::Problem> open_run(const OfflineArgs& a, const Ranks& ranks) {
+  if (a.out.empty() == a.append.empty()) throw InputError("offline needs one of --out DB.h5 and --append DB.h5");
+  const std::string& out = a.append.empty() ? a.out : a.append;
+  check_output_path(out);  // before the snapshots are computed
+  if (a.append.empty()) check_output_not_input(out, {a.problem});
+  fom::ProblemOptions popt;
+  popt.refine = a.refine;
+  auto problem = fom::make_problem(a.problem, popt);
+  if (ranks.root())
+    for (const std::string& w : fom::reference_contact_warnings(*problem)) std::cerr << "contactrom: warning: " << w << "\n";
+  return problem;
+}
+
+/// Two runs appending to one database at once would each read, extend and rename it,
+/// and one's snapshots would be lost: the second waits for the first (rank 0 holds the
+/// lock until the file is written).
+std::unique_ptr<FileLock> lock_for_append(const std::string& path, const Ranks& ranks) {
+  if (path.empty() || !ranks.root()) return nullptr;
+  return std::make_unique<FileLock>(path, [path] {
+    std::cerr << "contactrom: waiting for another run that is updating " << quoted(path, 200) << "\n";
+  });
+}
+
 /// The adaptive settings: the appended database's (or the defaults), overridden by
 /// those given on the command line.
 rom::AdaptiveOptions adaptive_options(const OfflineArgs& a, const rom::SnapshotDatabase* existing) {
@@ -149,24 +175,13 @@ void run_adaptive(const OfflineArgs& a) {
 #else
   const Ranks ranks;
 #endif
-  if (a.out.empty() == a.append.empty()) throw InputError("offline needs one of --out DB.h5 and --append DB.h5");
   if (!a.part.empty()) throw InputError("--part does not apply to --adaptive; expected a whole adaptive run");
+  const auto problem = open_run(a, ranks);
   const bool appending = !a.append.empty();
   const std::string& out = appending ? a.append : a.out;
-  check_output_path(out);
-  if (!appending) check_output_not_input(out, {a.problem});
-  fom::ProblemOptions popt;
-  popt.refine = a.refine;
-  auto problem = fom::make_problem(a.problem, popt);
-  if (ranks.root())
-    for (const std::string& w : fom::reference_contact_warnings(*problem)) std::cerr << "contactrom: warning: " << w << "\n";
-  std::unique_ptr<FileLock> lock;
+  const std::unique_ptr<FileLock> lock = lock_for_append(a.append, ranks);
   rom::SnapshotDatabase existing;
   if (appending) {
-    if (ranks.root())
-      lock = std::make_unique<FileLock>(a.append, [&] {
-        std::cerr << "contactrom: waiting for another run that is updating " << quoted(a.append, 200) << "\n";
-      });
     existing = rom::read_database(a.append);
     rom::check_database_problem(existing, *problem, a.append);
     if (existing.training_kind != "adaptive")
@@ -228,25 +243,11 @@ void run_offline(const OfflineArgs& a) {
 #else
   const Ranks ranks;
 #endif
-  if (a.out.empty() == a.append.empty()) throw InputError("offline needs one of --out DB.h5 and --append DB.h5");
+  const auto problem = open_run(a, ranks);
   const bool appending = !a.append.empty();
   const std::string& out = appending ? a.append : a.out;
-  check_output_path(out);  // before the snapshots are computed (every rank: all refuse alike)
-  if (!appending) check_output_not_input(out, {a.problem});
-  fom::ProblemOptions popt;
-  popt.refine = a.refine;
-  auto problem = fom::make_problem(a.problem, popt);
-  if (ranks.root())
-    for (const std::string& w : fom::reference_contact_warnings(*problem)) std::cerr << "contactrom: warning: " << w << "\n";
   const fom::SamplingPlan& plan = problem->definition().training;
-  // Two runs appending to one database at once would each read, extend and
-  // rename it, and one's snapshots would be lost: the second waits for the first
-  // (the lock is held until the file is written).
-  std::unique_ptr<FileLock> lock;
-  if (appending && ranks.root())
-    lock = std::make_unique<FileLock>(a.append, [&] {
-      std::cerr << "contactrom: waiting for another run that is updating " << quoted(a.append, 200) << "\n";
-    });
+  const std::unique_ptr<FileLock> lock = lock_for_append(a.append, ranks);
   // The database appended to is read on every rank (all refuse alike) and checked
   // against the run before any snapshot is computed.
   rom::SnapshotDatabase existing;
