@@ -7,6 +7,7 @@
 #include "core/format.hpp"
 #include "core/errors.hpp"
 #include "python/bindings.hpp"
+#include "rom/adaptive_training.hpp"
 #include "rom/fallback.hpp"
 #include "rom/offline.hpp"
 #include "rom/online_methods.hpp"
@@ -154,6 +155,29 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
       .def_property_readonly("time_s", [](const Database& d) { return d.db->time_s; })
       .def_property_readonly("wall_time_s", [](const Database& d) { return d.db->wall_time_s; })
       .def_property_readonly("threads", [](const Database& d) { return d.db->threads; })
+      .def_property_readonly(
+          "adaptive",
+          [](const Database& d) -> py::object {
+            if (d.db->training_kind != "adaptive") return py::none();
+            const rom::AdaptiveRecord& a = d.db->adaptive;
+            py::dict r;
+            r["tolerance"] = a.tolerance;
+            r["max_snapshots"] = a.max_snapshots;
+            r["candidates"] = a.candidates;
+            r["batch"] = a.batch;
+            r["seed"] = a.seed;
+            r["indicator"] = a.indicator;
+            r["method"] = a.method;
+            r["delta"] = a.delta;
+            r["initial_snapshots"] = a.initial_snapshots;
+            r["round_snapshots"] = py::array_t<int>(a.round_snapshots.size(), a.round_snapshots.data());
+            r["round_added"] = py::array_t<int>(a.round_added.size(), a.round_added.data());
+            r["round_max_indicator"] = py::array_t<double>(a.round_max_indicator.size(), a.round_max_indicator.data());
+            r["round_mean_indicator"] = py::array_t<double>(a.round_mean_indicator.size(), a.round_mean_indicator.data());
+            r["round_time_s"] = py::array_t<double>(a.round_time_s.size(), a.round_time_s.data());
+            return std::move(r);
+          },
+          "How an adaptive run built the database (a dict of its settings and per-round arrays), None otherwise.")
       .def(
           "validation_set",
           [](const Database& d) {
@@ -210,6 +234,46 @@ FOM snapshots in parallel (GIL released). `params` is an int n (the training set
 of size or level n, as `contactrom offline --train n` / `--level n`) or an array
 of parameters (n, n_params); a database of other parameters than a training set
 works in memory but is refused when read back from a file.)doc");
+
+  m.def(
+      "offline_adaptive",
+      [](std::shared_ptr<fom::Problem> problem, double tolerance, int max_snapshots, int candidates, int batch, int seed,
+         const std::string& indicator, const std::string& method, double delta, int initial, int threads,
+         py::object resume, py::object path_like) {
+        rom::AdaptiveOptions o;
+        o.tolerance = tolerance;
+        o.max_snapshots = max_snapshots;
+        o.candidates = candidates;
+        o.batch = batch;
+        o.seed = seed;
+        o.indicator = indicator;
+        o.method = method;
+        o.model.delta = delta;
+        o.initial = initial;
+        o.offline.threads = threads;
+        const std::string path = path_like.is_none() ? std::string() : path_arg(path_like);
+        if (!path.empty()) o.on_round = [path](const rom::AdaptiveRound&, const rom::SnapshotDatabase& db) {
+          rom::write_database(path, db);
+        };
+        const Database* previous = resume.is_none() ? nullptr : &resume.cast<const Database&>();
+        Database d;
+        d.problem = problem;
+        py::gil_scoped_release release;
+        const rom::AdaptiveTrainer trainer(*problem, o);
+        d.db = std::make_shared<rom::SnapshotDatabase>(previous ? trainer.resume(*previous->db, "the database to resume")
+                                                                : trainer.run());
+        return d;
+      },
+      py::arg("problem"), py::arg("tolerance"), py::arg("max_snapshots") = 200, py::arg("candidates") = 1000,
+      py::arg("batch") = 4, py::arg("seed") = 1, py::arg("indicator") = "max", py::arg("method") = "greedy",
+      py::arg("delta") = 1e-8, py::arg("initial") = 0, py::arg("threads") = 0, py::arg("resume") = py::none(),
+      py::arg("path") = py::none(), R"doc(
+Adaptive offline stage, as `contactrom offline --adaptive` (docs/rom.md, "Adaptive
+training"): FOM snapshots at the candidates where the reduced model's error estimate
+is largest, `batch` per round, until the largest estimate is below `tolerance` or the
+database holds `max_snapshots`. `resume`: an adaptive database to continue (its
+candidates, seed, indicator, method and delta must be given the same). `path`: the
+database is written there after every round. Returns the database.)doc");
 
   py::class_<rom::OnlineResult>(m, "RomSolution",
                                 "One online query; arrays are read-only views owned by this object.")

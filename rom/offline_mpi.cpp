@@ -108,9 +108,12 @@ bool all_ranks_ok(bool ok) {
   return all == 1;
 }
 
-SnapshotDatabase generate_snapshots_distributed(const fom::Problem& problem, const std::vector<fom::Param>& params,
-                                                const std::string& training_kind, int training_size,
-                                                const OfflineOptions& options) {
+namespace {
+
+/// generate_snapshots_distributed(), the database on rank 0 only or (`everywhere`) on every rank.
+SnapshotDatabase distributed(const fom::Problem& problem, const std::vector<fom::Param>& params,
+                             const std::string& training_kind, int training_size, const OfflineOptions& options,
+                             bool everywhere) {
   const auto t0 = std::chrono::steady_clock::now();
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -152,12 +155,18 @@ SnapshotDatabase generate_snapshots_distributed(const fom::Problem& problem, con
     displs[r] = offset;
     offset += counts[r];
   }
-  std::vector<double> all(rank == 0 ? static_cast<size_t>(n) * stride : 0);
-  MPI_Gatherv(buffer.data(), static_cast<int>(buffer.size()), MPI_DOUBLE, all.data(), counts.data(), displs.data(),
-              MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  std::vector<double> all(rank == 0 || everywhere ? static_cast<size_t>(n) * stride : 0);
   int local_threads = local.threads, threads = 0;
-  MPI_Reduce(&local_threads, &threads, 1, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD);
-  if (rank != 0) return SnapshotDatabase{};
+  if (everywhere) {
+    MPI_Allgatherv(buffer.data(), static_cast<int>(buffer.size()), MPI_DOUBLE, all.data(), counts.data(),
+                   displs.data(), MPI_DOUBLE, MPI_COMM_WORLD);
+    MPI_Allreduce(&local_threads, &threads, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  } else {
+    MPI_Gatherv(buffer.data(), static_cast<int>(buffer.size()), MPI_DOUBLE, all.data(), counts.data(), displs.data(),
+                MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    MPI_Reduce(&local_threads, &threads, 1, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD);
+    if (rank != 0) return SnapshotDatabase{};
+  }
 
   // Rank r's k-th snapshot is parameter j = r + k·size.
   SnapshotDatabase db = local;  // metadata (problem, fingerprint, names, ...) of rank 0
@@ -188,6 +197,22 @@ SnapshotDatabase generate_snapshots_distributed(const fom::Problem& problem, con
   db.threads = threads;
   db.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return db;
+}
+
+}  // namespace
+
+SnapshotDatabase generate_snapshots_distributed(const fom::Problem& problem, const std::vector<fom::Param>& params,
+                                                const std::string& training_kind, int training_size,
+                                                const OfflineOptions& options) {
+  return distributed(problem, params, training_kind, training_size, options, false);
+}
+
+SnapshotDatabase generate_snapshots_on_every_rank(const fom::Problem& problem, const std::vector<fom::Param>& params,
+                                                  const std::string& training_kind, int training_size,
+                                                  const OfflineOptions& options) {
+  if (!options.stream_to.empty())
+    throw std::invalid_argument("generate_snapshots_on_every_rank: the snapshots cannot be streamed to a file");
+  return distributed(problem, params, training_kind, training_size, options, true);
 }
 
 }  // namespace contactrom::rom::mpi

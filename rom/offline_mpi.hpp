@@ -72,6 +72,14 @@ SnapshotDatabase generate_snapshots_distributed(const fom::Problem& problem, con
                                                 const std::string& training_kind, int training_size,
                                                 const OfflineOptions& options = {});
 
+/// \brief As generate_snapshots_distributed(), but every rank returns the whole
+/// database (the ranks' snapshots are exchanged with MPI_Allgatherv): for a loop that
+/// runs on every rank and needs the snapshots there, the adaptive offline stage
+/// (rom/adaptive_training.hpp). `options.stream_to` must be empty.
+SnapshotDatabase generate_snapshots_on_every_rank(const fom::Problem& problem, const std::vector<fom::Param>& params,
+                                                  const std::string& training_kind, int training_size,
+                                                  const OfflineOptions& options = {});
+
 /// \brief Whether `ok` holds on every rank (collective; an agreement step, e.g.
 /// after rank 0 wrote the file, so that every rank exits with the same outcome).
 bool all_ranks_ok(bool ok);

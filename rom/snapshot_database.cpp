@@ -135,6 +135,65 @@ std::vector<int> SnapshotDatabase::successful_snapshots() const {
 
 namespace {
 
+/// The group /adaptive of an adaptive database (AdaptiveRecord): settings as
+/// attributes, one dataset per round column.
+void write_adaptive(hid_t f, hid_t dcpl, const AdaptiveRecord& a) {
+  Handle group(H5Gcreate2(f, "adaptive", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "group /adaptive");
+  const hid_t g = group.id();
+  write_scalar_attribute(g, "tolerance", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &a.tolerance);
+  write_scalar_attribute(g, "delta", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &a.delta);
+  for (const auto& [name, value] : {std::pair<const char*, const int*>{"max_snapshots", &a.max_snapshots},
+                                    {"candidates", &a.candidates}, {"batch", &a.batch}, {"seed", &a.seed},
+                                    {"initial_snapshots", &a.initial_snapshots}})
+    write_scalar_attribute(g, name, H5T_STD_I32LE, H5T_NATIVE_INT, value);
+  write_string_attribute(g, "indicator", a.indicator);
+  write_string_attribute(g, "method", a.method);
+  const hsize_t r = static_cast<hsize_t>(a.num_rounds());
+  write_dataset(g, dcpl, "round_snapshots", H5T_STD_I32LE, H5T_NATIVE_INT, 1, r, 0, a.round_snapshots.data());
+  write_dataset(g, dcpl, "round_added", H5T_STD_I32LE, H5T_NATIVE_INT, 1, r, 0, a.round_added.data());
+  write_dataset(g, dcpl, "round_max_indicator", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, r, 0, a.round_max_indicator.data());
+  write_dataset(g, dcpl, "round_mean_indicator", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, r, 0,
+                a.round_mean_indicator.data());
+  write_dataset(g, dcpl, "round_time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, r, 0, a.round_time_s.data());
+}
+
+/// Reads the group written by write_adaptive, checking what an adaptive run writes.
+AdaptiveRecord read_adaptive(hid_t f) {
+  if (H5Lexists(f, "adaptive", H5P_DEFAULT) <= 0)
+    throw hdf5::Refused("training_kind is 'adaptive' but the group /adaptive is missing");
+  Handle group(H5Gopen2(f, "adaptive", H5P_DEFAULT), H5Gclose, "group /adaptive");
+  const hid_t g = group.id();
+  AdaptiveRecord a;
+  a.tolerance = hdf5::read_double_attribute(g, "tolerance");
+  a.delta = hdf5::read_double_attribute(g, "delta");
+  a.max_snapshots = hdf5::read_int_attribute(g, "max_snapshots");
+  a.candidates = hdf5::read_int_attribute(g, "candidates");
+  a.batch = hdf5::read_int_attribute(g, "batch");
+  a.seed = hdf5::read_int_attribute(g, "seed");
+  a.initial_snapshots = hdf5::read_int_attribute(g, "initial_snapshots");
+  a.indicator = read_string_attribute(g, "indicator");
+  a.method = read_string_attribute(g, "method");
+  // Datasets by path from the file: the readers check their sizes against the file's.
+  hsize_t rows = 0, cols = 0;
+  const hsize_t r = hdf5::dataset_shape(f, "adaptive/round_snapshots")[0];
+  hdf5::read_int_dataset(f, "adaptive/round_snapshots", a.round_snapshots, rows, cols);
+  hdf5::read_int_dataset(f, "adaptive/round_added", a.round_added, rows, cols);
+  hdf5::read_double_dataset(f, "adaptive/round_max_indicator", a.round_max_indicator, rows, cols);
+  hdf5::read_double_dataset(f, "adaptive/round_mean_indicator", a.round_mean_indicator, rows, cols);
+  hdf5::read_double_dataset(f, "adaptive/round_time_s", a.round_time_s, rows, cols);
+  if (a.round_added.size() != r || a.round_max_indicator.size() != r || a.round_mean_indicator.size() != r ||
+      a.round_time_s.size() != r)
+    throw hdf5::Refused("the datasets of /adaptive differ in length; expected one value per round");
+  if (!(a.tolerance > 0.0) || !std::isfinite(a.tolerance) || !(a.delta >= 0.0 && a.delta <= 1.0) || a.batch < 1 ||
+      a.candidates < 1 || a.max_snapshots < 1 || a.initial_snapshots < 1)
+    throw hdf5::Refused("an attribute of /adaptive holds a value no adaptive run writes");
+  for (hsize_t k = 0; k < r; ++k)
+    if (a.round_snapshots[k] < 1 || a.round_added[k] < 0 || !(a.round_mean_indicator[k] >= 0.0) ||
+        !(a.round_max_indicator[k] >= 0.0) || !(a.round_time_s[k] >= 0.0))
+      throw hdf5::Refused("round " + std::to_string(k) + " of /adaptive holds a negative or undefined value");
+  return a;
+}
+
 /// Every field of `db`, in write_database's layout; the primal snapshots by `write_primal`
 /// (which does nothing when they were streamed into the file).
 void write_fields(hid_t f, hid_t dcpl, const SnapshotDatabase& db, const std::function<void()>& write_primal) {
@@ -162,6 +221,7 @@ void write_fields(hid_t f, hid_t dcpl, const SnapshotDatabase& db, const std::fu
   write_dataset(f, dcpl, "pairing_iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, db.pairing_iterations.data());
   write_dataset(f, dcpl, "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, n, 0, db.time_s.data());
   write_problem_record(f, dcpl, problem_record(db));
+  if (db.training_kind == "adaptive") write_adaptive(f, dcpl, db.adaptive);
 }
 
 /// Reads single primal snapshots (dataset rows) of the files of a database left on disk.
@@ -481,8 +541,11 @@ SnapshotDatabase read_database(const std::string& path, bool load_primal) {
     if (db.parameters.rows() != static_cast<Eigen::Index>(db.param_names.size()))
       throw hdf5::Refused("dataset /parameters has " + std::to_string(db.parameters.rows()) +
                         " columns but param_names lists " + std::to_string(db.param_names.size()));
-    if (db.training_kind != "train" && db.training_kind != "level" && db.training_kind != "list")
-      throw hdf5::Refused("attribute training_kind is " + quoted(db.training_kind, 200) + ", expected 'train', 'level' or 'list'");
+    if (db.training_kind != "train" && db.training_kind != "level" && db.training_kind != "list" &&
+        db.training_kind != "adaptive")
+      throw hdf5::Refused("attribute training_kind is " + quoted(db.training_kind, 200) +
+                          ", expected 'train', 'level', 'list' or 'adaptive'");
+    if (db.training_kind == "adaptive") db.adaptive = read_adaptive(f);
     validate_values(db);
     file.close("file close");
   } catch (const hdf5::Refused& e) {
@@ -496,7 +559,7 @@ SnapshotDatabase read_database(const std::string& path, bool load_primal) {
 void check_database(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path) {
   check_database_problem(db, problem, path);
   const std::string selector = problem.definition().training.selector();
-  if (db.training_kind != selector)
+  if (db.training_kind != selector && db.training_kind != "adaptive")
     throw InputError("database " + quoted(path, 200) + " selects its training set by " + quoted(db.training_kind, 200) + ", but " +
                      problem.name() + " uses " + quoted(selector, 200));
   check_training_set(db, problem, path);
@@ -526,7 +589,10 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
       throw InputError("database " + quoted(path, 200) + " dataset /parameters row " + std::to_string(j) + ": " + e.what());
     }
   }
-  const std::string option = db.training_kind == "level" ? "level " : db.training_kind == "list" ? "the list of " : "training size ";
+  const bool adaptive = db.training_kind == "adaptive";
+  const std::string kind = adaptive ? problem.definition().training.selector() : db.training_kind;
+  const std::string option = (adaptive ? "an adaptive run started from " : "") +
+                             std::string(kind == "level" ? "level " : kind == "list" ? "the list of " : "training size ");
   std::vector<fom::Param> expected;
   try {
     expected = fom::training_set(problem, db.training_size);
@@ -537,10 +603,24 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
     return InputError("database " + quoted(path, 200) + " claims " + option + std::to_string(db.training_size) + " of " +
                       problem.name() + ", but " + why + "; expected the snapshots of that training set");
   };
-  if (static_cast<int>(expected.size()) != db.num_snapshots())
+  if (adaptive) {
+    const AdaptiveRecord& a = db.adaptive;
+    int held = a.initial_snapshots;
+    for (int k = 0; k < a.num_rounds(); ++k) {
+      if (a.round_snapshots[k] != held)
+        throw mismatch("its round " + std::to_string(k) + " evaluated " + std::to_string(a.round_snapshots[k]) +
+                       " snapshots where the earlier rounds leave " + std::to_string(held));
+      held += a.round_added[k];
+    }
+    if (held != db.num_snapshots() || a.initial_snapshots != static_cast<int>(expected.size()))
+      throw mismatch("its rounds account for " + std::to_string(held) + " snapshots from " +
+                     std::to_string(a.initial_snapshots) + " initial ones, and it holds " +
+                     std::to_string(db.num_snapshots()) + " from " + std::to_string(expected.size()));
+  } else if (static_cast<int>(expected.size()) != db.num_snapshots()) {
     throw mismatch("it holds " + std::to_string(db.num_snapshots()) + " snapshots instead of " +
                    std::to_string(expected.size()));
-  for (int j = 0; j < db.num_snapshots(); ++j) {
+  }
+  for (int j = 0; j < static_cast<int>(expected.size()); ++j) {
     const double scale = std::max(1.0, expected[j].cwiseAbs().maxCoeff());
     if ((db.parameter(j) - expected[j]).cwiseAbs().maxCoeff() > kParameterMatchTolerance * scale)
       throw mismatch("its snapshot " + std::to_string(j) + " is not at the training parameter of that set");
@@ -562,10 +642,18 @@ std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, 
 }
 
 std::vector<fom::Param> database_training_set(const SnapshotDatabase& db, const fom::Problem& problem) {
+  if (db.training_kind == "adaptive") {
+    std::vector<fom::Param> out;
+    for (int j = 0; j < db.num_snapshots(); ++j) out.push_back(db.parameter(j));
+    return out;
+  }
   return fom::training_set(problem, db.training_size);
 }
 
 std::vector<fom::Param> database_validation_set(const SnapshotDatabase& db, const fom::Problem& problem) {
+  if (db.training_kind == "adaptive")
+    throw InputError("database of " + problem.name() + " was built adaptively and has no validation set of its own; "
+                     "expected a parameter list (online --validation --params FILE.csv)");
   return fom::validation_set(problem, db.training_size);
 }
 

@@ -36,6 +36,30 @@ namespace contactrom::rom {
 /// \brief Version of the file layout written by write_database (attribute `format_version`).
 inline constexpr int kDatabaseFormatVersion = 2;
 
+/// \brief How an adaptive offline run (rom/adaptive_training.hpp) built a database
+/// (training_kind "adaptive"): the settings of its latest run and one entry per round.
+/// Round k evaluated the error indicator of the model built from the first
+/// `round_snapshots[k]` snapshots at every remaining candidate, then added the
+/// `round_added[k]` snapshots that follow them (0 in the last round of a run that
+/// stopped). Stored in the group `/adaptive` (docs/database_format.md).
+struct AdaptiveRecord {
+  double tolerance = 0.0;        ///< ε: the run stops when the largest indicator is below it
+  int max_snapshots = 0;         ///< N: the run stops when the database holds N snapshots
+  int candidates = 0;            ///< M: size of the candidate set (a Latin hypercube)
+  int batch = 0;                 ///< B: FOM snapshots added per round, at most
+  int seed = 0;                  ///< seed of the candidates' Latin hypercube
+  std::string indicator;         ///< "primal", "dual" or "max" (of the two estimates)
+  std::string method;            ///< online method whose answers are estimated
+  double delta = 0.0;            ///< POD tolerance of the reduced models
+  int initial_snapshots = 0;     ///< the first snapshots: the initial training set
+  std::vector<int> round_snapshots;        ///< snapshots of the model evaluated in each round
+  std::vector<double> round_max_indicator; ///< largest indicator over the candidates (inf: a failed answer)
+  std::vector<double> round_mean_indicator;///< mean of the finite indicators over the candidates
+  std::vector<int> round_added;            ///< snapshots added after each round's evaluation
+  std::vector<double> round_time_s;        ///< wall time of each round (evaluation, FOM batch), s
+  int num_rounds() const { return static_cast<int>(round_snapshots.size()); }
+};
+
 /// \brief FOM snapshots at the training parameters; see the file comment.
 struct SnapshotDatabase {
   std::string problem;           ///< problem name
@@ -47,10 +71,14 @@ struct SnapshotDatabase {
   Eigen::MatrixXd lifting_terms;          ///< n_dofs × n_terms: the lifting basis L_k
   std::string mesh_fingerprint;  ///< Problem::fingerprint() of the discretisation
   std::string created_by;        ///< program and version that wrote the file
-  /// How the training set was selected: "train" (`--train n`), "level" (`--level n`)
-  /// or "list" (the problem's listed points).
+  /// How the training set was selected: "train" (`--train n`), "level" (`--level n`),
+  /// "list" (the problem's listed points) or "adaptive" (offline --adaptive: the
+  /// training set of size/level `training_size` first, then the points the error
+  /// indicator chose, in the order they were added; see `adaptive`).
   std::string training_kind = "train";
   int training_size = 0;                  ///< n of `--train n` or `--level n`
+  /// With training_kind "adaptive": how the run went; empty otherwise.
+  AdaptiveRecord adaptive;
   std::vector<std::string> param_names;   ///< names of the parameter components
   Eigen::MatrixXd parameters;             ///< n_params × n_snap, column j = μ_j
   /// n_dofs × n_snap, u(μ_j) − u_lift(μ_j) (zero on Dirichlet dofs); n_dofs × 0 when
@@ -179,16 +207,19 @@ void describe_problem(const fom::Problem& problem, SnapshotDatabase& db);
 /// \brief Checks that every stored parameter lies in `problem`'s range and that
 /// the snapshots are those of the training set named by the database's
 /// training_size (same count, same parameters): a database relabelled with
-/// another size or level is refused. Called by check_database.
+/// another size or level is refused. An adaptive database must start with that
+/// training set and its rounds must account for its snapshots. Called by check_database.
 /// \throws InputError naming `path`, the dataset or attribute and the value.
 void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path);
 
 /// \brief Training set of `problem` selected by the database's options
-/// (training_set(training_size)).
+/// (training_set(training_size)); the database's own parameters when it is adaptive.
 std::vector<fom::Param> database_training_set(const SnapshotDatabase& db, const fom::Problem& problem);
 
 /// \brief Validation set associated with the database's training options
 /// (validation_set(training_size)).
+/// \throws InputError for an adaptive database, which has none (its points are not
+///   a grid): evaluate it on a parameter list (`online --validation --params FILE.csv`).
 std::vector<fom::Param> database_validation_set(const SnapshotDatabase& db, const fom::Problem& problem);
 
 }  // namespace contactrom::rom

@@ -1,5 +1,11 @@
 // contactrom offline --problem P (--train N | --level n) (--out DB.h5 | --append DB.h5) [--threads T] [--part k/K]
 //                    [--progress] [--json]
+// contactrom offline --problem P --adaptive --tolerance EPS [--max-snapshots N] [--candidates M] [--batch B]
+//                    [--seed S] [--indicator primal|dual|max] [--method M] [--delta D] [--train n | --level n]
+//                    (--out DB.h5 | --append DB.h5) [--threads T] [--json]
+// --adaptive trains where the reduced model's error estimate is largest
+// (rom/adaptive_training.hpp), writes the database after every round (an interrupted
+// run loses at most one round) and reports each round on stderr; --append continues it.
 // Computes the FOM snapshots at the training parameters in parallel (one shared
 // factorisation, no warm start, deterministic) and writes them to an HDF5
 // database (docs/database_format.md). With --append, only the parameters the
@@ -16,11 +22,13 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "core/format.hpp"
 #include "core/errors.hpp"
 #include "fom/contact_checks.hpp"
+#include "rom/adaptive_training.hpp"
 #include "rom/database_merge.hpp"
 #include "rom/offline.hpp"
 #ifdef CONTACTROM_HAVE_MPI
@@ -39,6 +47,12 @@ struct OfflineArgs {
   int train = 0, level = 0, threads = 0, refine = 0;
   std::string part;  // "k/K": only the k-th of K contiguous parts of the training set
   bool progress = false, json = false;
+  // --adaptive and its settings; unset ones (< 0, empty) take the defaults, or the
+  // appended database's values
+  bool adaptive = false;
+  double tolerance = -1.0, delta = -1.0;
+  int max_snapshots = -1, candidates = -1, batch = -1, seed = -1;
+  std::string indicator, method;
 };
 
 std::string param_text(const fom::Problem& problem, const fom::Param& mu) {
@@ -93,7 +107,134 @@ void write_on_root(const std::string& path, const std::function<const rom::Snaps
 #endif
 }
 
+/// What every offline run checks first, on every rank (all refuse alike): one of --out
+/// and --append, an output path that can be written and is not an input; then the
+/// problem, whose reference-contact warnings rank 0 prints.
+std::unique_ptr<fom::Problem> open_run(const OfflineArgs& a, const Ranks& ranks) {
+  if (a.out.empty() == a.append.empty()) throw InputError("offline needs one of --out DB.h5 and --append DB.h5");
+  const std::string& out = a.append.empty() ? a.out : a.append;
+  check_output_path(out);  // before the snapshots are computed
+  if (a.append.empty()) check_output_not_input(out, {a.problem});
+  fom::ProblemOptions popt;
+  popt.refine = a.refine;
+  auto problem = fom::make_problem(a.problem, popt);
+  if (ranks.root())
+    for (const std::string& w : fom::reference_contact_warnings(*problem)) std::cerr << "contactrom: warning: " << w << "\n";
+  return problem;
+}
+
+/// Two runs appending to one database at once would each read, extend and rename it,
+/// and one's snapshots would be lost: the second waits for the first (rank 0 holds the
+/// lock until the file is written).
+std::unique_ptr<FileLock> lock_for_append(const std::string& path, const Ranks& ranks) {
+  if (path.empty() || !ranks.root()) return nullptr;
+  return std::make_unique<FileLock>(path, [path] {
+    std::cerr << "contactrom: waiting for another run that is updating " << quoted(path, 200) << "\n";
+  });
+}
+
+/// The adaptive settings: the appended database's (or the defaults), overridden by
+/// those given on the command line.
+rom::AdaptiveOptions adaptive_options(const OfflineArgs& a, const rom::SnapshotDatabase* existing) {
+  rom::AdaptiveOptions o = existing ? rom::adaptive_options_of(*existing) : rom::AdaptiveOptions{};
+  if (a.tolerance >= 0) o.tolerance = a.tolerance;
+  if (a.max_snapshots >= 0) o.max_snapshots = a.max_snapshots;
+  if (a.candidates >= 0) o.candidates = a.candidates;
+  if (a.batch >= 0) o.batch = a.batch;
+  if (a.seed >= 0) o.seed = a.seed;
+  if (!a.indicator.empty()) o.indicator = a.indicator;
+  if (!a.method.empty()) o.method = a.method;
+  if (a.delta >= 0) o.model.delta = a.delta;
+  if (a.train || a.level) o.initial = a.train ? a.train : a.level;
+  o.offline.threads = a.threads;
+  return o;
+}
+
+/// One line per round on stderr.
+void report_round(const fom::Problem& problem, const rom::AdaptiveRound& r) {
+  std::ostringstream line;
+  line << std::setprecision(3) << "contactrom: adaptive round " << r.round << ": " << r.snapshots << " snapshots, "
+       << r.candidates << " candidates, max indicator " << r.max_indicator << " at " << param_text(problem, r.worst)
+       << ", mean " << r.mean_indicator;
+  if (r.failed) line << ", " << r.failed << " without estimate";
+  line << "; added " << r.added.size() << " (" << r.time_s << " s)";
+  if (!r.stop.empty())
+    line << "; stop: "
+         << (r.stop == "tolerance" ? "max indicator below the tolerance"
+             : r.stop == "max_snapshots" ? "--max-snapshots reached"
+                                         : "no candidate left above the tolerance");
+  std::cerr << line.str() << std::endl;
+}
+
+void run_adaptive(const OfflineArgs& a) {
+#ifdef CONTACTROM_HAVE_MPI
+  // Under mpirun every rank runs the loop (the same candidates and indicators); the FOM
+  // batches are distributed over the ranks and every rank gets the whole batch.
+  const bool distributed = rom::mpi::active() && rom::mpi::world_size() > 1;
+  const Ranks ranks{rom::mpi::world_rank(), rom::mpi::world_size()};
+#else
+  const Ranks ranks;
+#endif
+  if (!a.part.empty()) throw InputError("--part does not apply to --adaptive; expected a whole adaptive run");
+  const auto problem = open_run(a, ranks);
+  const bool appending = !a.append.empty();
+  const std::string& out = appending ? a.append : a.out;
+  const std::unique_ptr<FileLock> lock = lock_for_append(a.append, ranks);
+  rom::SnapshotDatabase existing;
+  if (appending) {
+    existing = rom::read_database(a.append);
+    rom::check_database_problem(existing, *problem, a.append);
+    if (existing.training_kind != "adaptive")
+      throw InputError("cannot continue " + quoted(a.append, 200) + " adaptively: it holds the training set " +
+                       existing.training_kind + " " + std::to_string(existing.training_size) +
+                       "; expected a database written by offline --adaptive");
+  }
+  if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
+  rom::AdaptiveOptions options = adaptive_options(a, appending ? &existing : nullptr);
+  if (!appending && a.tolerance < 0) throw InputError("offline --adaptive needs --tolerance EPS (e.g. 0.05)");
+#ifdef CONTACTROM_HAVE_MPI
+  if (distributed) options.generate = rom::mpi::generate_snapshots_on_every_rank;
+#endif
+  options.on_round = [&](const rom::AdaptiveRound& r, const rom::SnapshotDatabase& db) {
+    // atomically, on rank 0: the file always holds whole rounds
+    write_on_root(out, [&]() -> const rom::SnapshotDatabase& { return db; }, ranks);
+    if (ranks.root()) report_round(*problem, r);
+  };
+  const rom::AdaptiveTrainer trainer(*problem, options);
+  const int before = appending ? existing.num_snapshots() : 0;
+  const rom::SnapshotDatabase db = appending ? trainer.resume(std::move(existing), a.append) : trainer.run();
+  if (!ranks.root()) return;
+  const rom::AdaptiveRecord& rec = db.adaptive;
+  const double worst = rec.round_max_indicator.back();
+  const bool converged = worst < rec.tolerance;
+  if (a.json) {
+    nlohmann::json j;
+    j["problem"] = problem->name();
+    j["adaptive"] = true;
+    j["snapshots"] = db.num_snapshots() - before;
+    j["total_snapshots"] = db.num_snapshots();
+    j["rounds"] = rec.num_rounds();
+    j["max_indicator"] = worst;
+    j["mean_indicator"] = rec.round_mean_indicator.back();
+    j["tolerance"] = rec.tolerance;
+    j["converged"] = converged;
+    j["indicator"] = rec.indicator;
+    j["threads"] = db.threads;
+    j["ranks"] = ranks.size;
+    j["wall_time_s"] = db.wall_time_s;
+    j["out"] = out;
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::cout << std::setprecision(3) << "offline " << problem->name() << " adaptive: " << db.num_snapshots()
+            << " snapshots in " << rec.num_rounds() << " rounds, max indicator (" << rec.indicator << ") " << worst
+            << (converged ? " < " : " >= ") << rec.tolerance << (converged ? "" : " (not reached)") << "\n"
+            << "wall time " << db.wall_time_s << " s\n"
+            << (appending ? "appended to " : "database written to ") << out << "\n";
+}
+
 void run_offline(const OfflineArgs& a) {
+  if (a.adaptive) return run_adaptive(a);
 #ifdef CONTACTROM_HAVE_MPI
   // Under mpirun (main() started MPI), the snapshots are distributed over the ranks
   // (rom/offline_mpi.hpp).
@@ -102,29 +243,18 @@ void run_offline(const OfflineArgs& a) {
 #else
   const Ranks ranks;
 #endif
-  if (a.out.empty() == a.append.empty()) throw InputError("offline needs one of --out DB.h5 and --append DB.h5");
+  const auto problem = open_run(a, ranks);
   const bool appending = !a.append.empty();
   const std::string& out = appending ? a.append : a.out;
-  check_output_path(out);  // before the snapshots are computed (every rank: all refuse alike)
-  if (!appending) check_output_not_input(out, {a.problem});
-  fom::ProblemOptions popt;
-  popt.refine = a.refine;
-  auto problem = fom::make_problem(a.problem, popt);
-  if (ranks.root())
-    for (const std::string& w : fom::reference_contact_warnings(*problem)) std::cerr << "contactrom: warning: " << w << "\n";
   const fom::SamplingPlan& plan = problem->definition().training;
-  // Two runs appending to one database at once would each read, extend and
-  // rename it, and one's snapshots would be lost: the second waits for the first
-  // (the lock is held until the file is written).
-  std::unique_ptr<FileLock> lock;
-  if (appending && ranks.root())
-    lock = std::make_unique<FileLock>(a.append, [&] {
-      std::cerr << "contactrom: waiting for another run that is updating " << quoted(a.append, 200) << "\n";
-    });
+  const std::unique_ptr<FileLock> lock = lock_for_append(a.append, ranks);
   // The database appended to is read on every rank (all refuse alike) and checked
   // against the run before any snapshot is computed.
   rom::SnapshotDatabase existing;
   if (appending) existing = rom::read_database(a.append, false);
+  if (appending && existing.training_kind == "adaptive")
+    throw InputError("database " + quoted(a.append, 200) +
+                     " was built by offline --adaptive; expected --adaptive to continue it");
   // --append without --train/--level: the database's training set.
   const bool size_from_db = appending && !a.train && !a.level && plan.selector() != "list";
   const int n = size_from_db ? existing.training_size
@@ -251,6 +381,26 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
   sub->add_option("--part", args->part,
                   "k/K: only the k-th of K contiguous parts of the training set (join the parts with merge)");
   sub->add_flag("--progress", args->progress, "draw the progress bar even when stderr is not a terminal");
+  auto* adaptive = sub->add_flag("--adaptive", args->adaptive,
+                                 "train where the reduced model's error estimate is largest (docs/rom.md, "
+                                 "\"Adaptive training\"); --train/--level give the initial set (default: the coarsest)");
+  const auto adaptive_only = [&](CLI::Option* o) { o->needs(adaptive); };
+  adaptive_only(add_number(sub, "--tolerance", args->tolerance,
+                           "adaptive: stop when the largest indicator over the candidates is below EPS (> 0)",
+                           Interval::greater_than(0)));
+  adaptive_only(add_integer(sub, "--max-snapshots", args->max_snapshots,
+                            "adaptive: stop at N snapshots, the initial ones included (default 200)", 1, 10000000));
+  adaptive_only(add_integer(sub, "--candidates", args->candidates,
+                            "adaptive: M candidate parameters, a Latin hypercube (default 1000, at most 100000)", 1, 100000));
+  adaptive_only(add_integer(sub, "--batch", args->batch, "adaptive: FOM snapshots added per round, at most (default 4)",
+                            1, 100000));
+  adaptive_only(add_integer(sub, "--seed", args->seed, "adaptive: seed of the candidates (default 1)", 0, 2147483647));
+  adaptive_only(sub->add_option("--indicator", args->indicator,
+                                "adaptive: estimate that ranks the candidates: primal | dual | max (default max)")
+                    ->check(CLI::IsMember({"primal", "dual", "max"})));
+  adaptive_only(sub->add_option("--method", args->method, "adaptive: online method estimated (default greedy)"));
+  adaptive_only(add_number(sub, "--delta", args->delta, "adaptive: POD tolerance of the reduced models (default 1e-8)",
+                           Interval::closed(0, 1)));
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_offline(*args); });
 });
