@@ -114,9 +114,13 @@ class CpgActiveSet final : public ReducedActiveSet {
 /// \brief Builds the CPG basis of a reduced model's dictionary (L²(Γc) norm).
 CpgBasis build_cpg_basis(const rom::ReducedModel& model, const CpgOptions& options = {});
 
-/// \brief Reads the CPG settings from OnlineSolverOptions::extra: "cpg_tolerance"
-/// (number in [0, 1]) and "cpg_max_size" (integer ≥ 0). \throws InputError naming
-/// the key and the value if one does not parse.
+/// \brief Binding table of CpgOptions: the options of `cpg` beyond the reduced
+/// active set's, declared once (rom/option_table.hpp).
+const rom::OptionTable<CpgOptions>& cpg_option_table();
+
+/// \brief `options` read through cpg_option_table() (rom::read_options()); other keys
+/// of `extra` are left to the reduced active set. \throws InputError naming the key
+/// and the value if one is malformed or out of range.
 CpgOptions cpg_options(const rom::OnlineSolverOptions& options);
 
 /// \brief Registry factory of "cpg".

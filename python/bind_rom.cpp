@@ -287,8 +287,10 @@ object owns the problem (and the database) it needs.)doc")
           },
           "The snapshot database it was built from (None when loaded from a file).")
       .def_property_readonly("method", [](const ReducedModel& r) { return r.rom->method(); })
-      .def_property_readonly("options", [](const ReducedModel& r) { return rom::options_to_map(r.rom->method(), r.rom->options()); },
-                             "The method's settings as text, as stored in the reduced-model file.")
+      .def_property_readonly(
+          "options", [](const ReducedModel& r) { return rom::options_to_values(r.rom->method(), r.rom->options()); },
+          "Every setting of the method (defaults filled in), as stored in the reduced-model file: numbers as "
+          "int or float, flags as bool, choices as str.")
       .def_property_readonly("delta", [](const ReducedModel& r) { return r.rom->model().delta(); })
       .def_property_readonly("primal_rank", [](const ReducedModel& r) { return r.rom->model().primal_rank(); })
       .def_property_readonly("dictionary_size", [](const ReducedModel& r) { return r.rom->model().dictionary_size(); })

@@ -104,7 +104,7 @@ struct MethodArgs {
     }
     rom::OnlineSolverOptions o = rom::options_from_map(method, values);
     if (!values.count("tau")) o.tau = tau;
-    if (!values.count("tau_scaling")) o.tau_scaling = tau_scaling;
+    if (!values.count("tau_scaling")) rom::active_set_settings_table().read(o, "tau_scaling", tau_scaling, "--tau-scaling");
     if (!values.count("max_iterations")) o.max_iterations = max_iterations;
     return o;
   }

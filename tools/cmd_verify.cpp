@@ -62,7 +62,7 @@ std::string sci(double v) {
 std::vector<baselines::VerifyMethod> methods_of(const VerifyArgs& a) {
   rom::OnlineSolverOptions options;
   options.tau = a.tau;
-  options.tau_scaling = a.tau_scaling;
+  rom::active_set_settings_table().read(options, "tau_scaling", a.tau_scaling, "--tau-scaling");
   options.max_iterations = a.max_iterations;
   std::vector<baselines::VerifyMethod> out;
   for (const std::string& m : split_list(a.methods, "--method")) {

@@ -834,12 +834,13 @@ BOOST_AUTO_TEST_CASE(registry_and_timing) {
   } catch (const InputError& e) {
     BOOST_TEST(std::string(e.what()).find("greedy") != std::string::npos);
   }
-  rom::OnlineSolverOptions bad;
-  bad.tau_scaling = "logarithmic";
-  BOOST_CHECK_THROW(rom::make_online_solver("greedy", model, bad), InputError);
-  rom::register_online_solver("greedy-copy", [](const rom::ReducedModel& m, const rom::OnlineSolverOptions& o) {
-    return std::unique_ptr<rom::OnlineSolver>(std::make_unique<rom::GreedyActiveSet>(m, rom::greedy_options(o)));
-  });
+  BOOST_CHECK_THROW(rom::options_from_map("greedy", {{"tau_scaling", "logarithmic"}}), InputError);
+  rom::register_online_method(rom::make_online_method(
+      "greedy-copy", "a copy of greedy",
+      [](const rom::ReducedModel& m, const rom::OnlineSolverOptions& o) {
+        return std::unique_ptr<rom::OnlineSolver>(std::make_unique<rom::GreedyActiveSet>(m, rom::greedy_options(o)));
+      },
+      rom::greedy_option_table()));
   const auto names = rom::online_solver_names();
   BOOST_TEST((std::find(names.begin(), names.end(), "greedy-copy") != names.end()));
 
