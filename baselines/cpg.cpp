@@ -22,7 +22,7 @@ Eigen::MatrixXd scaled_snapshots(const Eigen::MatrixXd& snapshots, const Eigen::
 
 /// Errors of the scaled columns `a` on the cone of a[:, basis]; selected columns get 0.
 Eigen::VectorXd projection_errors_scaled(const Eigen::MatrixXd& a, const Eigen::VectorXd& norms,
-                                         const std::vector<int>& basis, const rom::NnlsOptions& options,
+                                         const std::vector<int>& basis, const NnlsOptions& options,
                                          Status* status) {
   const Eigen::Index m = a.cols();
   Eigen::VectorXd errors = Eigen::VectorXd::Zero(m);
@@ -33,7 +33,7 @@ Eigen::VectorXd projection_errors_scaled(const Eigen::MatrixXd& a, const Eigen::
     ab.col(static_cast<Eigen::Index>(i)) = a.col(basis[i]);
     selected[basis[i]] = 1;
   }
-  rom::Nnls nnls(options);
+  Nnls nnls(options);
   if (!basis.empty()) nnls.compute(ab);
   for (Eigen::Index j = 0; j < m; ++j) {
     if (selected[j] || norms(j) == 0.0) continue;  // exactly representable
@@ -62,7 +62,7 @@ double default_cpg_tolerance(const fom::Problem& problem) {
 }
 
 Eigen::VectorXd cone_projection_errors(const Eigen::MatrixXd& snapshots, const Eigen::VectorXd& weights,
-                                       const std::vector<int>& basis, const rom::NnlsOptions& nnls, Status* status) {
+                                       const std::vector<int>& basis, const NnlsOptions& nnls, Status* status) {
   const Eigen::MatrixXd a = scaled_snapshots(snapshots, weights);
   for (int p : basis)
     if (p < 0 || p >= a.cols())

@@ -15,7 +15,7 @@
 ///     every non-zero snapshot, so this is the greedy choice with the tie broken by
 ///     the norm);
 ///  2. project every snapshot on the cone {Wx : x ≥ 0} (NNLS in Gram form,
-///     rom::NnlsQp) and compute its relative projection error
+///     NnlsQp) and compute its relative projection error
 ///     \f$ e_j = \|\lambda_j - W x_j\| / \|\lambda_j\| \f$;
 ///  3. stop when \f$ \max_j e_j \le \f$ tolerance, else add the worst approximated
 ///     snapshot and go to 2.
@@ -49,8 +49,8 @@ struct CpgOptions {
   double tolerance = -1.0;
   /// Cap on the basis size; ≤ 0: no cap (at most every non-zero snapshot). Default 0.
   int max_size = 0;
-  /// Settings of the NNLS cone projections (default: those of rom::NnlsOptions).
-  rom::NnlsOptions nnls;
+  /// Settings of the NNLS cone projections (default: those of NnlsOptions).
+  NnlsOptions nnls;
 };
 
 /// \brief The problem's CPG tolerance: its file's `[rom] cpg_tolerance`, else 1e-2.
@@ -92,7 +92,7 @@ CpgBasis cone_projected_greedy(const Eigen::MatrixXd& snapshots, const Eigen::Ve
 /// greedy loop and by tests.
 /// \param status set to NumericalIssue if an NNLS projection failed (optional)
 Eigen::VectorXd cone_projection_errors(const Eigen::MatrixXd& snapshots, const Eigen::VectorXd& weights,
-                                       const std::vector<int>& basis, const rom::NnlsOptions& nnls = {},
+                                       const std::vector<int>& basis, const NnlsOptions& nnls = {},
                                        Status* status = nullptr);
 
 /// \brief The CPG online solver: ReducedActiveSet with W = the CPG basis built (in the

@@ -143,7 +143,7 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
   std::vector<int> active, next, solved;  // positions in W
   rom::SelectionHistory seen;             // active sets met on the current operators
   std::vector<char> in_active(mw, 0);
-  rom::NnlsQp nnls(m_options.nnls);
+  NnlsQp nnls(m_options.nnls);
   const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
   rom::OperatorClock operators(m_options.time_operators);
 

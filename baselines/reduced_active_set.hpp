@@ -46,7 +46,7 @@
 /// (measured in docs/baselines.md). `NonNegative` (default) solves the same system with
 /// the sign condition imposed, \f$ \min_{\hat\lambda_I \ge 0} \tfrac12
 /// \hat\lambda_I^T S \hat\lambda_I - (\hat C_I \hat K^{-1}\hat f - \hat g_I)^T
-/// \hat\lambda_I \f$ (rom::NnlsQp), i.e. "remove every negative" is done exactly inside
+/// \hat\lambda_I \f$ (NnlsQp), i.e. "remove every negative" is done exactly inside
 /// the solve; a column leaves I when its multiplier is zero and its constraint holds.
 /// For a fixed pairing the working set then only gains violated columns or loses
 /// inactive ones, so the iteration cannot cycle.
@@ -86,8 +86,8 @@ struct ReducedActiveSetOptions : rom::ActiveSetSettings {
   double singular_tolerance = 1e-13;
   /// Inner solve of the saddle-point system. Default InnerSolve::NonNegative.
   InnerSolve inner_solve = InnerSolve::NonNegative;
-  /// Settings of the NNLS inner solve (default: those of rom::NnlsOptions).
-  rom::NnlsOptions nnls;
+  /// Settings of the NNLS inner solve (default: those of NnlsOptions).
+  NnlsOptions nnls;
   /// Starting point: rom::WarmStart::Empty (default; û = K̂⁻¹f̂, as the paper ran the
   /// baselines); rom::WarmStart::Primal (û interpolated from the training snapshots
   /// around μ; the first active set is the set of columns violated there); or

@@ -336,7 +336,7 @@ struct GreedyActiveSet::Interleaved {
   SupportRows::RowsScratch rows;  // rows of C_R Φ_s shared by the selected columns
   std::vector<int> active, solved;  // the selection, and the one of the last solve
   std::vector<char> in_active;
-  fom::AndersonMixer mixer{0};  // of the rebuild point while the selection stays the same
+  AndersonMixer mixer{0};  // of the rebuild point while the selection stays the same
   SelectionHistory seen;     // selections of the query so far
   bool pending = false;  // settled in the sense of Alg. 1: to be confirmed at û's fresh pairing
   int removed = -1, added = -1;  // the last step's change (positions in `solved` / columns)
@@ -529,7 +529,7 @@ struct GreedyActiveSet::Nested {
   SupportRows::ResidualsScratch residuals_scratch;  // physically_converged
   std::vector<double> feasible;  // settle_exact: the non-negative multipliers of `cols`
   std::vector<int> blocked;      // settle_exact: columns not offered again on these operators
-  fom::AndersonMixer mixer{0};
+  AndersonMixer mixer{0};
   bool pending = false;  // settled: to be confirmed at the fresh pairing of û
   bool failed_test = false;  // fixed-point schedule: the last settled û failed the physical test
   bool finite = true;    // every solve so far gave finite values

@@ -68,7 +68,7 @@ std::vector<baselines::VerifyMethod> methods_of(const VerifyArgs& a) {
   for (const std::string& m : split_list(a.methods, "--method")) {
     (void)rom::online_method(m);  // unknown names are refused before the database is read
     rom::OnlineSolverOptions o = options;
-    if (m == "cpg" && a.cpg_tolerance >= 0.0) o.extra["cpg_tolerance"] = fom::format_number(a.cpg_tolerance);
+    if (m == "cpg" && a.cpg_tolerance >= 0.0) o.extra["cpg_tolerance"] = format_number(a.cpg_tolerance);
     if ((m == "cpg" || m == "full-dictionary") && !a.inner_solve.empty()) o.extra["inner_solve"] = a.inner_solve;
     if ((m == "greedy" || m == "greedy-nested" || m == "cpg" || m == "full-dictionary") && !a.init.empty())
       o.extra["init"] = a.init;
@@ -148,12 +148,12 @@ baselines::VerifyOptions verify_options(const VerifyArgs& a) {
 /// Progress bars on stderr, one per stage (label); finish() ends the last one.
 struct StageProgress {
   bool show;
-  std::unique_ptr<rom::ProgressBar> bar;
+  std::unique_ptr<ProgressBar> bar;
   std::string stage;
   void update(const std::string& label, int done, int total) {
     if (label != stage) {
       finish();
-      bar = std::make_unique<rom::ProgressBar>(std::cerr, "verify: " + label, show);
+      bar = std::make_unique<ProgressBar>(std::cerr, "verify: " + label, show);
       stage = label;
     }
     bar->update(done, total);

@@ -93,7 +93,7 @@ double reference_error(const MatrixXd& d, const VectorXd& w, const std::vector<i
   for (size_t i = 0; i < basis.size(); ++i) a.col(static_cast<Eigen::Index>(i)) = sw.asDiagonal() * d.col(basis[i]);
   const VectorXd b = sw.asDiagonal() * d.col(j);
   if (basis.empty()) return b.norm() > 0 ? 1.0 : 0.0;
-  rom::Nnls nnls;
+  Nnls nnls;
   nnls.compute(a);
   const VectorXd x = nnls.solve(b);
   return (b - a * x).norm() / b.norm();

@@ -63,7 +63,7 @@ VectorXd exact_reduced_solution(const rom::ReducedModel& model, const fom::Param
   const Eigen::LLT<MatrixXd> k(model.reduced_stiffness(mu));
   const VectorXd f_hat = model.reduced_rhs(mu);
   const MatrixXd z = k.solve(c_hat.transpose());
-  rom::NnlsQp qp;
+  NnlsQp qp;
   qp.compute(c_hat * z);
   const VectorXd lambda = qp.solve(c_hat * k.solve(f_hat) - g_hat);
   BOOST_TEST(qp.info() == Status::Success);

@@ -914,7 +914,7 @@ BOOST_AUTO_TEST_CASE(concurrent_queries_match_sequential_ones) {
   for (int i = 1; i <= 16; ++i) params.push_back(Eigen::VectorXd::Constant(1, 0.3 * (i - 0.3) / 16));
   std::vector<rom::OnlineResult> seq, par(params.size());
   for (const auto& mu : params) seq.push_back(greedy.solve(mu));
-  rom::parallel_for(static_cast<int>(params.size()), 2, [&](int i) { par[i] = greedy.solve(params[i]); });
+  parallel_for(static_cast<int>(params.size()), 2, [&](int i) { par[i] = greedy.solve(params[i]); });
   for (size_t i = 0; i < params.size(); ++i) {
     BOOST_TEST(par[i].selected == seq[i].selected, boost::test_tools::per_element());
     BOOST_TEST((par[i].u - seq[i].u).norm() == 0.0);
