@@ -488,7 +488,8 @@ const OptionTable<ConvexHullOptions>& convex_hull_option_table() {
         .number("basis_delta", &O::basis_delta, "energy tolerance of the SVD basis; < 0: delta of the model")
         .integer("rank_l", &O::rank_l, "random basis: number of combinations (0: rank of the SVD basis)", 0, 100000)
         .integer("seed", &O::seed, "random basis: seed of the generator", 0, 9e15)
-        .number("sum_weight", &O::sum_weight, "weight of the convexity row relative to the largest column norm")
+        .number("sum_weight", &O::sum_weight, "weight of the convexity row relative to the largest column norm",
+                Interval::greater_than(0))
         .flag("polish", &O::polish, "re-solve the simplex-constrained least squares on the support")
         .integer("max_pairing_iterations", &O::max_pairing_iterations, "cap of the pairing fixed point", 1, 1e6)
         .integer("selection_iterations", &O::selection_iterations,
