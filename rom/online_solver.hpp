@@ -2,8 +2,10 @@
 /// \file online_solver.hpp
 /// \brief The common interface of the online ROM methods (greedy active set,
 /// convex hull, CPG, full dictionary, ...): one query's result, the solver
-/// interface, the settings the methods share (and the parsing of their
-/// method-specific ones), and the clock of the contact-operator construction.
+/// interface, the settings given to a method by name (OnlineSolverOptions) and
+/// their reading into a method's options struct through its binding table
+/// (read_options(), rom/option_table.hpp), and the clock of the contact-operator
+/// construction.
 ///
 /// Methods are built by name through the registry (rom/online_methods.hpp) and
 /// evaluated against the FOM by rom/online_evaluation.hpp.
