@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include "fom/input_values.hpp"
@@ -485,7 +486,8 @@ const OptionTable<ConvexHullOptions>& convex_hull_option_table() {
     OptionTable<O> o;
     o.choice("basis", &O::basis, "projection basis: truncated SVD or random combinations",
              {{"svd", ProjectionBasis::Svd}, {"random", ProjectionBasis::Random}})
-        .number("basis_delta", &O::basis_delta, "energy tolerance of the SVD basis; < 0: delta of the model")
+        .number("basis_delta", &O::basis_delta, "energy tolerance of the SVD basis; < 0: delta of the model",
+                Interval{-std::numeric_limits<double>::infinity(), 1.0})
         .integer("rank_l", &O::rank_l, "random basis: number of combinations (0: rank of the SVD basis)", 0, 100000)
         .integer("seed", &O::seed, "random basis: seed of the generator", 0, 9e15)
         .number("sum_weight", &O::sum_weight, "weight of the convexity row relative to the largest column norm",
