@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace contactrom::baselines {
@@ -21,7 +22,7 @@ Eigen::MatrixXd scaled_snapshots(const Eigen::MatrixXd& snapshots, const Eigen::
 
 /// Errors of the scaled columns `a` on the cone of a[:, basis]; selected columns get 0.
 Eigen::VectorXd projection_errors_scaled(const Eigen::MatrixXd& a, const Eigen::VectorXd& norms,
-                                         const std::vector<int>& basis, const rom::NnlsOptions& options,
+                                         const std::vector<int>& basis, const NnlsOptions& options,
                                          Status* status) {
   const Eigen::Index m = a.cols();
   Eigen::VectorXd errors = Eigen::VectorXd::Zero(m);
@@ -32,7 +33,7 @@ Eigen::VectorXd projection_errors_scaled(const Eigen::MatrixXd& a, const Eigen::
     ab.col(static_cast<Eigen::Index>(i)) = a.col(basis[i]);
     selected[basis[i]] = 1;
   }
-  rom::Nnls nnls(options);
+  Nnls nnls(options);
   if (!basis.empty()) nnls.compute(ab);
   for (Eigen::Index j = 0; j < m; ++j) {
     if (selected[j] || norms(j) == 0.0) continue;  // exactly representable
@@ -61,7 +62,7 @@ double default_cpg_tolerance(const fom::Problem& problem) {
 }
 
 Eigen::VectorXd cone_projection_errors(const Eigen::MatrixXd& snapshots, const Eigen::VectorXd& weights,
-                                       const std::vector<int>& basis, const rom::NnlsOptions& nnls, Status* status) {
+                                       const std::vector<int>& basis, const NnlsOptions& nnls, Status* status) {
   const Eigen::MatrixXd a = scaled_snapshots(snapshots, weights);
   for (int p : basis)
     if (p < 0 || p >= a.cols())
@@ -124,26 +125,26 @@ CpgActiveSet::CpgActiveSet(const rom::ReducedModel& model, const CpgOptions& cpg
 CpgActiveSet::CpgActiveSet(CpgBasis&& basis, const rom::ReducedModel& model, const ReducedActiveSetOptions& options)
     : ReducedActiveSet("cpg", model, basis.columns, options), m_basis(std::move(basis)) {}
 
+const rom::OptionTable<CpgOptions>& cpg_option_table() {
+  static const rom::OptionTable<CpgOptions> t = [] {
+    rom::OptionTable<CpgOptions> o;
+    o.number("cpg_tolerance", &CpgOptions::tolerance,
+             "cone-projected greedy: worst relative projection error; < 0: the problem's [rom] cpg_tolerance, else "
+             "1e-2",
+             Interval{-std::numeric_limits<double>::infinity(), 1.0})
+        .integer("cpg_max_size", &CpgOptions::max_size, "cap on the CPG basis size (0: none)", 0, 1e9);
+    return o;
+  }();
+  return t;
+}
+
 CpgOptions cpg_options(const rom::OnlineSolverOptions& options) {
-  CpgOptions o;
-  if (const auto it = options.extra.find("cpg_tolerance"); it != options.extra.end()) {
-    o.tolerance = rom::parse_option_number("cpg", it->first, it->second);
-    if (!(o.tolerance >= 0.0 && o.tolerance <= 1.0))
-      throw InputError("option cpg_tolerance = '" + it->second + "' invalid; expected a value in [0, 1]");
-  }
-  if (const auto it = options.extra.find("cpg_max_size"); it != options.extra.end()) {
-    const double v = rom::parse_option_number("cpg", it->first, it->second);
-    if (!(v >= 0.0) || v != std::floor(v) || v > 1e9)
-      throw InputError("option cpg_max_size = '" + it->second + "' invalid; expected an integer >= 0");
-    o.max_size = static_cast<int>(v);
-  }
-  return o;
+  return rom::read_options(cpg_option_table(), options, "cpg", /*strict=*/false);
 }
 
 std::unique_ptr<rom::OnlineSolver> make_cpg_solver(const rom::ReducedModel& model,
                                                    const rom::OnlineSolverOptions& options) {
-  rom::check_extra_options(options, "cpg", {"cpg_tolerance", "cpg_max_size", "inner_solve", "init", "rebuild", "anderson_depth", "surface_step", "max_solves"});
-  return std::make_unique<CpgActiveSet>(model, cpg_options(options), reduced_active_set_options(options));
+  return std::make_unique<CpgActiveSet>(model, cpg_options(options), reduced_active_set_options(options, "cpg"));
 }
 
 }  // namespace contactrom::baselines

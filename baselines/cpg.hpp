@@ -15,7 +15,7 @@
 ///     every non-zero snapshot, so this is the greedy choice with the tie broken by
 ///     the norm);
 ///  2. project every snapshot on the cone {Wx : x ≥ 0} (NNLS in Gram form,
-///     rom::NnlsQp) and compute its relative projection error
+///     NnlsQp) and compute its relative projection error
 ///     \f$ e_j = \|\lambda_j - W x_j\| / \|\lambda_j\| \f$;
 ///  3. stop when \f$ \max_j e_j \le \f$ tolerance, else add the worst approximated
 ///     snapshot and go to 2.
@@ -49,8 +49,8 @@ struct CpgOptions {
   double tolerance = -1.0;
   /// Cap on the basis size; ≤ 0: no cap (at most every non-zero snapshot). Default 0.
   int max_size = 0;
-  /// Settings of the NNLS cone projections (default: those of rom::NnlsOptions).
-  rom::NnlsOptions nnls;
+  /// Settings of the NNLS cone projections (default: those of NnlsOptions).
+  NnlsOptions nnls;
 };
 
 /// \brief The problem's CPG tolerance: its file's `[rom] cpg_tolerance`, else 1e-2.
@@ -92,7 +92,7 @@ CpgBasis cone_projected_greedy(const Eigen::MatrixXd& snapshots, const Eigen::Ve
 /// greedy loop and by tests.
 /// \param status set to NumericalIssue if an NNLS projection failed (optional)
 Eigen::VectorXd cone_projection_errors(const Eigen::MatrixXd& snapshots, const Eigen::VectorXd& weights,
-                                       const std::vector<int>& basis, const rom::NnlsOptions& nnls = {},
+                                       const std::vector<int>& basis, const NnlsOptions& nnls = {},
                                        Status* status = nullptr);
 
 /// \brief The CPG online solver: ReducedActiveSet with W = the CPG basis built (in the
@@ -114,9 +114,13 @@ class CpgActiveSet final : public ReducedActiveSet {
 /// \brief Builds the CPG basis of a reduced model's dictionary (L²(Γc) norm).
 CpgBasis build_cpg_basis(const rom::ReducedModel& model, const CpgOptions& options = {});
 
-/// \brief Reads the CPG settings from OnlineSolverOptions::extra: "cpg_tolerance"
-/// (number in [0, 1]) and "cpg_max_size" (integer ≥ 0). \throws InputError naming
-/// the key and the value if one does not parse.
+/// \brief Binding table of CpgOptions: the options of `cpg` beyond the reduced
+/// active set's, declared once (rom/option_table.hpp).
+const rom::OptionTable<CpgOptions>& cpg_option_table();
+
+/// \brief `options` read through cpg_option_table() (rom::read_options()); other keys
+/// of `extra` are left to the reduced active set. \throws InputError naming the key
+/// and the value if one is malformed or out of range.
 CpgOptions cpg_options(const rom::OnlineSolverOptions& options);
 
 /// \brief Registry factory of "cpg".

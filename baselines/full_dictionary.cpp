@@ -16,8 +16,7 @@ FullDictionaryActiveSet::FullDictionaryActiveSet(const rom::ReducedModel& model,
 
 std::unique_ptr<rom::OnlineSolver> make_full_dictionary_solver(const rom::ReducedModel& model,
                                                                const rom::OnlineSolverOptions& options) {
-  rom::check_extra_options(options, "full-dictionary", {"inner_solve", "init", "rebuild", "anderson_depth", "surface_step", "max_solves"});
-  return std::make_unique<FullDictionaryActiveSet>(model, reduced_active_set_options(options));
+  return std::make_unique<FullDictionaryActiveSet>(model, reduced_active_set_options(options, "full-dictionary"));
 }
 
 }  // namespace contactrom::baselines

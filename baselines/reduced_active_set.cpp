@@ -15,40 +15,29 @@
 
 namespace contactrom::baselines {
 
-ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options) {
-  // The greedy's translation validates the shared fields; reuse it, not a copy.
-  rom::OnlineSolverOptions shared = options;
-  shared.extra.erase("init");  // read below: the baselines know fewer starting points
-  const rom::GreedyOptions g = rom::greedy_options(shared);
-  ReducedActiveSetOptions o;
-  if (const auto it = options.extra.find("init"); it != options.extra.end()) {
-    if (it->second == "empty")
-      o.init = rom::WarmStart::Empty;
-    else if (it->second == "primal")
-      o.init = rom::WarmStart::Primal;
-    else if (it->second == "cell")
-      o.init = rom::WarmStart::Cell;
-    else
-      throw InputError("option init = " + quoted(it->second, 200) + " unknown; expected empty, primal or cell");
-  }
-  o.tau = g.tau;
-  o.tau_scaling = g.tau_scaling;
-  o.max_iterations = g.max_iterations;
-  o.step_tolerance = g.step_tolerance;
-  o.time_operators = g.time_operators;
-  o.rebuild = g.rebuild;
-  o.anderson_depth = g.anderson_depth;
-  o.surface_step = g.surface_step;
-  o.max_solves = g.max_solves;
-  if (const auto it = options.extra.find("inner_solve"); it != options.extra.end()) {
-    if (it->second == "nonnegative")
-      o.inner_solve = InnerSolve::NonNegative;
-    else if (it->second == "equality")
-      o.inner_solve = InnerSolve::Equality;
-    else
-      throw InputError("option inner_solve = " + quoted(it->second, 200) + " unknown; expected nonnegative or equality");
-  }
-  return o;
+const rom::OptionTable<ReducedActiveSetOptions>& reduced_active_set_option_table() {
+  static const rom::OptionTable<ReducedActiveSetOptions> t = [] {
+    using O = ReducedActiveSetOptions;
+    rom::OptionTable<O> o;
+    o.include(rom::active_set_settings_table())
+        .choice("init", &O::init, "starting point: empty, primal or cell",
+                {{"empty", rom::WarmStart::Empty}, {"primal", rom::WarmStart::Primal}, {"cell", rom::WarmStart::Cell}})
+        .choice("inner_solve", &O::inner_solve, "saddle-point solve: nonnegative or equality (textbook PDAS)",
+                {{"nonnegative", InnerSolve::NonNegative}, {"equality", InnerSolve::Equality}})
+        .choice("rebuild", &O::rebuild, "contact operators rebuilt on the changed rows only (partial) or all (full)",
+                {{"partial", rom::OperatorRebuild::Partial}, {"full", rom::OperatorRebuild::Full}})
+        .integer("anderson_depth", &O::anderson_depth, "Anderson depth of the rebuild point (0: plain)", 0, 1e6)
+        .number("surface_step", &O::surface_step,
+                "largest move of the contact surface (units of U) between the operators' point and the answer",
+                Interval::greater_than(0))
+        .integer("max_solves", &O::max_solves, "cap on the saddle-point solves of a query", 1, 1e9);
+    return o;
+  }();
+  return t;
+}
+
+ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options, const std::string& method) {
+  return rom::read_options(reduced_active_set_option_table(), options, method, /*strict=*/false);
 }
 
 ReducedActiveSet::ReducedActiveSet(std::string name, const rom::ReducedModel& model, std::vector<int> dual_columns,
@@ -154,7 +143,7 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
   std::vector<int> active, next, solved;  // positions in W
   rom::SelectionHistory seen;             // active sets met on the current operators
   std::vector<char> in_active(mw, 0);
-  rom::NnlsQp nnls(m_options.nnls);
+  NnlsQp nnls(m_options.nnls);
   const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
   rom::OperatorClock operators(m_options.time_operators);
 
@@ -308,7 +297,5 @@ double reduced_penetration(const rom::ReducedModel& model, const std::vector<int
   for (int p : columns) worst = std::max(worst, model.dictionary().col(p).dot(v));
   return worst;
 }
-
-void register_baseline_online_solvers() { (void)baseline_online_methods(); }
 
 }  // namespace contactrom::baselines

@@ -46,7 +46,7 @@
 /// (measured in docs/baselines.md). `NonNegative` (default) solves the same system with
 /// the sign condition imposed, \f$ \min_{\hat\lambda_I \ge 0} \tfrac12
 /// \hat\lambda_I^T S \hat\lambda_I - (\hat C_I \hat K^{-1}\hat f - \hat g_I)^T
-/// \hat\lambda_I \f$ (rom::NnlsQp), i.e. "remove every negative" is done exactly inside
+/// \hat\lambda_I \f$ (NnlsQp), i.e. "remove every negative" is done exactly inside
 /// the solve; a column leaves I when its multiplier is zero and its constraint holds.
 /// For a fixed pairing the working set then only gains violated columns or loses
 /// inactive ones, so the iteration cannot cycle.
@@ -75,29 +75,19 @@ enum class InnerSolve {
   Equality      ///< textbook PDAS: equality solve, negatives removed afterwards
 };
 
-/// \brief Settings of ReducedActiveSet (documented defaults; tau … step_tolerance have
-/// the same meaning as in rom::GreedyOptions).
-struct ReducedActiveSetOptions {
-  /// Penetration threshold τ of the reduced constraint; < 0: τ = δ of the model. Default −1.
-  double tau = -1.0;
-  /// Absolute (paper, default) or relative threshold, as for the greedy.
-  rom::TauScaling tau_scaling = rom::TauScaling::Absolute;
-  /// Cap on the operator rebuilds (k_max). Default 50.
-  int max_iterations = 50;
-  /// Unused: the loop's step test is surface_step (kept so that the generic option
-  /// step_tolerance is accepted as for every active set). Default 1e-5.
-  double step_tolerance = 1e-5;
+/// \brief Settings of ReducedActiveSet (documented defaults). τ, its scaling, the cap
+/// on the operator rebuilds (max_iterations) and the operator clock are the
+/// rom::ActiveSetSettings of every active-set method; step_tolerance is accepted but
+/// unused (the loop's step test is surface_step).
+struct ReducedActiveSetOptions : rom::ActiveSetSettings {
   /// Reciprocal condition estimate of the Schur complement's LDLᵀ under which the
   /// system is solved in the least-squares, minimum-norm sense (dependent rows, e.g.
   /// more active columns than primal modes). Default 1e-13.
   double singular_tolerance = 1e-13;
   /// Inner solve of the saddle-point system. Default InnerSolve::NonNegative.
   InnerSolve inner_solve = InnerSolve::NonNegative;
-  /// Settings of the NNLS inner solve (default: those of rom::NnlsOptions).
-  rom::NnlsOptions nnls;
-  /// Measure OnlineResult::operator_time_s (see rom::OnlineSolverOptions::time_operators).
-  /// Default false.
-  bool time_operators = false;
+  /// Settings of the NNLS inner solve (default: those of NnlsOptions).
+  NnlsOptions nnls;
   /// Starting point: rom::WarmStart::Empty (default; û = K̂⁻¹f̂, as the paper ran the
   /// baselines); rom::WarmStart::Primal (û interpolated from the training snapshots
   /// around μ; the first active set is the set of columns violated there); or
@@ -121,12 +111,16 @@ struct ReducedActiveSetOptions {
   int max_solves = 1000;
 };
 
-/// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
-/// step_tolerance, time_operators, `extra["rebuild"]`; validated as for the greedy),
-/// `extra["inner_solve"]` ("nonnegative" or "equality") and `extra["init"]` ("empty",
-/// "primal" or "cell").
-/// \throws InputError on bad values.
-ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options);
+/// \brief Binding table of ReducedActiveSetOptions: the options `cpg` and
+/// `full-dictionary` share, declared once (rom/option_table.hpp).
+const rom::OptionTable<ReducedActiveSetOptions>& reduced_active_set_option_table();
+
+/// \brief `options` read through reduced_active_set_option_table()
+/// (rom::read_options()); keys of `extra` it does not declare are left to the
+/// method's other tables. \throws InputError on bad values.
+/// \param method named in messages
+ReducedActiveSetOptions reduced_active_set_options(const rom::OnlineSolverOptions& options,
+                                                   const std::string& method = "full-dictionary");
 
 /// \brief Primal–dual active-set online solver with dual basis W = D_d[:, columns];
 /// see the file comment.
@@ -177,10 +171,5 @@ class ReducedActiveSet : public rom::OnlineSolver {
 /// `u` (as fom::kkt_residuals does). Returns −∞ for an empty column list.
 double reduced_penetration(const rom::ReducedModel& model, const std::vector<int>& columns,
                            const Eigen::VectorXd& u);
-
-/// \brief Registers "cpg" and "full-dictionary" (idempotent). Not needed: linking
-/// contactrom::baselines registers them (baselines/online_methods.hpp); kept for
-/// programs written before.
-void register_baseline_online_solvers();
 
 }  // namespace contactrom::baselines

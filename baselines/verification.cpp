@@ -54,7 +54,7 @@ void describe_constraint(const rom::OnlineSolver& solver, const rom::OnlineSolve
 void solve_references(const fom::FullOrderSolver& solver, const fom::Problem& problem, const VerifyOptions& o,
                       VerifyReport& r) {
   const int n = static_cast<int>(r.params.size());
-  rom::parallel_for(
+  parallel_for(
       n, o.threads,
       [&](int i) {
         r.references[i] = solver.solve(r.params[i]);
@@ -195,29 +195,29 @@ void write_verify_csv(const std::string& path, const fom::Problem& problem, cons
            "complementarity,reduced_penetration,tau,converged,status,iterations,sparsity,time_s\n";
     auto params_text = [&](size_t i) {
       std::string s;
-      for (int k = 0; k < r.params[i].size(); ++k) s += fom::format_number(r.params[i](k)) + ",";
+      for (int k = 0; k < r.params[i].size(); ++k) s += format_number(r.params[i](k)) + ",";
       return s;
     };
     auto kkt_text = [](const fom::KktResiduals& k) {
-      return fom::format_number(k.stationarity) + ',' + fom::format_number(k.penetration) + ',' +
-             fom::format_number(k.negative_pressure) + ',' + fom::format_number(k.complementarity);
+      return format_number(k.stationarity) + ',' + format_number(k.penetration) + ',' +
+             format_number(k.negative_pressure) + ',' + format_number(k.complementarity);
     };
     for (size_t i = 0; i < r.params.size(); ++i) {
       const fom::FomSolution& ref = r.references[i];
       out << r.reference << ',' << params_text(i) << "0,0,relative,0," << kkt_text(r.reference_reports[i].kkt) << ",,,"
           << (ref.status == Status::Success ? 1 : 0) << ',' << to_string(ref.status) << ',' << ref.iterations << ','
-          << ref.active << ',' << fom::format_number(ref.time_s) << '\n';
+          << ref.active << ',' << format_number(ref.time_s) << '\n';
     }
     for (const MethodVerification& m : r.methods)
       for (size_t i = 0; i < r.params.size(); ++i) {
         const VerifyRow& row = m.rows[i];
         const fom::ReferenceErrors& e = row.errors;
-        out << m.name << ',' << params_text(i) << fom::format_number(e.primal) << ',' << fom::format_number(e.dual)
+        out << m.name << ',' << params_text(i) << format_number(e.primal) << ',' << format_number(e.dual)
             << ',' << (e.absolute ? "absolute" : "relative") << ',' << row.report.errors.active_set_differences << ','
             << kkt_text(row.report.kkt) << ','
-            << fom::format_number(row.reduced_penetration) << ',' << fom::format_number(m.tau) << ','
+            << format_number(row.reduced_penetration) << ',' << format_number(m.tau) << ','
             << (row.converged ? 1 : 0) << ',' << to_string(row.status) << ',' << row.iterations << ','
-            << row.sparsity << ',' << fom::format_number(row.time_s) << '\n';
+            << row.sparsity << ',' << format_number(row.time_s) << '\n';
       }
   });
 }

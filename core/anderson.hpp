@@ -56,8 +56,5 @@ class AndersonMixer {
   Eigen::LDLT<Eigen::MatrixXd> m_ldlt;
 };
 
-namespace fom {
-using contactrom::AndersonMixer;  // the name it had when it lived in fom/
-}  // namespace fom
 
 }  // namespace contactrom

@@ -21,8 +21,5 @@ std::string join(const std::vector<std::string>& items, const std::string& separ
 /// and marked with "... (N bytes)".
 std::string quoted(const std::string& text, std::size_t max_length = 80);
 
-namespace fom {
-using contactrom::format_number;  // the name it had when it lived in fom/parameter_space.hpp
-}  // namespace fom
 
 }  // namespace contactrom

@@ -229,12 +229,5 @@ class Nnls {
   Status m_info = Status::InvalidInput;
 };
 
-namespace rom {
-using contactrom::gram_matrix;  // the names they had when they lived in rom/nnls.hpp
-using contactrom::GramCholesky;
-using contactrom::Nnls;
-using contactrom::NnlsOptions;
-using contactrom::NnlsQp;
-}  // namespace rom
 
 }  // namespace contactrom

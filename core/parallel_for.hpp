@@ -20,10 +20,5 @@ void parallel_for(int n, int threads, const std::function<void(int)>& task, cons
 /// \brief Number of worker threads `requested` resolves to (≤ 0: hardware concurrency, at least 1).
 int resolve_threads(int requested);
 
-namespace rom {
-using contactrom::parallel_for;  // the names they had when they lived in rom/offline.hpp
-using contactrom::ProgressCallback;
-using contactrom::resolve_threads;
-}  // namespace rom
 
 }  // namespace contactrom

@@ -27,8 +27,5 @@ class ProgressBar {
   std::chrono::steady_clock::time_point m_start, m_last;
 };
 
-namespace rom {
-using contactrom::ProgressBar;  // the name it had when it lived in rom/offline.hpp
-}  // namespace rom
 
 }  // namespace contactrom

@@ -227,25 +227,15 @@ ActiveSetSolver::ActiveSetSolver(const Problem& problem, ActiveSetOptions option
   }
   m_constant = std::make_unique<Condensation>();
   Param mid = 0.5 * (problem.param_lower() + problem.param_upper());
-  m_constant_ok = condense(problem, mid, *m_constant);
   // A stiffness that cannot be factorised is a problem definition error (a body
   // held by nothing), not a numerical accident of one query.
-  if (!m_constant_ok) throw InputError(singular_stiffness_message(problem));
+  if (!condense(problem, mid, *m_constant)) throw InputError(singular_stiffness_message(problem));
   m_setup_time = seconds_since(t0);
 }
 
 FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) const {
   m_problem.check_param(mu);
-  if (m_constant) {
-    if (!m_constant_ok) {
-      FomSolution s;
-      s.mu = mu;
-      s.status = Status::NumericalIssue;
-      s.message = "Cholesky factorisation of the stiffness failed (matrix not positive definite)";
-      return s;
-    }
-    return solve_with(*m_constant, mu, warm);
-  }
+  if (m_constant) return solve_with(*m_constant, mu, warm);
   const auto t0 = std::chrono::steady_clock::now();
   Condensation cond;
   if (!condense(m_problem, mu, cond, m_order.empty() ? nullptr : &m_order)) {

@@ -162,7 +162,6 @@ class ActiveSetSolver final : public FullOrderSolver {
   ActiveSetOptions m_options;
   std::unique_ptr<Condensation> m_constant;  // set when K does not depend on μ
   std::vector<int> m_order;  // otherwise: elimination order reused by every query's factorisation
-  bool m_constant_ok = true;
   double m_setup_time = 0.0;
 };
 

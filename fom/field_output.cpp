@@ -122,13 +122,6 @@ FileWriter surface_csv_writer(const Problem& problem, const Eigen::VectorXd& u, 
 
 }  // namespace
 
-void ensure_directory(const std::string& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir))
-    throw InputError("cannot create output folder " + quoted(dir, 200) + ": " + (ec ? ec.message() : "not a folder"));
-}
-
 void write_vtu(const std::string& path, const Problem& problem, const Param& mu, const Eigen::VectorXd& u,
                const Eigen::VectorXd& lambda) {
   write_file_atomically(path, vtu_writer(problem, mu, u, lambda));

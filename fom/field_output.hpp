@@ -53,7 +53,4 @@ struct FieldSet {
 void write_field_sets(const std::string& dir, const Problem& problem, const std::vector<FieldSet>& sets,
                       const std::vector<std::pair<std::string, FileWriter>>& extra = {});
 
-/// \brief Creates `dir` (and parents) if needed; throws InputError naming it on failure.
-void ensure_directory(const std::string& dir);
-
 }  // namespace contactrom::fom

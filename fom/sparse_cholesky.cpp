@@ -197,11 +197,6 @@ SparseCholesky& SparseCholesky::compute(const Eigen::SparseMatrix<double>& a, co
   return *this;
 }
 
-long SparseCholesky::factor_nonzeros() const {
-  if (!m_impl || !m_impl->factor) return 0;
-  return static_cast<long>(m_impl->factor->xsize);
-}
-
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
   if (m_info != Status::Success || b.rows() != m_n) return Eigen::MatrixXd();
   // A workspace per call: CHOLMOD keeps counters and scratch space in its common

@@ -58,8 +58,6 @@ class SparseCholesky {
   int size() const { return m_n; }
   /// Size of the trailing set `last` of compute().
   int trailing_size() const { return m_trailing; }
-  /// Non-zeros of the factor L (supernodal storage, zeros of the supernodes included).
-  long factor_nonzeros() const;
 
   /// \brief \f$ A^{-1} b \f$ for one or several right-hand sides (n x k).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;

@@ -239,7 +239,7 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
             const std::vector<fom::Param> ps = to_params(*s.problem, params);
             std::vector<FomResult> out(ps.size());
             py::gil_scoped_release release;
-            rom::parallel_for(static_cast<int>(ps.size()), threads,
+            parallel_for(static_cast<int>(ps.size()), threads,
                               [&](int i) { out[i] = finish(*s.problem, s.solve(ps[i])); });
             return out;
           },

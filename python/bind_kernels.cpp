@@ -81,10 +81,10 @@ void bind_kernels(py::module_& m) {
       "nnls",
       [](const Eigen::MatrixXd& a, const Eigen::VectorXd& b, int max_iterations, double tolerance) {
         check_system("nnls", a, b, "A", "b");
-        rom::NnlsOptions o;
+        NnlsOptions o;
         o.max_iterations = max_iterations;
         o.tolerance = tolerance;
-        rom::Nnls solver(o);
+        Nnls solver(o);
         return run(solver, [&] { return solver.compute(a).solve(b); });
       },
       py::arg("A"), py::arg("b"), py::arg("max_iterations") = 0, py::arg("tolerance") = 1e-12,

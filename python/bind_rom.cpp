@@ -25,7 +25,7 @@ std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, doub
                                                   const py::dict& options, const std::string& lifting,
                                                   bool include_failed) {
   if (!(delta >= 0.0 && delta <= 1.0))
-    throw InputError("delta = " + fom::format_number(delta) + " is outside [0, 1]; expected a POD tolerance such as 1e-8");
+    throw InputError("delta = " + format_number(delta) + " is outside [0, 1]; expected a POD tolerance such as 1e-8");
   rom::check_online_method(method);
   std::map<std::string, std::string> values;
   for (const auto& [key, value] : options) values[py::str(key)] = option_text(value);
@@ -42,7 +42,7 @@ std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, doub
   }
   if (r->rom->model().primal_rank() == 0 &&
       PyErr_WarnEx(PyExc_RuntimeWarning,
-                   ("ReducedModel: delta " + fom::format_number(delta) +
+                   ("ReducedModel: delta " + format_number(delta) +
                     " keeps no POD mode; the reduced displacement is the offset alone")
                        .c_str(),
                    1) != 0)
@@ -363,8 +363,10 @@ not succeed. ValueError names the argument for a bad value.)doc")
           },
           "The snapshot database it was built from (None when loaded from a file).")
       .def_property_readonly("method", [](const ReducedModel& r) { return r.rom->method(); })
-      .def_property_readonly("options", [](const ReducedModel& r) { return rom::options_to_map(r.rom->method(), r.rom->options()); },
-                             "The method's settings as text, as stored in the reduced-model file.")
+      .def_property_readonly(
+          "options", [](const ReducedModel& r) { return rom::options_to_values(r.rom->method(), r.rom->options()); },
+          "Every setting of the method (defaults filled in), as stored in the reduced-model file: numbers as "
+          "int or float, flags as bool, choices as str.")
       .def_property_readonly("delta", [](const ReducedModel& r) { return r.rom->model().delta(); })
       .def_property_readonly("primal_rank", [](const ReducedModel& r) { return r.rom->model().primal_rank(); })
       .def_property_readonly("dictionary_size", [](const ReducedModel& r) { return r.rom->model().dictionary_size(); })
@@ -395,7 +397,7 @@ not succeed. ValueError names the argument for a bad value.)doc")
           [](const ReducedModel& r, double primal_tolerance, double dual_tolerance) {
             if (!(primal_tolerance > 0.0) || !(dual_tolerance > 0.0))
               throw InputError("with_fallback: tolerances must be positive numbers, got " +
-                               fom::format_number(primal_tolerance) + " and " + fom::format_number(dual_tolerance));
+                               format_number(primal_tolerance) + " and " + format_number(dual_tolerance));
             rom::FallbackOptions o;
             o.primal_tolerance = primal_tolerance;
             o.dual_tolerance = dual_tolerance;

@@ -17,7 +17,7 @@ namespace {
 // CLI's for the same numbers.
 fom::Param checked_param(const fom::Problem& problem, const double* values, py::ssize_t n) {
   std::string text;
-  for (py::ssize_t i = 0; i < n; ++i) text += (i ? "," : "") + fom::format_number(values[i]);
+  for (py::ssize_t i = 0; i < n; ++i) text += (i ? "," : "") + format_number(values[i]);
   return parse_problem_param(problem, text);
 }
 }  // namespace
@@ -69,7 +69,7 @@ void check_vector(const Eigen::VectorXd& v, const char* name, Eigen::Index size,
                      std::to_string(size) + " (" + what + ")");
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!std::isfinite(v(i)))
-      throw InputError(std::string(name) + "[" + std::to_string(i) + "] is " + fom::format_number(v(i)) +
+      throw InputError(std::string(name) + "[" + std::to_string(i) + "] is " + format_number(v(i)) +
                        "; expected finite numbers");
 }
 
@@ -111,7 +111,7 @@ py::dict kkt_dict(const fom::KktResiduals& k) {
 std::string option_text(py::handle value) {
   if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
   if (py::isinstance<py::int_>(value)) return py::str(value);
-  if (py::isinstance<py::float_>(value)) return fom::format_number(value.cast<double>());
+  if (py::isinstance<py::float_>(value)) return format_number(value.cast<double>());
   if (py::isinstance<py::str>(value)) return value.cast<std::string>();
   throw InputError("option value " + std::string(py::str(py::repr(value))) +
                    " is not a number, a string or a bool");

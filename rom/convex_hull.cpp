@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include "fom/input_values.hpp"
@@ -38,14 +39,6 @@ std::vector<Index> nonzeros(const VectorXd& v) {
   for (Index i = 0; i < v.size(); ++i)
     if (v(i) != 0.0) out.push_back(i);
   return out;
-}
-
-double parse_double(const std::string& key, const std::string& text) {
-  return parse_option_number("convex-hull", key, text);
-}
-
-long long parse_integer(const std::string& key, const std::string& text) {
-  return parse_option_integer("convex-hull", key, text);
 }
 
 /// One solve of the projected problem for a fixed contact operator.
@@ -487,68 +480,45 @@ ConvexHullResult ConvexHullSolver::run(const fom::Param& mu) const {
   return res;
 }
 
+const OptionTable<ConvexHullOptions>& convex_hull_option_table() {
+  static const OptionTable<ConvexHullOptions> t = [] {
+    using O = ConvexHullOptions;
+    OptionTable<O> o;
+    o.choice("basis", &O::basis, "projection basis: truncated SVD or random combinations",
+             {{"svd", ProjectionBasis::Svd}, {"random", ProjectionBasis::Random}})
+        .number("basis_delta", &O::basis_delta, "energy tolerance of the SVD basis; < 0: delta of the model",
+                Interval{-std::numeric_limits<double>::infinity(), 1.0})
+        .integer("rank_l", &O::rank_l, "random basis: number of combinations (0: rank of the SVD basis)", 0, 100000)
+        .integer("seed", &O::seed, "random basis: seed of the generator", 0, 9e15)
+        .number("sum_weight", &O::sum_weight, "weight of the convexity row relative to the largest column norm",
+                Interval::greater_than(0))
+        .flag("polish", &O::polish, "re-solve the simplex-constrained least squares on the support")
+        .integer("max_pairing_iterations", &O::max_pairing_iterations, "cap of the pairing fixed point", 1, 1e6)
+        .integer("selection_iterations", &O::selection_iterations,
+                 "pairing loop: full nnFOCUSS solves before the support is frozen", 1, 1e6)
+        .integer("anderson_depth", &O::anderson_depth,
+                 "Anderson depth of the pairing fixed point (on the surface displacement)", 0, 100)
+        .number("pairing_tolerance", &O::pairing_tolerance,
+                "pairing fixed point: largest relative change of contact forces and gaps on re-pairing")
+        .number("residual_tolerance", &O::residual_tolerance,
+                "largest relative projected residual reported as success", Interval::at_least(0))
+        .integer("focuss_max_iterations", [](auto& c) -> auto& { return c.focuss.max_iterations; },
+                 "nnFOCUSS iteration cap", 1, 1e6)
+        .number("focuss_tolerance", [](auto& c) -> auto& { return c.focuss.tolerance; },
+                "nnFOCUSS stopping tolerance")
+        .number("prune_tolerance", [](auto& c) -> auto& { return c.focuss.prune_tolerance; },
+                "nnFOCUSS pruning threshold");
+    return o;
+  }();
+  return t;
+}
+
 ConvexHullOptions convex_hull_options(const OnlineSolverOptions& options) {
-  ConvexHullOptions o;
-  for (const auto& [key, value] : options.extra) {
-    if (key == "basis") {
-      if (value == "svd")
-        o.basis = ProjectionBasis::Svd;
-      else if (value == "random")
-        o.basis = ProjectionBasis::Random;
-      else
-        throw InputError("convex-hull basis " + quoted(value, 200) + " unknown; expected svd or random");
-    } else if (key == "basis_delta") {
-      o.basis_delta = parse_double(key, value);
-    } else if (key == "rank_l") {
-      const long long l = parse_integer(key, value);
-      if (l < 1 || l > 100000) throw InputError("convex-hull rank_l = " + value + " invalid; expected 1..100000");
-      o.rank_l = static_cast<int>(l);
-    } else if (key == "seed") {
-      const long long s = parse_integer(key, value);
-      if (s < 0) throw InputError("convex-hull seed = " + value + " invalid; expected >= 0");
-      o.seed = static_cast<std::uint64_t>(s);
-    } else if (key == "sum_weight") {
-      o.sum_weight = parse_double(key, value);
-    } else if (key == "polish") {
-      if (value == "1" || value == "true")
-        o.polish = true;
-      else if (value == "0" || value == "false")
-        o.polish = false;
-      else
-        throw InputError("convex-hull polish = " + quoted(value, 200) + " invalid; expected 0, 1, true or false");
-    } else if (key == "max_pairing_iterations") {
-      o.max_pairing_iterations = static_cast<int>(std::clamp(parse_integer(key, value), -1LL, 1000000LL));
-    } else if (key == "selection_iterations") {
-      o.selection_iterations = static_cast<int>(std::clamp(parse_integer(key, value), -1LL, 1000000LL));
-    } else if (key == "anderson_depth") {
-      o.anderson_depth = static_cast<int>(std::clamp(parse_integer(key, value), 0LL, 100LL));
-    } else if (key == "pairing_tolerance") {
-      o.pairing_tolerance = parse_double(key, value);
-    } else if (key == "focuss_max_iterations") {
-      const long long n = parse_integer(key, value);
-      if (n < 1 || n > 1000000) throw InputError("convex-hull focuss_max_iterations = " + value + " invalid; expected >= 1");
-      o.focuss.max_iterations = static_cast<int>(n);
-    } else if (key == "residual_tolerance") {
-      o.residual_tolerance = parse_number(value, "convex-hull option residual_tolerance", Interval::at_least(0));
-    } else if (key == "focuss_tolerance") {
-      o.focuss.tolerance = parse_double(key, value);
-    } else if (key == "prune_tolerance") {
-      o.focuss.prune_tolerance = parse_double(key, value);
-    } else {
-      throw InputError("convex-hull option '" + key +
-                       "' unknown; expected basis, basis_delta, rank_l, seed, sum_weight, polish, "
-                       "max_pairing_iterations, selection_iterations, anderson_depth, pairing_tolerance, residual_tolerance, "
-                       "focuss_max_iterations, focuss_tolerance or "
-                       "prune_tolerance");
-    }
-  }
-  return o;
+  return read_options(convex_hull_option_table(), options, "convex-hull");
 }
 
 std::unique_ptr<OnlineSolver> make_convex_hull_solver(const ReducedModel& model, const OnlineSolverOptions& options) {
   return std::make_unique<ConvexHullSolver>(model, convex_hull_options(options));
 }
-
-void register_convex_hull_solver() { register_online_solver("convex-hull", make_convex_hull_solver); }
 
 }  // namespace contactrom::rom

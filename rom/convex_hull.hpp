@@ -246,21 +246,17 @@ class ConvexHullSolver final : public OnlineSolver {
   MonolithicDictionary m_dictionary;
 };
 
-/// \brief Reads the convex-hull settings from OnlineSolverOptions::extra: "basis"
-/// (svd|random), "basis_delta", "rank_l", "seed", "sum_weight", "polish" (0|1|true|false),
-/// "max_pairing_iterations", "selection_iterations", "anderson_depth", "pairing_tolerance", "focuss_max_iterations",
-/// "focuss_tolerance", "prune_tolerance". The generic fields (tau, max_iterations,
-/// ...) belong to the greedy method and are ignored.
-/// \throws InputError for an unknown key or a malformed value.
+/// \brief Binding table of ConvexHullOptions: every option of the method
+/// `convex-hull`, declared once (rom/option_table.hpp).
+const OptionTable<ConvexHullOptions>& convex_hull_option_table();
+
+/// \brief `options` read through convex_hull_option_table() (read_options()); the
+/// active-set settings (tau, max_iterations, ...) are not the convex hull's and are
+/// ignored. \throws InputError for an unknown key or a value outside its declaration.
 ConvexHullOptions convex_hull_options(const OnlineSolverOptions& options);
 
 /// \brief Factory of the registry entry "convex-hull": ConvexHullSolver with
 /// convex_hull_options(options). \throws InputError as ConvexHullSolver.
 std::unique_ptr<OnlineSolver> make_convex_hull_solver(const ReducedModel& model, const OnlineSolverOptions& options);
-
-/// \brief Registers "convex-hull" with the online-solver registry (idempotent).
-/// The CLI calls it from a static registrar in tools/cmd_chls.cpp; tests call it
-/// directly.
-void register_convex_hull_solver();
 
 }  // namespace contactrom::rom

@@ -86,8 +86,8 @@ void write_chls_csv(const std::string& path, const SnapshotDatabase& db, const D
     out << "chls_error,status,iterations,support\n";
     for (std::size_t k = 0; k < c.snapshots.size(); ++k) {
       const fom::Param mu = db.parameter(c.snapshots[k]);
-      for (Eigen::Index i = 0; i < mu.size(); ++i) out << fom::format_number(mu(i)) << ',';
-      out << fom::format_number(c.result.errors(static_cast<Eigen::Index>(k))) << ',' << to_string(c.result.status[k])
+      for (Eigen::Index i = 0; i < mu.size(); ++i) out << format_number(mu(i)) << ',';
+      out << format_number(c.result.errors(static_cast<Eigen::Index>(k))) << ',' << to_string(c.result.status[k])
           << ',' << c.result.iterations[k] << ',';
       const std::vector<int> support = c.support(k);
       for (std::size_t j = 0; j < support.size(); ++j) out << (j ? " " : "") << support[j];
@@ -146,7 +146,7 @@ void write_hull_report_csv(const std::string& path, const ConvexHullSolver& solv
     std::string s;
     for (std::size_t k = 0; k < on.selected.size(); ++k) {
       s += k ? " " : "";
-      s += coefficients ? fom::format_number(on.coefficients(static_cast<Eigen::Index>(k)))
+      s += coefficients ? format_number(on.coefficients(static_cast<Eigen::Index>(k)))
                         : std::to_string(model.dictionary_snapshots()[static_cast<std::size_t>(on.selected[k])]);
     }
     return s;
@@ -158,15 +158,15 @@ void write_hull_report_csv(const std::string& path, const ConvexHullSolver& solv
            "converged,status,time_s,selected,coefficients\n";
     for (const HullReportRow& row : report.rows) {
       const OnlineResult& on = row.result.online;
-      for (Eigen::Index k = 0; k < row.mu.size(); ++k) out << fom::format_number(row.mu(k)) << ',';
-      out << fom::format_number(row.primal_error) << ',' << fom::format_number(row.dual_error) << ','
+      for (Eigen::Index k = 0; k < row.mu.size(); ++k) out << format_number(row.mu(k)) << ',';
+      out << format_number(row.primal_error) << ',' << format_number(row.dual_error) << ','
           << (row.absolute_errors ? "absolute" : "relative") << ',' << on.selected.size()
-          << ',' << fom::format_number(row.result.sum_violation) << ',' << fom::format_number(row.kkt.penetration) << ','
-          << fom::format_number(row.penetration_abs) << ',' << fom::format_number(row.kkt.complementarity) << ','
-          << fom::format_number(row.complementarity_abs) << ',' << fom::format_number(row.kkt.stationarity) << ','
-          << fom::format_number(row.kkt.negative_pressure) << ',' << fom::format_number(row.result.projected_residual) << ','
+          << ',' << format_number(row.result.sum_violation) << ',' << format_number(row.kkt.penetration) << ','
+          << format_number(row.penetration_abs) << ',' << format_number(row.kkt.complementarity) << ','
+          << format_number(row.complementarity_abs) << ',' << format_number(row.kkt.stationarity) << ','
+          << format_number(row.kkt.negative_pressure) << ',' << format_number(row.result.projected_residual) << ','
           << on.iterations << ',' << row.result.pairing_iterations << ',' << (on.converged ? 1 : 0) << ','
-          << to_string(on.status) << ',' << fom::format_number(on.time_s) << ',' << selected_text(on, false) << ','
+          << to_string(on.status) << ',' << format_number(on.time_s) << ',' << selected_text(on, false) << ','
           << selected_text(on, true) << '\n';
     }
   });

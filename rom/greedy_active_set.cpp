@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <initializer_list>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -16,27 +15,6 @@
 namespace contactrom::rom {
 
 namespace {
-
-/// Integer greedy setting `key` = `value`, at least `minimum`.
-int greedy_int_option(const std::string& key, const std::string& value, int minimum) {
-  const long long v = parse_option_integer("greedy", key, value);
-  if (v < minimum || v > 1000000000)
-    throw InputError("greedy option " + key + " = '" + value + "' invalid; expected an integer >= " +
-                     std::to_string(minimum));
-  return static_cast<int>(v);
-}
-
-/// Greedy setting `key` = `value`, one of the named `choices`.
-template <class T>
-T greedy_choice(const std::string& key, const std::string& value,
-                std::initializer_list<std::pair<const char*, T>> choices) {
-  std::string names;
-  for (const auto& [name, v] : choices) {
-    if (value == name) return v;
-    names += (names.empty() ? "" : " or ") + std::string(name);
-  }
-  throw InputError("greedy option " + key + " = '" + value + "' unknown; expected " + names);
-}
 
 /// Alg. 1's elimination: position of the most negative multiplier, −1 if none is.
 int most_negative(const Eigen::Ref<const Eigen::VectorXd>& lambda) {
@@ -67,14 +45,6 @@ bool revisits(SelectionHistory& seen, const std::vector<int>& before, const std:
 
 }  // namespace
 
-WarmStart parse_warm_start(const std::string& method, const std::string& text) {
-  if (text == "empty") return WarmStart::Empty;
-  if (text == "cell") return WarmStart::Cell;
-  if (text == "nearest") return WarmStart::Nearest;
-  if (text == "primal") return WarmStart::Primal;
-  throw InputError(method + " option init = '" + text + "' unknown; expected empty, cell, nearest or primal");
-}
-
 void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Param& mu,
                       const Eigen::VectorXd& u_free, std::vector<int>& columns, Eigen::VectorXd& u_hat,
                       int* nearest) {
@@ -98,48 +68,46 @@ void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Para
   for (const auto& s : stencil) u_hat.noalias() += s.weight * coords.col(s.column);
 }
 
+const OptionTable<GreedyOptions>& greedy_option_table() {
+  static const OptionTable<GreedyOptions> t = [] {
+    OptionTable<GreedyOptions> o;
+    o.include(active_set_settings_table())
+        .choice("init", &GreedyOptions::init, "starting point: empty (paper Alg. 1), cell, nearest or primal",
+                {{"empty", WarmStart::Empty}, {"cell", WarmStart::Cell}, {"nearest", WarmStart::Nearest},
+                 {"primal", WarmStart::Primal}})
+        .choice(
+            "schedule", &GreedyOptions::schedule,
+            "fixed-point (exact reduced solves, Anderson on the rebuild point), interleaved (one change per "
+            "rebuild, Alg. 1 with safeguards), paper (Alg. 1 exactly) or nested",
+            {{"fixed-point", GreedySchedule::FixedPoint},
+             {"interleaved", GreedySchedule::Interleaved},
+             {"paper", GreedySchedule::Interleaved},
+             {"nested", GreedySchedule::Nested}},
+            // paper: the interleaved schedule without Anderson nor the switch on a cycle
+            [](GreedyOptions& g, const std::string& word) {
+              if (word == "paper") g.anderson_depth = 0, g.nested_on_cycle = false;
+            })
+        .integer("anderson_depth", &GreedyOptions::anderson_depth,
+                 "fixed-point and nested schedules: Anderson depth of the rebuild point (0: plain)", 0, 1e6)
+        .number("surface_step", &GreedyOptions::surface_step,
+                "fixed-point schedule: largest move of the contact surface (units of U) between the operators' "
+                "point and the answer",
+                Interval::greater_than(0))
+        .integer("max_solves", &GreedyOptions::max_solves, "nested schedule: cap on the one-change solves of a query",
+                 1, 1e9)
+        .choice("rebuild", &GreedyOptions::rebuild,
+                "contact operators rebuilt on the changed rows only (partial) or all (full)",
+                {{"partial", OperatorRebuild::Partial}, {"full", OperatorRebuild::Full}})
+        .choice("on_cycle", &GreedyOptions::nested_on_cycle,
+                "interleaved schedule: on a revisited selection switch to nested, or continue",
+                {{"nested", true}, {"continue", false}});
+    return o;
+  }();
+  return t;
+}
+
 GreedyOptions greedy_options(const OnlineSolverOptions& options) {
-  GreedyOptions g;
-  g.tau = options.tau;
-  if (options.tau_scaling == "absolute")
-    g.tau_scaling = TauScaling::Absolute;
-  else if (options.tau_scaling == "relative")
-    g.tau_scaling = TauScaling::Relative;
-  else
-    throw InputError("tau scaling '" + options.tau_scaling + "' unknown; expected absolute or relative");
-  if (options.max_iterations < 1)
-    throw InputError("max iterations " + std::to_string(options.max_iterations) + " invalid; expected >= 1");
-  if (!(options.step_tolerance >= 0.0))
-    throw InputError("step tolerance " + std::to_string(options.step_tolerance) + " invalid; expected >= 0");
-  g.max_iterations = options.max_iterations;
-  g.step_tolerance = options.step_tolerance;
-  g.time_operators = options.time_operators;
-  for (const auto& [key, value] : options.extra) {
-    if (key == "schedule") {
-      g.schedule = greedy_choice<GreedySchedule>(key, value,
-                                                 {{"fixed-point", GreedySchedule::FixedPoint},
-                                                  {"interleaved", GreedySchedule::Interleaved},
-                                                  {"paper", GreedySchedule::Interleaved},
-                                                  {"nested", GreedySchedule::Nested}});
-      if (value == "paper") g.anderson_depth = 0, g.nested_on_cycle = false;
-    } else if (key == "anderson_depth") {
-      g.anderson_depth = greedy_int_option(key, value, 0);
-    } else if (key == "max_solves") {
-      g.max_solves = greedy_int_option(key, value, 1);
-    } else if (key == "init") {
-      g.init = parse_warm_start("greedy", value);
-    } else if (key == "rebuild") {
-      g.rebuild = greedy_choice<OperatorRebuild>(
-          key, value, {{"partial", OperatorRebuild::Partial}, {"full", OperatorRebuild::Full}});
-    } else if (key == "surface_step") {
-      g.surface_step = parse_option_number("greedy", key, value);
-      if (!(g.surface_step > 0.0))
-        throw InputError("greedy option surface_step = '" + value + "' invalid; expected a number > 0");
-    } else if (key == "on_cycle") {
-      g.nested_on_cycle = greedy_choice<bool>(key, value, {{"nested", true}, {"continue", false}});
-    }
-  }
-  return g;
+  return read_options(greedy_option_table(), options, "greedy");
 }
 
 double greedy_threshold(const ReducedModel& model, const GreedyOptions& options) {
@@ -368,7 +336,7 @@ struct GreedyActiveSet::Interleaved {
   SupportRows::RowsScratch rows;  // rows of C_R Φ_s shared by the selected columns
   std::vector<int> active, solved;  // the selection, and the one of the last solve
   std::vector<char> in_active;
-  fom::AndersonMixer mixer{0};  // of the rebuild point while the selection stays the same
+  AndersonMixer mixer{0};  // of the rebuild point while the selection stays the same
   SelectionHistory seen;     // selections of the query so far
   bool pending = false;  // settled in the sense of Alg. 1: to be confirmed at û's fresh pairing
   int removed = -1, added = -1;  // the last step's change (positions in `solved` / columns)
@@ -561,7 +529,7 @@ struct GreedyActiveSet::Nested {
   SupportRows::ResidualsScratch residuals_scratch;  // physically_converged
   std::vector<double> feasible;  // settle_exact: the non-negative multipliers of `cols`
   std::vector<int> blocked;      // settle_exact: columns not offered again on these operators
-  fom::AndersonMixer mixer{0};
+  AndersonMixer mixer{0};
   bool pending = false;  // settled: to be confirmed at the fresh pairing of û
   bool failed_test = false;  // fixed-point schedule: the last settled û failed the physical test
   bool finite = true;    // every solve so far gave finite values

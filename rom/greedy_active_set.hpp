@@ -67,12 +67,6 @@
 
 namespace contactrom::rom {
 
-/// \brief How the threshold τ is applied to the dictionary violations.
-enum class TauScaling {
-  Absolute,  ///< paper: entries of \f$ D_d^T (Cu - g) \f$ compared with τ directly
-  Relative   ///< compared with τ·U·max_p Σ_s w_s|D_d[s,p]| (U: displacement scale)
-};
-
 /// \brief When the reduced contact operators are rebuilt (see docs/rom.md).
 enum class GreedySchedule {
   /// Default: the fixed point x ↦ û(x), û(x) the reduced problem on the contact
@@ -117,10 +111,6 @@ enum class WarmStart {
   Primal
 };
 
-/// \brief WarmStart from its option text ("empty", "cell", "nearest", "primal").
-/// \throws InputError "<method> option init = '<text>' unknown; expected ..." otherwise.
-WarmStart parse_warm_start(const std::string& method, const std::string& text);
-
 /// \brief The starting point of `init` at μ: the selected dictionary columns (empty
 /// for Empty and Primal) and the reduced displacement (u_free for Empty).
 /// \param nearest if given, set to the heaviest stencil point's column (whose
@@ -129,16 +119,10 @@ void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Para
                       const Eigen::VectorXd& u_free, std::vector<int>& columns, Eigen::VectorXd& u_hat,
                       int* nearest = nullptr);
 
-/// \brief Settings of GreedyActiveSet (documented defaults).
-struct GreedyOptions {
-  /// Threshold τ; < 0: τ = δ of the reduced model (paper). Default −1.
-  double tau = -1.0;
-  /// Absolute (paper, default) or Relative threshold; see docs/rom.md.
-  TauScaling tau_scaling = TauScaling::Absolute;
-  /// Iteration cap k_max (paper: 50). Default 50.
-  int max_iterations = 50;
-  /// Stop when the relative change of û is at most this (paper: 1e-5). Default 1e-5.
-  double step_tolerance = 1e-5;
+/// \brief Settings of GreedyActiveSet (documented defaults); τ, its scaling, the
+/// iteration cap k_max, the step tolerance and the operator clock are the
+/// ActiveSetSettings of every active-set method.
+struct GreedyOptions : ActiveSetSettings {
   /// Relative pivot under which the Schur complement S is treated as singular
   /// (reciprocal condition estimate of its LDLᵀ); the system is then solved in the
   /// least-squares, minimum-norm sense. Default 1e-13.
@@ -172,9 +156,6 @@ struct GreedyOptions {
   /// Nested schedule: cap on the one-change solves of a query, over all rebuilds.
   /// Default 1000.
   int max_solves = 1000;
-  /// Measure OnlineResult::operator_time_s (see OnlineSolverOptions::time_operators).
-  /// Default false.
-  bool time_operators = false;
   /// If set, one line per iteration (|I|, action, largest violation, step) is
   /// written here; for diagnosis only (not thread-safe). Default nullptr.
   std::ostream* trace = nullptr;
@@ -235,11 +216,12 @@ void schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur, const Eig
 Eigen::VectorXd schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur,
                                   const Eigen::Ref<const Eigen::VectorXd>& rhs, double singular_tolerance);
 
-/// \brief Translates the generic online options (tau, tau_scaling, max_iterations,
-/// step_tolerance, and the extra keys schedule = interleaved|nested, anderson_depth,
-/// max_solves, init = empty|cell|nearest|primal, rebuild = partial|full,
-/// on_cycle = nested|continue) into GreedyOptions. \throws InputError
-/// for an unknown tau_scaling, schedule or init, or a malformed number.
+/// \brief Binding table of GreedyOptions: every option of the methods `greedy` and
+/// (without schedule, surface_step and on_cycle) `greedy-nested`, declared once.
+const OptionTable<GreedyOptions>& greedy_option_table();
+
+/// \brief `options` read through greedy_option_table() (read_options()).
+/// \throws InputError for an unknown key or a value outside its declaration.
 GreedyOptions greedy_options(const OnlineSolverOptions& options);
 
 }  // namespace contactrom::rom

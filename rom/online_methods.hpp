@@ -1,9 +1,14 @@
 #pragma once
 /// \file online_methods.hpp
 /// \brief The registry of online ROM methods: each method's name, summary, the
-/// options it reads (declared once, with type, default and help text) and its
-/// factory; validation of option values and conversion between
-/// OnlineSolverOptions and key/value text.
+/// options it reads and its factory; validation of option values and conversion
+/// between OnlineSolverOptions and key/value text or typed values.
+///
+/// A method's options are declared once, in the binding table of its options
+/// struct (rom/option_table.hpp: greedy_option_table(), convex_hull_option_table(),
+/// the baselines' reduced_active_set_option_table() and cpg_option_table()), plus
+/// contact_check_table() that every method reads; the declarations below, `--help`,
+/// the parser and the reduced-model file's option maps are generated from them.
 ///
 /// The built-in methods are registered without any call from the user:
 /// - `greedy`, `greedy-nested` (rom/greedy_active_set.hpp) and `convex-hull`
@@ -21,8 +26,8 @@
 /// The CLI's `--option KEY=VALUE` goes through the same validation
 /// (validate_online_options) and `contactrom online --help` prints
 /// describe_online_methods(). Adding a method: implement OnlineSolver
-/// (rom/online_solver.hpp), then register it with register_online_method()
-/// (declaring its options) or register_online_solver().
+/// (rom/online_solver.hpp), declare its options struct's OptionTable, then
+/// register_online_method(make_online_method(name, summary, factory, table)).
 #include <functional>
 #include <map>
 #include <memory>
@@ -39,18 +44,6 @@ namespace contactrom::rom {
 using OnlineSolverFactory =
     std::function<std::unique_ptr<OnlineSolver>(const ReducedModel& model, const OnlineSolverOptions& options)>;
 
-/// \brief Registers (or replaces) the factory of method `name`.
-void register_online_solver(const std::string& name, OnlineSolverFactory factory);
-
-/// \brief Registers a method at static-initialisation time. Beware: in a static
-/// library the linker drops an object file that nothing references, together with
-/// its registrar; a registrar in a program's own source file is safe.
-struct OnlineSolverRegistrar {
-  OnlineSolverRegistrar(const std::string& name, OnlineSolverFactory factory) {
-    register_online_solver(name, std::move(factory));
-  }
-};
-
 /// \brief Registered method names, sorted.
 std::vector<std::string> online_solver_names();
 
@@ -65,40 +58,48 @@ void check_online_method(const std::string& name);
 std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const ReducedModel& model,
                                                  const OnlineSolverOptions& options = {});
 
-/// \brief Kind of value an option takes.
-enum class OptionType {
-  Number,   ///< a finite real number, possibly bounded
-  Integer,  ///< an integer, possibly bounded
-  Choice,   ///< one word out of OptionSpec::choices
-  Flag      ///< true/false (also 1/0)
-};
-
-/// \brief One option of an online method, declared once.
-struct OptionSpec {
-  std::string key;            ///< name, as in `--option key=value`
-  OptionType type = OptionType::Number;  ///< kind of value
-  std::string default_value;  ///< default, as text (may be a word such as "delta" when computed)
-  std::string help;           ///< one-line meaning (with unit where there is one)
-  std::vector<std::string> choices;  ///< accepted words (OptionType::Choice)
-  Interval range;             ///< accepted values (Number); Integer uses its bounds too
-};
-
 /// \brief An online method: what the registry knows about it.
 struct OnlineMethod {
   std::string name;                  ///< registry name ("greedy", "cpg", ...)
   std::string summary;               ///< one-line description
-  std::vector<OptionSpec> options;   ///< every option the method reads
+  std::vector<OptionSpec> options;   ///< every option the method reads (from its tables)
+  /// The value of every option of `options` once the settings are read into the
+  /// method's options structs (read_options(): values checked, defaults filled in).
+  std::function<std::map<std::string, OptionValue>(const OnlineSolverOptions&)> read;
   OnlineSolverFactory factory;       ///< builds the solver
-  /// Options not declared (a method added with register_online_solver()): every
-  /// key of OnlineSolverOptions::extra is passed to the factory, which checks it.
-  bool open_options = false;
   /// Whether the method combines the primal training snapshots themselves
-  /// (ReducedModel::primal_snapshots(), n × m): a reduced-model file then stores
-  /// them. Methods added with register_online_solver() are assumed to.
+  /// (ReducedModel::primal_snapshots(), n × m): a reduced-model file then stores them.
   bool needs_primal_snapshots = false;
 };
 
-/// \brief Registers (or replaces) a method with its option declarations.
+/// \brief A method whose options are those of `tables` (one per options struct it
+/// reads) and of contact_check_table(). Every key must be declared once.
+template <class... S>
+OnlineMethod make_online_method(std::string name, std::string summary, OnlineSolverFactory factory,
+                                const OptionTable<S>&... tables) {
+  OnlineMethod m;
+  m.name = std::move(name);
+  m.summary = std::move(summary);
+  m.factory = std::move(factory);
+  auto append = [&m](const auto& table) {
+    for (const OptionSpec& spec : table.specs()) m.options.push_back(spec);
+  };
+  (append(tables), ...);
+  append(contact_check_table());
+  m.read = [method = m.name, tables...](const OnlineSolverOptions& o) {
+    std::map<std::string, OptionValue> values;
+    auto add = [&](const auto& table) {
+      for (auto& [key, value] : table.to_values(read_options(table, o, method, /*strict=*/false)))
+        values[key] = std::move(value);
+    };
+    (add(tables), ...);
+    add(contact_check_table());
+    return values;
+  };
+  return m;
+}
+
+/// \brief Registers (or replaces) a method (make_online_method()).
 void register_online_method(OnlineMethod method);
 
 /// \brief Every registered method, sorted by name.
@@ -117,31 +118,22 @@ bool online_method_needs_primal_snapshots(const std::string& name);
 /// `convex-hull`); the registry starts with them.
 std::vector<OnlineMethod> rom_online_methods();
 
-/// \brief Declarations of OnlineSolverOptions' named fields (`tau`, `tau_scaling`,
-/// `max_iterations`, `step_tolerance`, `time_operators`), read by every active-set
-/// method (the greedy and the baselines).
-std::vector<OptionSpec> active_set_option_specs();
-
-/// \brief The keys of OnlineSolverOptions' named fields (`tau`, `tau_scaling`,
-/// `max_iterations`, `step_tolerance`, `time_operators`); every other key of a
-/// method lives in OnlineSolverOptions::extra.
-const std::vector<std::string>& shared_option_keys();
-
-/// \brief Checks `value` against `spec`.
-/// \throws InputError "online method 'm' option key = 'value' invalid; expected ...".
-void validate_option_value(const std::string& method, const OptionSpec& spec, const std::string& value);
-
 /// \brief Checks every setting of `options` that `method` reads: unknown keys in
 /// OnlineSolverOptions::extra, values of the wrong type or outside their range.
 /// make_online_solver() calls it before building the solver.
 /// \throws InputError naming the method, the key, the value and what was expected.
 void validate_online_options(const std::string& method, const OnlineSolverOptions& options);
 
-/// \brief The settings of `options` that `method` reads, as key/value text: the
-/// named fields the method declares and every entry of
-/// OnlineSolverOptions::extra. options_from_map(method, result) gives back
-/// equivalent options.
+/// \brief Every option of `method` with its value in `options` (defaults filled
+/// in), as key/value text: what a reduced-model file stores.
+/// options_from_map(method, result) gives back equivalent options.
+/// \throws InputError as validate_online_options().
 std::map<std::string, std::string> options_to_map(const std::string& method, const OnlineSolverOptions& options);
+
+/// \brief Every option of `method` with its typed value in `options` (numbers as
+/// numbers, flags as bools, choices as words).
+/// \throws InputError as validate_online_options().
+std::map<std::string, OptionValue> options_to_values(const std::string& method, const OnlineSolverOptions& options);
 
 /// \brief Options of `method` from key/value text (e.g. `--option` pairs or a
 /// reduced-model file); keys absent keep their defaults.
@@ -156,9 +148,5 @@ std::pair<std::string, std::string> split_option(const std::string& key_value);
 /// `--help`): one paragraph per method, one line per option with its type,
 /// default and help.
 std::string describe_online_methods();
-
-/// \brief What a value of `spec` must be, e.g. "a number in [0, 1]", "an integer >= 1",
-/// "empty, primal or cell", "true or false (1 or 0)".
-std::string describe_option_type(const OptionSpec& spec);
 
 }  // namespace contactrom::rom

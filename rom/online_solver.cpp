@@ -7,6 +7,46 @@
 
 namespace contactrom::rom {
 
+const OptionTable<ActiveSetSettings>& active_set_settings_table() {
+  static const OptionTable<ActiveSetSettings> t = [] {
+    OptionTable<ActiveSetSettings> o;
+    o.number("tau", &ActiveSetSettings::tau, "penetration threshold of the reduced constraint; < 0: delta of the model")
+        .choice("tau_scaling", &ActiveSetSettings::tau_scaling,
+                "absolute (paper) or relative to the dictionary's force scale",
+                {{"absolute", TauScaling::Absolute}, {"relative", TauScaling::Relative}})
+        .integer("max_iterations", &ActiveSetSettings::max_iterations, "iteration cap k_max", 1, 1e6)
+        .number("step_tolerance", &ActiveSetSettings::step_tolerance,
+                "relative change of u_hat under which the iteration may stop", Interval::at_least(0))
+        .flag("time_operators", &ActiveSetSettings::time_operators,
+              "measure the time spent building the contact operators");
+    return o;
+  }();
+  return t;
+}
+
+const OptionTable<ContactCheckOptions>& contact_check_table() {
+  static const OptionTable<ContactCheckOptions> t = [] {
+    OptionTable<ContactCheckOptions> o;
+    o.number("penetration_tolerance", &ContactCheckOptions::penetration_tolerance,
+             "largest penetration (units of U) of an answer reported success; < 0: the problem's [rom] value, else "
+             "5e-2")
+        .number("complementarity_tolerance", &ContactCheckOptions::complementarity_tolerance,
+                "largest separation under pressure (units of U) of an answer reported success; < 0: the problem's "
+                "[rom] value, else 5e-2")
+        .flag("estimate", &ContactCheckOptions::estimate,
+              "estimate the primal and dual errors of every answer at the full order on the contact surface");
+    return o;
+  }();
+  return t;
+}
+
+void throw_unknown_option(const std::string& method, const std::string& key, const std::vector<OptionSpec>& known) {
+  std::vector<std::string> keys;
+  for (const OptionSpec& s : known) keys.push_back(s.key);
+  throw InputError("online method " + quoted(method, 200) + " has no option " + quoted(key, 200) +
+                   "; it knows: " + (keys.empty() ? "none" : join(keys, ", ")));
+}
+
 fom::ContactTolerances OnlineSolver::contact_tolerances() const {
   return m_tolerances_set ? m_tolerances : fom::default_contact_tolerances(model().problem());
 }

@@ -2,8 +2,10 @@
 /// \file online_solver.hpp
 /// \brief The common interface of the online ROM methods (greedy active set,
 /// convex hull, CPG, full dictionary, ...): one query's result, the solver
-/// interface, the settings the methods share (and the parsing of their
-/// method-specific ones), and the clock of the contact-operator construction.
+/// interface, the settings given to a method by name (OnlineSolverOptions) and
+/// their reading into a method's options struct through its binding table
+/// (read_options(), rom/option_table.hpp), and the clock of the contact-operator
+/// construction.
 ///
 /// Methods are built by name through the registry (rom/online_methods.hpp) and
 /// evaluated against the FOM by rom/online_evaluation.hpp.
@@ -17,11 +19,14 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/format.hpp"
 #include "fom/contact_residuals.hpp"
 #include "fom/problem.hpp"
+#include "rom/option_table.hpp"
 #include "rom/reduced_model.hpp"
 
 namespace contactrom::rom {
@@ -129,44 +134,86 @@ const fom::Pairing* check_contact(const ReducedModel& model, const fom::ContactT
 /// check_contact() searched at it.
 void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairing, OnlineResult& res);
 
-/// \brief Settings shared by the online methods (each documents which it reads).
-struct OnlineSolverOptions {
-  /// Penetration threshold τ of the greedy enrichment; < 0: τ = δ of the model (the
+/// \brief How the threshold τ is applied to the dictionary violations.
+enum class TauScaling {
+  Absolute,  ///< paper: entries of \f$ D_d^T (Cu - g) \f$ compared with τ directly
+  Relative   ///< compared with τ·U·max_p Σ_s w_s|D_d[s,p]| (U: displacement scale)
+};
+
+/// \brief Settings of every active-set method (the greedy, `cpg`, `full-dictionary`).
+struct ActiveSetSettings {
+  /// Penetration threshold τ of the reduced constraint; < 0: τ = δ of the model (the
   /// paper's choice). Default −1.
   double tau = -1.0;
-  /// How τ is applied: "absolute" (paper: on D_dᵀ(Cu − g) directly) or "relative"
-  /// (τ times the scale U·max_p Σ_s w_s|D_d[s,p]|; see docs/rom.md). Default "absolute".
-  std::string tau_scaling = "absolute";
-  /// Iteration cap k_max. Default 50.
+  /// How τ is applied: Absolute (paper: on D_dᵀ(Cu − g) directly) or Relative (τ
+  /// times the scale U·max_p Σ_s w_s|D_d[s,p]|; see docs/rom.md). Default Absolute.
+  TauScaling tau_scaling = TauScaling::Absolute;
+  /// Iteration cap k_max (paper: 50; the fixed-point loops: operator rebuilds). Default 50.
   int max_iterations = 50;
-  /// Relative change of û under which the iteration may stop. Default 1e-5.
+  /// Relative change of û under which the iteration may stop (paper: 1e-5; the
+  /// fixed-point loops test surface_step instead). Default 1e-5.
   double step_tolerance = 1e-5;
+  /// Measure OnlineResult::operator_time_s. Off by default: the clock reads add
+  /// about 1 % to a query.
+  bool time_operators = false;
+};
+
+/// \brief Binding table of ActiveSetSettings (rom/option_table.hpp).
+const OptionTable<ActiveSetSettings>& active_set_settings_table();
+
+/// \brief Settings of the check every online method makes of its answers.
+struct ContactCheckOptions {
   /// Tolerances of the full-order contact check of every answer (OnlineSolver);
   /// each < 0: the problem's (`[rom]` of its file, else fom::ContactTolerances).
+  /// Default −1.
   double penetration_tolerance = -1.0;
-  double complementarity_tolerance = -1.0;
+  double complementarity_tolerance = -1.0;  ///< see penetration_tolerance
   /// Estimate the errors of every answer (OnlineResult::primal_estimate and
   /// dual_estimate; rom/error_indicator.hpp). Default true.
   bool estimate = true;
-  /// Measure OnlineResult::operator_time_s (greedy, greedy-nested, cpg,
-  /// full-dictionary). Off by default: the clock reads add about 1 % to a query.
-  bool time_operators = false;
-  /// Method-specific settings by name (for methods added later), as text.
+};
+
+/// \brief Binding table of ContactCheckOptions.
+const OptionTable<ContactCheckOptions>& contact_check_table();
+
+/// \brief The settings given to an online method by name (rom/online_methods.hpp):
+/// the active-set settings and the contact check as typed fields, every other
+/// setting of the method as text by key (`extra`, as `--option KEY=VALUE` gives it),
+/// read into the method's own options struct through its OptionTable.
+struct OnlineSolverOptions : ActiveSetSettings, ContactCheckOptions {
+  /// Method-specific settings by key, as text.
   std::map<std::string, std::string> extra;
 };
 
-/// \brief Refuses method-specific settings (OnlineSolverOptions::extra) that `method`
-/// does not know. \throws InputError "online method 'm' has no option 'k'; it knows: ...".
-void check_extra_options(const OnlineSolverOptions& options, const std::string& method,
-                         const std::vector<std::string>& known);
+/// \brief Throws InputError "online method 'm' has no option 'k'; it knows: ...".
+[[noreturn]] void throw_unknown_option(const std::string& method, const std::string& key,
+                                       const std::vector<OptionSpec>& known);
 
-/// \brief Value of a method-specific setting (OnlineSolverOptions::extra) as a finite
-/// number. \throws InputError "<method> option <key> = '<text>' is not a number".
-double parse_option_number(const std::string& method, const std::string& key, const std::string& text);
-
-/// \brief Value of a method-specific setting as an integer (the whole text).
-/// \throws InputError "<method> option <key> = '<text>' is not an integer".
-long long parse_option_integer(const std::string& method, const std::string& key, const std::string& text);
+/// \brief `options` read into a method's options struct `S` through its table:
+/// the typed fields of the bases that `S` shares with OnlineSolverOptions, then
+/// every entry of OnlineSolverOptions::extra that the table declares; every member
+/// is then checked against its declaration.
+/// \param method named in messages
+/// \param strict refuse a key of `extra` the table does not declare
+/// \throws InputError naming the method, the key, the value and what was expected.
+template <class S>
+S read_options(const OptionTable<S>& table, const OnlineSolverOptions& options, const std::string& method,
+               bool strict = true) {
+  S s{};
+  if constexpr (std::is_base_of_v<ActiveSetSettings, S>)
+    static_cast<ActiveSetSettings&>(s) = static_cast<const ActiveSetSettings&>(options);
+  if constexpr (std::is_base_of_v<ContactCheckOptions, S>)
+    static_cast<ContactCheckOptions&>(s) = static_cast<const ContactCheckOptions&>(options);
+  const std::string prefix = "online method " + quoted(method, 200) + " option ";
+  for (const auto& [key, value] : options.extra) {
+    if (table.find(key))
+      table.read(s, key, value, prefix + key);
+    else if (strict)
+      throw_unknown_option(method, key, table.specs());
+  }
+  table.check(s, prefix);
+  return s;
+}
 
 /// \brief Accumulates the wall time of the operator-construction phases of one
 /// query into OnlineResult::operator_time_s; does nothing unless enabled.

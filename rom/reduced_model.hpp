@@ -210,10 +210,6 @@ class ReducedModel {
 
   /// Reduced stiffness terms \f$ \Phi^T K_q \Phi \f$ (r × r each).
   const std::vector<Eigen::MatrixXd>& reduced_stiffness_terms() const { return m_k_hat; }
-  /// Reduced load terms (r × T): column k is \f$ \Phi^T f_{ext,k} \f$.
-  const Eigen::MatrixXd& reduced_load_terms() const { return m_f_hat; }
-  /// Per stiffness term q (r × T): column k is \f$ \Phi^T K_q \tilde L_k \f$.
-  const std::vector<Eigen::MatrixXd>& reduced_stiffness_offset_terms() const { return m_kl_hat; }
   /// \f$ \hat K(\mu) = \sum_q \theta_q(\mu) \Phi^T K_q \Phi \f$.
   Eigen::MatrixXd reduced_stiffness(const fom::Param& mu) const;
   /// \f$ \hat f(\mu) = \Phi^T f(\mu) \f$ from the affine pieces.
@@ -224,8 +220,6 @@ class ReducedModel {
   const std::vector<Eigen::VectorXd>& offset_terms() const { return m_offset; }
   /// \f$ u_{off}(\mu) = \sum_k \phi_k(\mu) \tilde L_k \f$ (n_dofs).
   Eigen::VectorXd offset(const fom::Param& mu) const;
-  /// Lifting terms restricted to the surface dofs (n_s × n_terms).
-  const Eigen::MatrixXd& surface_lifting_terms() const { return m_lift_s; }
 
   /// \brief Cholesky factor of \f$ \Phi^T K_0 \Phi \f$ when the problem has a single
   /// stiffness term (then \f$ \hat K(\mu) = \theta_0(\mu)\,\Phi^T K_0\Phi \f$: factorised

@@ -154,7 +154,7 @@ OnlineModel OnlineModel::load(const std::string& path) {
     method = hdf5::read_string_attribute(f, "method");
     d.options.delta = hdf5::read_double_attribute(f, "delta");
     if (!(d.options.delta >= 0.0) || !std::isfinite(d.options.delta))
-      throw hdf5::Refused("attribute delta is " + fom::format_number(d.options.delta) + ", expected a number >= 0");
+      throw hdf5::Refused("attribute delta is " + format_number(d.options.delta) + ", expected a number >= 0");
     const std::string lifting = hdf5::read_string_attribute(f, "lifting");
     if (lifting != "harmonic" && lifting != "dirichlet")
       throw hdf5::Refused("attribute lifting is " + quoted(lifting, 200) + ", expected 'harmonic' or 'dirichlet'");
@@ -176,7 +176,7 @@ OnlineModel OnlineModel::load(const std::string& path) {
     if (cols != 1 || rows < r) throw hdf5::Refused("dataset /singular_values holds fewer values than modes");
     for (double v : sigma)
       if (!std::isfinite(v) || v < 0.0)
-        throw hdf5::Refused("dataset /singular_values holds " + fom::format_number(v) + ", expected finite values >= 0");
+        throw hdf5::Refused("dataset /singular_values holds " + format_number(v) + ", expected finite values >= 0");
     d.singular_values = Eigen::Map<Eigen::VectorXd>(sigma.data(), static_cast<Eigen::Index>(rows));
     const auto [nt, n_offset] = shape2(f, "offset");
     const Eigen::MatrixXd offset = read_columns(f, "offset", n, nt);
@@ -293,16 +293,16 @@ FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResu
         << (with_source ? ",source\n" : "\n");
     for (size_t i = 0; i < results.size(); ++i) {
       const OnlineResult& res = results[i];
-      for (int k = 0; k < res.mu.size(); ++k) out << fom::format_number(res.mu(k)) << ',';
+      for (int k = 0; k < res.mu.size(); ++k) out << format_number(res.mu(k)) << ',';
       out << to_string(res.status) << ',' << (res.converged ? 1 : 0) << ',' << res.iterations << ','
-          << res.selected.size() << ',' << fom::format_number(fom::contact_force(rom.problem(), res.lambda)) << ','
-          << fom::format_number(res.time_s) << ',';
+          << res.selected.size() << ',' << format_number(fom::contact_force(rom.problem(), res.lambda)) << ','
+          << format_number(res.time_s) << ',';
       for (size_t j = 0; j < res.selected.size(); ++j)
         out << (j ? " " : "") << rom.model().dictionary_snapshots()[static_cast<size_t>(res.selected[j])];
       out << ',';
-      for (Eigen::Index j = 0; j < res.coefficients.size(); ++j) out << (j ? " " : "") << fom::format_number(res.coefficients(j));
-      out << ',' << fom::format_number(res.contact.penetration) << ',' << fom::format_number(res.contact.complementarity)
-          << ',' << fom::format_number(res.primal_estimate) << ',' << fom::format_number(res.dual_estimate);
+      for (Eigen::Index j = 0; j < res.coefficients.size(); ++j) out << (j ? " " : "") << format_number(res.coefficients(j));
+      out << ',' << format_number(res.contact.penetration) << ',' << format_number(res.contact.complementarity)
+          << ',' << format_number(res.primal_estimate) << ',' << format_number(res.dual_estimate);
       if (with_source) out << ',' << sources[i];
       out << '\n';
     }

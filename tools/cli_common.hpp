@@ -41,6 +41,35 @@ CLI::Option* add_integer(CLI::App* sub, const std::string& name, Int& target, co
       ->type_name("INT");
 }
 
+/// Adds flag `name` for the option `key` of an options table (rom/option_table.hpp):
+/// its help, default and range or words are the declaration's. `target` (a double, an
+/// integer or the word) starts at the struct's default (setting_default()).
+template <class S, class T>
+CLI::Option* add_setting(CLI::App* sub, const std::string& name, T& target, const rom::OptionTable<S>& table,
+                         const std::string& key) {
+  const rom::OptionSpec& spec = table.find(key)->spec;
+  const std::string help = spec.help + " (default " + spec.default_value + "; as --option " + key + ")";
+  if constexpr (std::is_same_v<T, double>)
+    return add_number(sub, name, target, help, spec.range);
+  else if constexpr (std::is_same_v<T, std::string>)
+    return sub->add_option(name, target, help)->check(CLI::IsMember(spec.choices));
+  else
+    return add_integer(sub, name, target, help, static_cast<long long>(spec.range.lower),
+                       static_cast<long long>(std::min(spec.range.upper, 9e18)));
+}
+
+/// The default of the option `key` of the active-set settings, typed as T.
+template <class T>
+T setting_default(const std::string& key) {
+  const rom::OptionValue v = rom::active_set_settings_table().to_values(rom::ActiveSetSettings{}).at(key);
+  if constexpr (std::is_same_v<T, std::string>)
+    return std::get<std::string>(v);
+  else if constexpr (std::is_same_v<T, double>)
+    return std::get<double>(v);
+  else
+    return static_cast<T>(std::get<long long>(v));
+}
+
 /// Validator of a file or folder option: an empty value ("--out ''") is refused
 /// rather than read as "not given".
 inline CLI::Validator non_empty_path() {
@@ -81,9 +110,10 @@ inline void warn_if_no_primal_modes(const rom::ReducedModel& model) {
 
 /// The options that choose a reduced model and its online method (`online`, `reduce`).
 struct MethodArgs {
-  std::string method = "greedy", tau_scaling = "absolute", lifting = "harmonic";
-  double delta = 1e-8, tau = -1.0;
-  int max_iterations = 50;
+  std::string method = "greedy", lifting = "harmonic";
+  std::string tau_scaling = setting_default<std::string>("tau_scaling");
+  double delta = 1e-8, tau = setting_default<double>("tau");
+  int max_iterations = setting_default<int>("max_iterations");
   std::vector<std::string> options;  // KEY=VALUE method settings
 
   /// The reduced-model settings (δ, lifting).
@@ -104,7 +134,7 @@ struct MethodArgs {
     }
     rom::OnlineSolverOptions o = rom::options_from_map(method, values);
     if (!values.count("tau")) o.tau = tau;
-    if (!values.count("tau_scaling")) o.tau_scaling = tau_scaling;
+    if (!values.count("tau_scaling")) rom::active_set_settings_table().read(o, "tau_scaling", tau_scaling, "--tau-scaling");
     if (!values.count("max_iterations")) o.max_iterations = max_iterations;
     return o;
   }
@@ -115,13 +145,12 @@ inline void add_method_options(CLI::App* sub, MethodArgs& a) {
   sub->add_option("--method", a.method, "online method (default greedy; listed below)");
   sub->footer(rom::describe_online_methods());
   add_number(sub, "--delta", a.delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
-  add_number(sub, "--tau", a.tau, "greedy penetration threshold (default: tau = delta)", Interval::at_least(0));
-  sub->add_option("--tau-scaling", a.tau_scaling, "absolute (default, paper) | relative")
-      ->check(CLI::IsMember({"absolute", "relative"}));
+  add_setting(sub, "--tau", a.tau, rom::active_set_settings_table(), "tau");
+  add_setting(sub, "--tau-scaling", a.tau_scaling, rom::active_set_settings_table(), "tau_scaling");
   sub->add_option("--lifting", a.lifting,
                   "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet")
       ->check(CLI::IsMember({"harmonic", "dirichlet"}));
-  add_integer(sub, "--max-iterations", a.max_iterations, "iteration cap k_max (default 50)", 1, 100000);
+  add_setting(sub, "--max-iterations", a.max_iterations, rom::active_set_settings_table(), "max_iterations");
   sub->add_option("--option", a.options, "method setting KEY=VALUE, repeatable; each method's keys are listed below");
 }
 

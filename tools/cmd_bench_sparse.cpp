@@ -146,7 +146,7 @@ void run_bench(const BenchArgs& args) {
   for (std::size_t s = 0; s < sizes.size(); ++s) {
     const Problem p = make_problem(sizes[s].m, sizes[s].n, args.noise, base_seed + static_cast<unsigned>(s));
     std::vector<KernelResult> kernels;
-    kernels.push_back(bench_kernel<rom::Nnls>("nnls", rom::NnlsOptions{}, p, args.repeats));
+    kernels.push_back(bench_kernel<contactrom::Nnls>("nnls", contactrom::NnlsOptions{}, p, args.repeats));
     kernels.push_back(bench_kernel<rom::Omp>("omp", rom::OmpOptions{}, p, args.repeats));
     kernels.push_back(bench_kernel<rom::Focuss>("focuss", rom::FocussOptions{}, p, args.repeats));
     kernels.push_back(bench_kernel<rom::NnFocuss>("nnfocuss", rom::FocussOptions{}, p, args.repeats));

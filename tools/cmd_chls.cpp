@@ -101,10 +101,13 @@ CommandRegistrar reg_chls("chls", [](CLI::App& app) {
 // ---------------------------------------------------------------- hull-report
 
 struct HullArgs {
-  std::string db, set = "validation", basis = "svd", out;
-  double delta = 1e-8, basis_delta = -1.0, sum_weight = 0.1;
-  int rank_l = 0, threads = 0, repeats = 3, max_pairing_iterations = 20;
-  long long seed = 42;
+  // The convex-hull settings start at ConvexHullOptions' defaults.
+  inline static const rom::ConvexHullOptions kDefaults{};
+  std::string db, set = "validation", out;
+  std::string basis = std::get<std::string>(rom::convex_hull_option_table().to_values(kDefaults).at("basis"));
+  double delta = 1e-8, basis_delta = kDefaults.basis_delta, sum_weight = kDefaults.sum_weight;
+  int rank_l = kDefaults.rank_l, threads = 0, repeats = 3, max_pairing_iterations = kDefaults.max_pairing_iterations;
+  long long seed = static_cast<long long>(kDefaults.seed);
   bool no_polish = false, json = false, time = false;
   std::vector<std::string> options;
 };
@@ -121,8 +124,8 @@ void run_hull_report(const HullArgs& a) {
   // through OnlineSolverOptions::extra, as for `contactrom online`.
   rom::OnlineSolverOptions generic;
   generic.extra["basis"] = a.basis;
-  if (a.basis_delta >= 0.0) generic.extra["basis_delta"] = format_number(a.basis_delta);
-  if (a.rank_l > 0) generic.extra["rank_l"] = std::to_string(a.rank_l);
+  generic.extra["basis_delta"] = format_number(a.basis_delta);
+  generic.extra["rank_l"] = std::to_string(a.rank_l);
   generic.extra["seed"] = std::to_string(a.seed);
   generic.extra["sum_weight"] = format_number(a.sum_weight);
   generic.extra["polish"] = a.no_polish ? "0" : "1";
@@ -192,16 +195,14 @@ CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
   sub->add_option("--set", args->set, "training | validation (default)")
       ->check(CLI::IsMember({"training", "validation"}));
   add_number(sub, "--delta", args->delta, "POD/SVD energy tolerance (default 1e-8; paper rope: 1e-7)", Interval::closed(0, 1));
-  sub->add_option("--basis", args->basis, "projection basis: svd (default) | random")
-      ->check(CLI::IsMember({"svd", "random"}));
-  add_number(sub, "--basis-delta", args->basis_delta, "SVD tolerance of the projection basis (default: --delta)",
-             Interval::closed(0, 1));
-  add_integer(sub, "--rank-l", args->rank_l, "random basis: number of combinations L (default: SVD rank)", 1, 100000);
-  add_integer(sub, "--seed", args->seed, "random basis: seed of std::mt19937_64 (default 42)", 0,
-              std::numeric_limits<long long>::max());
-  add_number(sub, "--sum-weight", args->sum_weight, "weight of the convexity row, relative (default 0.1)", Interval::greater_than(0));
+  const auto& hull = rom::convex_hull_option_table();
+  add_setting(sub, "--basis", args->basis, hull, "basis");
+  add_setting(sub, "--basis-delta", args->basis_delta, hull, "basis_delta");
+  add_setting(sub, "--rank-l", args->rank_l, hull, "rank_l");
+  add_setting(sub, "--seed", args->seed, hull, "seed");
+  add_setting(sub, "--sum-weight", args->sum_weight, hull, "sum_weight");
   sub->add_flag("--no-polish", args->no_polish, "keep the plain nnFOCUSS coefficients (no exact simplex re-solve)");
-  add_integer(sub, "--max-pairing-iterations", args->max_pairing_iterations, "pairing fixed-point cap (default 20)", 1, 100000);
+  add_setting(sub, "--max-pairing-iterations", args->max_pairing_iterations, hull, "max_pairing_iterations");
   std::string keys;
   for (const rom::OptionSpec& spec : rom::online_method("convex-hull").options)
     keys += (keys.empty() ? "" : ", ") + spec.key;

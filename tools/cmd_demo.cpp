@@ -132,7 +132,7 @@ void run_demo(const DemoArgs& a) {
   const std::string db_path = dir + "/hertz" + std::to_string(a.train) + ".h5";
   rom::OfflineOptions offline;
   offline.threads = a.threads;
-  rom::ProgressBar bar(std::cerr, "   offline", ::isatty(STDERR_FILENO));
+  ProgressBar bar(std::cerr, "   offline", ::isatty(STDERR_FILENO));
   offline.progress = [&bar](int done, int total) { bar.update(done, total); };
   const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, a.train, offline);
   bar.finish();

@@ -289,7 +289,7 @@ void run_offline(const OfflineArgs& a) {
 
   const std::string label =
       "offline " + problem->name() + (ranks.size > 1 ? " (rank 0 of " + std::to_string(ranks.size) + ")" : "");
-  rom::ProgressBar bar(std::cerr, label, ranks.root() && (a.progress || ::isatty(STDERR_FILENO)));
+  ProgressBar bar(std::cerr, label, ranks.root() && (a.progress || ::isatty(STDERR_FILENO)));
   rom::OfflineOptions options;
   options.threads = a.threads;
   // Snapshots are streamed to a file of this process as they are computed; it

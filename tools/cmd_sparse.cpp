@@ -61,10 +61,10 @@ SparseRun run_method(const SparseArgs& args, bool has_tol, bool has_max_iter, bo
   namespace rom = contactrom::rom;
   SparseRun run;
   if (args.method == "nnls") {
-    rom::NnlsOptions options;
+    contactrom::NnlsOptions options;
     if (has_tol) options.tolerance = args.tolerance;
     if (has_max_iter) options.max_iterations = args.max_iterations;
-    rom::Nnls nnls(options);
+    contactrom::Nnls nnls(options);
     run.coefficients = nnls.compute(d).solve(x);
     run.status = nnls.info();
     run.iterations = nnls.iterations();

@@ -44,9 +44,10 @@ namespace {
 
 
 struct VerifyArgs {
-  std::string db, methods, reference = "ipopt", out, tau_scaling = "absolute", inner_solve, init;
-  double delta = 1e-8, tau = -1.0, cpg_tolerance = -1.0;
-  int threads = 0, max_iterations = 50, limit = 0, repeats = 3;
+  std::string db, methods, reference = "ipopt", out, inner_solve, init;
+  std::string tau_scaling = setting_default<std::string>("tau_scaling");
+  double delta = 1e-8, tau = setting_default<double>("tau"), cpg_tolerance = baselines::CpgOptions{}.tolerance;
+  int threads = 0, max_iterations = setting_default<int>("max_iterations"), limit = 0, repeats = 3;
   bool json = false, progress = false, bench = false;
 };
 
@@ -62,13 +63,13 @@ std::string sci(double v) {
 std::vector<baselines::VerifyMethod> methods_of(const VerifyArgs& a) {
   rom::OnlineSolverOptions options;
   options.tau = a.tau;
-  options.tau_scaling = a.tau_scaling;
+  rom::active_set_settings_table().read(options, "tau_scaling", a.tau_scaling, "--tau-scaling");
   options.max_iterations = a.max_iterations;
   std::vector<baselines::VerifyMethod> out;
   for (const std::string& m : split_list(a.methods, "--method")) {
     (void)rom::online_method(m);  // unknown names are refused before the database is read
     rom::OnlineSolverOptions o = options;
-    if (m == "cpg" && a.cpg_tolerance >= 0.0) o.extra["cpg_tolerance"] = fom::format_number(a.cpg_tolerance);
+    if (m == "cpg" && a.cpg_tolerance >= 0.0) o.extra["cpg_tolerance"] = format_number(a.cpg_tolerance);
     if ((m == "cpg" || m == "full-dictionary") && !a.inner_solve.empty()) o.extra["inner_solve"] = a.inner_solve;
     if ((m == "greedy" || m == "greedy-nested" || m == "cpg" || m == "full-dictionary") && !a.init.empty())
       o.extra["init"] = a.init;
@@ -148,12 +149,12 @@ baselines::VerifyOptions verify_options(const VerifyArgs& a) {
 /// Progress bars on stderr, one per stage (label); finish() ends the last one.
 struct StageProgress {
   bool show;
-  std::unique_ptr<rom::ProgressBar> bar;
+  std::unique_ptr<ProgressBar> bar;
   std::string stage;
   void update(const std::string& label, int done, int total) {
     if (label != stage) {
       finish();
-      bar = std::make_unique<rom::ProgressBar>(std::cerr, "verify: " + label, show);
+      bar = std::make_unique<ProgressBar>(std::cerr, "verify: " + label, show);
       stage = label;
     }
     bar->update(done, total);
@@ -244,14 +245,11 @@ CommandRegistrar reg("verify", [](CLI::App& app) {
   sub->add_option("--method", args->methods, "online method(s), comma-separated (e.g. greedy,cpg,full-dictionary)")
       ->required();
   add_number(sub, "--delta", args->delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
-  add_number(sub, "--tau", args->tau, "penetration threshold of the reduced constraint (default: tau = delta)", Interval::at_least(0));
-  sub->add_option("--tau-scaling", args->tau_scaling, "absolute (default, paper) | relative")
-      ->check(CLI::IsMember({"absolute", "relative"}));
-  add_integer(sub, "--max-iterations", args->max_iterations, "iteration cap k_max (default 50)", 1, 100000);
-  add_number(sub, "--cpg-tolerance", args->cpg_tolerance, "CPG cone-projection tolerance (default: 1e-2 hertz, 5e-2 ironing/ironing2, 1e-2 otherwise)", Interval::closed(0, 1));
-  sub->add_option("--inner-solve", args->inner_solve,
-                  "cpg/full-dictionary saddle-point solve: nonnegative (default) | equality (textbook PDAS)")
-      ->check(CLI::IsMember({"nonnegative", "equality"}));
+  add_setting(sub, "--tau", args->tau, rom::active_set_settings_table(), "tau");
+  add_setting(sub, "--tau-scaling", args->tau_scaling, rom::active_set_settings_table(), "tau_scaling");
+  add_setting(sub, "--max-iterations", args->max_iterations, rom::active_set_settings_table(), "max_iterations");
+  add_setting(sub, "--cpg-tolerance", args->cpg_tolerance, baselines::cpg_option_table(), "cpg_tolerance");
+  add_setting(sub, "--inner-solve", args->inner_solve, baselines::reduced_active_set_option_table(), "inner_solve");
   sub->add_option("--init", args->init,
                   "starting point of greedy/greedy-nested (empty|cell|nearest|primal; default cell) and of "
                   "cpg/full-dictionary (empty|primal|cell; default empty)");

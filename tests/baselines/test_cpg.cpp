@@ -93,7 +93,7 @@ double reference_error(const MatrixXd& d, const VectorXd& w, const std::vector<i
   for (size_t i = 0; i < basis.size(); ++i) a.col(static_cast<Eigen::Index>(i)) = sw.asDiagonal() * d.col(basis[i]);
   const VectorXd b = sw.asDiagonal() * d.col(j);
   if (basis.empty()) return b.norm() > 0 ? 1.0 : 0.0;
-  rom::Nnls nnls;
+  Nnls nnls;
   nnls.compute(a);
   const VectorXd x = nnls.solve(b);
   return (b - a * x).norm() / b.norm();
@@ -225,7 +225,9 @@ BOOST_AUTO_TEST_CASE(options_from_the_registry_extras) {
   const CpgOptions c = baselines::cpg_options(o);
   BOOST_TEST(c.tolerance == 0.05);
   BOOST_TEST(c.max_size == 7);
-  for (const char* bad : {"abc", "", "-1", "2", "nan"}) {
+  o.extra["cpg_tolerance"] = "-1";  // the documented default: the problem's tolerance
+  BOOST_TEST(baselines::cpg_options(o).tolerance < 0.0);
+  for (const char* bad : {"abc", "", "2", "nan"}) {
     rom::OnlineSolverOptions b;
     b.extra["cpg_tolerance"] = bad;
     BOOST_CHECK_THROW(baselines::cpg_options(b), InputError);
@@ -285,7 +287,6 @@ BOOST_AUTO_TEST_CASE(hertz_basis_and_online_solver) {
     BOOST_TEST(baselines::reduced_penetration(model, cpg.dual_columns(), res.u) <= cpg.threshold() + 1e-10);
   }
   // Registry: "cpg" with an explicit tolerance.
-  baselines::register_baseline_online_solvers();
   rom::OnlineSolverOptions options;
   options.extra["cpg_tolerance"] = "0.05";
   const auto solver = rom::make_online_solver("cpg", model, options);

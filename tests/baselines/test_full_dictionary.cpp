@@ -63,7 +63,7 @@ VectorXd exact_reduced_solution(const rom::ReducedModel& model, const fom::Param
   const Eigen::LLT<MatrixXd> k(model.reduced_stiffness(mu));
   const VectorXd f_hat = model.reduced_rhs(mu);
   const MatrixXd z = k.solve(c_hat.transpose());
-  rom::NnlsQp qp;
+  NnlsQp qp;
   qp.compute(c_hat * z);
   const VectorXd lambda = qp.solve(c_hat * k.solve(f_hat) - g_hat);
   BOOST_TEST(qp.info() == Status::Success);
@@ -164,9 +164,7 @@ BOOST_AUTO_TEST_CASE(bad_columns_and_options_are_input_errors) {
   baselines::ReducedActiveSetOptions zero;
   zero.max_iterations = 0;
   BOOST_CHECK_THROW(baselines::FullDictionaryActiveSet(model, zero), InputError);
-  rom::OnlineSolverOptions bad;
-  bad.tau_scaling = "sideways";
-  BOOST_CHECK_THROW(baselines::reduced_active_set_options(bad), InputError);
+  BOOST_CHECK_THROW(rom::options_from_map("full-dictionary", {{"tau_scaling", "sideways"}}), InputError);
   // An empty dual basis is allowed: unconstrained solution.
   const rom::OnlineResult res = baselines::ReducedActiveSet("empty", model, {}).solve(hertz().params.front());
   BOOST_TEST(res.converged);
@@ -175,8 +173,6 @@ BOOST_AUTO_TEST_CASE(bad_columns_and_options_are_input_errors) {
 
 BOOST_AUTO_TEST_CASE(registry_and_thread_safety) {
   Hertz& h = hertz();
-  baselines::register_baseline_online_solvers();
-  baselines::register_baseline_online_solvers();  // idempotent
   const std::vector<std::string> names = rom::online_solver_names();
   for (const char* n : {"cpg", "full-dictionary", "greedy"})
     BOOST_TEST(std::count(names.begin(), names.end(), n) == 1);

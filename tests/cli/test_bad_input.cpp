@@ -104,7 +104,7 @@ BOOST_FIXTURE_TEST_CASE(options_and_parameters, Fixture) {
       {"online --db " + rope_db + " --param 60", "'60'", "", ""},
       {"online --db " + rope_db + " --method nosuch", "'nosuch'", "", ""},
       {"chls --db " + file("missing.h5"), "missing.h5", "", ""},
-      {"hull-report --db " + rope_db + " --basis-delta -1", "--basis-delta '-1'", "", ""},
+      {"hull-report --db " + rope_db + " --basis-delta 2", "--basis-delta '2'", "", ""},
       {"hull-report --db " + rope_db + " --basis-delta nan", "--basis-delta 'nan'", "", ""},
       {"hull-report --db " + rope_db + " --seed -3", "--seed '-3'", "", ""},
       {"verify --db " + rope_db + " --method greedy --cpg-tolerance nan", "'nan'", "", ""},

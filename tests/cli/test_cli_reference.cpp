@@ -121,3 +121,74 @@ BOOST_AUTO_TEST_CASE(every_online_method_and_setting_of_the_help_is_in_the_refer
   BOOST_TEST(methods >= 4, "online --help lists " << methods << " methods");
   BOOST_TEST(keys >= 20, "online --help lists " << keys << " method settings");
 }
+
+namespace {
+
+/// The default column of the row of `key` in the tables of `text` ("" if none),
+/// without backticks and with "−" written "-".
+std::string documented_default(const std::string& text, const std::string& key) {
+  const std::string row = "\n| `" + key + "` | ";
+  const std::size_t at = text.find(row);
+  if (at == std::string::npos) return "";
+  const std::size_t begin = at + row.size();
+  std::string cell = text.substr(begin, text.find(" |", begin) - begin);
+  std::string out;
+  for (std::size_t i = 0; i < cell.size(); ++i) {
+    if (cell[i] == '`') continue;
+    if (cell.compare(i, 3, "\u2212") == 0) {
+      out += '-';
+      i += 2;
+      continue;
+    }
+    out += cell[i];
+  }
+  return out;
+}
+
+/// Whether the documented default `doc` ("-1 (tau = delta)", "1e-3", "svd") states `value`.
+bool states(const std::string& doc, const std::string& value) {
+  const std::string first = doc.substr(0, doc.find_first_of(" :("));
+  if (first == value) return true;
+  try {
+    std::size_t a = 0, b = 0;
+    const double x = std::stod(first, &a), y = std::stod(value, &b);
+    return a == first.size() && b == value.size() && x == y;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(every_documented_setting_default_is_the_programs) {
+  // The default of every setting in docs/cli.md is the one --help prints (read from
+  // the options structs): looked up in the method's own table, then in the shared
+  // tables above the methods, then in the method its text refers to ("as for `cpg`").
+  const auto r = run_command(exe + " online --help");
+  BOOST_REQUIRE_EQUAL(r.exit_code, 0);
+  const std::string section = doc_section(cli_doc(), "## Online methods and their settings");
+  const std::string shared = section.substr(0, section.find("\n### "));
+  const std::regex method(R"(^  ([a-z][a-z-]*): )"), key(R"(^    ([a-z_]+): .*; default (.*)\]$)"),
+      refers(R"((?:as for|settings of)\s+`([a-z-]+)`)");
+  std::string name, own, referred;
+  int checked = 0;
+  for (const std::string& line : section_lines(r.out, "Online methods and their options (--option KEY=VALUE):")) {
+    std::smatch m;
+    if (std::regex_search(line, m, method)) {
+      name = m[1];
+      own = doc_section(section, "### `" + name + "`");
+      referred.clear();
+      if (std::regex_search(own, m, refers)) referred = doc_section(section, "### `" + m[1].str() + "`");
+    } else if (std::regex_search(line, m, key)) {
+      std::string doc = documented_default(own, m[1]);
+      if (doc.empty()) doc = documented_default(shared, m[1]);
+      if (doc.empty()) doc = documented_default(referred, m[1]);
+      BOOST_TEST(!doc.empty(), "docs/cli.md: no default of " << name << " " << m[1]);
+      if (doc.empty()) continue;
+      ++checked;
+      BOOST_TEST(states(doc, m[2]), "docs/cli.md: " << name << " " << m[1] << " default '" << doc
+                                                    << "', the program's is " << m[2]);
+    }
+  }
+  BOOST_TEST(checked >= 60, checked << " defaults checked");
+}

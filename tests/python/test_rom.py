@@ -1,6 +1,7 @@
 """A Python reduced model built from a CLI database answers as `contactrom online`
 on that database; a Python offline stage writes the CLI's database."""
 import gc
+import re
 
 import numpy as np
 import pytest
@@ -190,7 +191,7 @@ def test_cli_reduced_model_loads_in_python(tmp_path, hertz_db_path):
             "--out", str(path))
     loaded = contactrom.ReducedModel.load(str(path))
     assert loaded.method == "cpg"
-    assert float(loaded.options["cpg_tolerance"]) == 0.01
+    assert loaded.options["cpg_tolerance"] == 0.01
     assert_same_answers(loaded, query_cli(tmp_path, path))
     with pytest.raises(ValueError, match="needs params"):
         loaded.evaluate()
@@ -234,3 +235,37 @@ def test_every_class_and_constructor_has_a_docstring():
         # pybind11 puts the signature on the first line; a description must follow it.
         described = [line for line in init_doc.splitlines()[1:] if line.strip()]
         assert described, f"{cls.__name__}.__init__ has no description"
+
+
+def documented_defaults():
+    """{method: {key: default text}} as `contactrom online --help` prints them."""
+    methods, current = {}, None
+    for line in run_cli("online", "--help").stdout.splitlines():
+        head = re.match(r"^  ([a-z-]+): ", line)
+        option = re.match(r"^    ([a-z_]+): .*; default (.*)\]$", line)
+        if head:
+            current = methods.setdefault(head.group(1), {})
+        elif option and current is not None:
+            current[option.group(1)] = option.group(2)
+    return methods
+
+
+def test_every_option_reports_its_documented_default_typed(db):
+    methods = documented_defaults()
+    assert set(methods) >= {"greedy", "greedy-nested", "convex-hull", "cpg", "full-dictionary"}
+    for method, defaults in methods.items():
+        options = contactrom.ReducedModel(db, method=method).options
+        assert set(options) == set(defaults), method
+        for key, text in defaults.items():
+            value = options[key]
+            if text in ("true", "false"):
+                assert value is (text == "true"), (method, key, value)
+            elif re.fullmatch(r"-?\d+", text) and isinstance(value, int):
+                assert value == int(text), (method, key, value)
+            elif re.fullmatch(r"[-+0-9.e]+", text):
+                assert isinstance(value, float) and value == float(text), (method, key, value)
+            else:
+                assert value == text, (method, key, value)
+            # typed back in, the documented default is accepted and kept
+            again = contactrom.ReducedModel(db, method=method, options={key: value}).options
+            assert again[key] == value, (method, key)

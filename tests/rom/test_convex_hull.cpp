@@ -304,7 +304,6 @@ BOOST_AUTO_TEST_CASE(applicability) {
 }
 
 BOOST_AUTO_TEST_CASE(registry_and_options) {
-  rom::register_convex_hull_solver();
   const Setup& s = rope();
   const rom::ReducedModel model = model_of(s, 1e-7);
   rom::OnlineSolverOptions options;
@@ -322,7 +321,7 @@ BOOST_AUTO_TEST_CASE(registry_and_options) {
   BOOST_TEST(r.selected.size() == static_cast<std::size_t>(r.coefficients.size()));
   BOOST_TEST((r.u - hull->solve_detailed(mu).online.u).norm() == 0.0);
   for (const auto& bad : std::vector<std::pair<std::string, std::string>>{
-           {"basis", "qr"}, {"rank_l", "0"}, {"seed", "x"}, {"polish", "maybe"}, {"colour", "red"}}) {
+           {"basis", "qr"}, {"rank_l", "100001"}, {"seed", "x"}, {"polish", "maybe"}, {"colour", "red"}}) {
     rom::OnlineSolverOptions o;
     o.extra[bad.first] = bad.second;
     BOOST_CHECK_THROW(rom::convex_hull_options(o), InputError);

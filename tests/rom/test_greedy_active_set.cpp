@@ -834,12 +834,13 @@ BOOST_AUTO_TEST_CASE(registry_and_timing) {
   } catch (const InputError& e) {
     BOOST_TEST(std::string(e.what()).find("greedy") != std::string::npos);
   }
-  rom::OnlineSolverOptions bad;
-  bad.tau_scaling = "logarithmic";
-  BOOST_CHECK_THROW(rom::make_online_solver("greedy", model, bad), InputError);
-  rom::register_online_solver("greedy-copy", [](const rom::ReducedModel& m, const rom::OnlineSolverOptions& o) {
-    return std::unique_ptr<rom::OnlineSolver>(std::make_unique<rom::GreedyActiveSet>(m, rom::greedy_options(o)));
-  });
+  BOOST_CHECK_THROW(rom::options_from_map("greedy", {{"tau_scaling", "logarithmic"}}), InputError);
+  rom::register_online_method(rom::make_online_method(
+      "greedy-copy", "a copy of greedy",
+      [](const rom::ReducedModel& m, const rom::OnlineSolverOptions& o) {
+        return std::unique_ptr<rom::OnlineSolver>(std::make_unique<rom::GreedyActiveSet>(m, rom::greedy_options(o)));
+      },
+      rom::greedy_option_table()));
   const auto names = rom::online_solver_names();
   BOOST_TEST((std::find(names.begin(), names.end(), "greedy-copy") != names.end()));
 
@@ -913,7 +914,7 @@ BOOST_AUTO_TEST_CASE(concurrent_queries_match_sequential_ones) {
   for (int i = 1; i <= 16; ++i) params.push_back(Eigen::VectorXd::Constant(1, 0.3 * (i - 0.3) / 16));
   std::vector<rom::OnlineResult> seq, par(params.size());
   for (const auto& mu : params) seq.push_back(greedy.solve(mu));
-  rom::parallel_for(static_cast<int>(params.size()), 2, [&](int i) { par[i] = greedy.solve(params[i]); });
+  parallel_for(static_cast<int>(params.size()), 2, [&](int i) { par[i] = greedy.solve(params[i]); });
   for (size_t i = 0; i < params.size(); ++i) {
     BOOST_TEST(par[i].selected == seq[i].selected, boost::test_tools::per_element());
     BOOST_TEST((par[i].u - seq[i].u).norm() == 0.0);

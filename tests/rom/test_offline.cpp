@@ -125,7 +125,7 @@ BOOST_AUTO_TEST_CASE(parallel_for_visits_every_task_once_and_reports_progress) {
   std::vector<std::atomic<int>> visits(n);
   int last = 0, calls = 0;
   bool monotone = true;
-  contactrom::rom::parallel_for(
+  contactrom::parallel_for(
       n, 3, [&](int i) { visits[i]++; },
       [&](int done, int total) {
         monotone = monotone && done > last && total == n;
@@ -141,12 +141,12 @@ BOOST_AUTO_TEST_CASE(parallel_for_visits_every_task_once_and_reports_progress) {
 }
 
 BOOST_AUTO_TEST_CASE(parallel_for_rethrows_the_first_error) {
-  BOOST_CHECK_THROW(contactrom::rom::parallel_for(50, 2,
+  BOOST_CHECK_THROW(contactrom::parallel_for(50, 2,
                                                   [](int i) {
                                                     if (i == 17) throw std::runtime_error("task 17 failed");
                                                   }),
                     std::runtime_error);
-  contactrom::rom::parallel_for(0, 2, [](int) { throw std::runtime_error("never called"); });  // no tasks
+  contactrom::parallel_for(0, 2, [](int) { throw std::runtime_error("never called"); });  // no tasks
 }
 
 BOOST_AUTO_TEST_CASE(cli_offline_then_online_validation) {

@@ -253,12 +253,6 @@ BOOST_AUTO_TEST_CASE(unknown_methods_and_options_are_refused) {
   BOOST_CHECK_NO_THROW(rom::check_online_method("greedy"));
   rom::OnlineSolverOptions options;
   options.extra["colour"] = "blue";
-  BOOST_CHECK_THROW(rom::check_extra_options(options, "greedy", {"schedule"}), InputError);
-  BOOST_CHECK_NO_THROW(rom::check_extra_options(options, "greedy", {"colour"}));
-  BOOST_TEST(rom::parse_option_number("m", "k", "2.5") == 2.5);
-  BOOST_CHECK_THROW(rom::parse_option_number("m", "k", "2.5x"), InputError);
-  BOOST_CHECK_THROW(rom::parse_option_number("m", "k", "nan"), InputError);
-  BOOST_TEST(rom::parse_option_integer("m", "k", "12") == 12);
-  BOOST_CHECK_THROW(rom::parse_option_integer("m", "k", "1.5"), InputError);
+  BOOST_CHECK_THROW(rom::validate_online_options("greedy", options), InputError);
   BOOST_CHECK_THROW(rom::make_online_solver("no-such-method", evaluated().model), InputError);
 }
