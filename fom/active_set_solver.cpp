@@ -278,6 +278,11 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
       contact, m_problem.displacement_scale(), x, contact.search(x), pairing_options(),
       [&](const Pairing& pairing, const ConstraintMatrix& c, const Eigen::VectorXd& g, const Eigen::VectorXd& xk) {
         return qp.solve(pairing, c, g, xk, sol.iterations);
+      },
+      [&](const Pairing& pairing, const ConstraintMatrix& c, const PairedSolution& at, const Pairing& next,
+          Pairing& out) {
+        return newton_pairing(contact, cond.s, pairing, c, at.lambda, at.surface_displacement, next,
+                              m_options.newton_max_active, out);
       });
   // 4. The displacement u = u0 − K⁻¹ E_s Cᵀλ (one solve with the factor).
   sol.pairing_iterations = fp.iterations;
@@ -317,6 +322,7 @@ PairingFixedPointOptions ActiveSetSolver::pairing_options() const {
   o.max_iterations = m_options.max_pairing_iterations;
   o.tolerance = m_options.pairing_tolerance;
   o.anderson_depth = m_options.anderson_depth;
+  o.newton_start = m_options.newton_start;
   return o;
 }
 
