@@ -143,6 +143,15 @@ class ActiveSetSolver {
   /// \param warm optional previous solution: its multipliers and pairing seed the iteration.
   FomSolution solve(const Param& mu, const FomSolution* warm = nullptr) const;
 
+  /// \brief The query at a known pairing: the unconstrained solution, one assembly of
+  /// C, one dual QP on its working set (chosen at the surface displacement `x_s`),
+  /// one back-substitution and the certificate, without the pairing fixed point. With
+  /// a solution's own pairing and surface displacement it reproduces that solution;
+  /// its time is the limit a query's pairing loop is measured against (`contactrom
+  /// bench`, key `fom_limit`). Needs a parameter-independent stiffness (else
+  /// InvalidInput).
+  FomSolution solve_at(const Param& mu, const Pairing& pairing, const Eigen::VectorXd& x_s) const;
+
   /// Time spent in the constructor: factorising and condensing when K is constant,
   /// ordering the dofs for the per-query factorisations otherwise (rope).
   double setup_time() const { return m_setup_time; }
@@ -150,6 +159,9 @@ class ActiveSetSolver {
 
  private:
   FomSolution solve_with(const Condensation& cond, const Param& mu, const FomSolution* warm) const;
+  /// λ, the pairing and u = u0 − K⁻¹ E_s Cᵀλ into `sol`, certified (certify_fom_solution()).
+  void finish(const Condensation& cond, const Eigen::VectorXd& u0, const Pairing& pairing, const ConstraintMatrix& c,
+              const Eigen::VectorXd& lambda, FomSolution& sol) const;
   PairingFixedPointOptions pairing_options() const;
 
   const Problem& m_problem;

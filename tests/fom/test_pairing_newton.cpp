@@ -3,7 +3,8 @@
 // assembly (hertz and ironing, at converged solutions); the Newton-stepped fixed
 // point reaches the Anderson-only fixed point on ironing (where the plain iteration
 // does not converge at all and Anderson needs several times more iterations) and on
-// hertz with the row cap lifted, with KKT residuals at rounding level; without a
+// hertz with the row cap lifted, with KKT residuals at rounding level; solve_at a
+// solution's own pairing reproduces it; without a
 // linearisation (3D, obstacles) no step is proposed.
 #define BOOST_TEST_MODULE fom_pairing_newton
 #include <boost/test/unit_test.hpp>
@@ -155,4 +156,25 @@ BOOST_AUTO_TEST_CASE(no_step_without_a_linearisation_or_active_rows) {
   Pairing out;
   const Eigen::MatrixXd s = Eigen::MatrixXd::Identity(u.size(), u.size());
   BOOST_TEST(!newton_pairing(hc, s, pairing, c, Eigen::VectorXd::Zero(hc.num_constraints()), u, pairing, 100, out));
+}
+
+BOOST_AUTO_TEST_CASE(solve_at_the_final_pairing_reproduces_the_solution) {
+  // ActiveSetSolver::solve_at (the limit model of `contactrom bench`): one QP at a
+  // solution's own pairing gives that solution back, in one pairing iteration.
+  for (const auto& [name, d] : {std::pair<std::string, double>{"hertz", 0.15}, {"ironing", 1.5}}) {
+    const Problem& p = problem(name);
+    const ActiveSetSolver solver(p);
+    const FomSolution s = solver.solve(p1(d));
+    BOOST_TEST_REQUIRE(s.status == Status::Success, s.message);
+    const FomSolution at = solver.solve_at(p1(d), s.pairing, p.contact().restrict_to_surface(s.u));
+    BOOST_TEST_REQUIRE(at.status == Status::Success, at.message);
+    BOOST_TEST(at.pairing_iterations == 1);
+    BOOST_TEST((at.u - s.u).norm() <= 1e-12 * s.u.norm(), name);
+    BOOST_TEST((at.lambda - s.lambda).norm() <= 1e-10 * s.lambda.norm(), name);
+    BOOST_TEST(at.kkt.max() <= 1e-10);
+  }
+  // A stiffness that depends on μ has no single factorisation to reuse: refused.
+  const Problem& rope = problem("rope");
+  const FomSolution r = ActiveSetSolver(rope).solve_at(p1(20.0), Pairing{}, Eigen::VectorXd());
+  BOOST_TEST(r.status == Status::InvalidInput);
 }
