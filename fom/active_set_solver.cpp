@@ -353,6 +353,7 @@ PairingFixedPointOptions ActiveSetSolver::pairing_options() const {
   o.max_iterations = m_options.max_pairing_iterations;
   o.tolerance = m_options.pairing_tolerance;
   o.anderson_depth = m_options.anderson_depth;
+  o.anderson_restart = m_options.anderson_restart;
   o.newton_start = m_options.newton_start;
   return o;
 }

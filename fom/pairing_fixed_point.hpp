@@ -62,6 +62,8 @@ struct PairingFixedPointOptions {
   int max_iterations = 300;   ///< cap on the solves (pairing iterations). Default 300.
   double tolerance = 1e-12;   ///< stop when pairing_change() ≤ this (relative). Default 1e-12.
   int anderson_depth = 10;    ///< Anderson depth (0: plain fixed-point iteration). Default 10.
+  /// Clear the Anderson history whenever the change |F(x) − x| grows. Default true.
+  bool anderson_restart = true;
   /// Whether the penetration under the new pairing is part of pairing_change() (see
   /// the file comment): true for exact solves, false for reduced solutions, which
   /// penetrate slightly whatever their pairing. Default true.
@@ -125,7 +127,7 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
                                                   Pairing pairing, const PairingFixedPointOptions& options,
                                                   SolveAtPairing&& solve_at, NewtonStep&& newton = nullptr) {
   PairingFixedPointResult out;
-  AndersonMixer mixer(options.anderson_depth);
+  AndersonMixer mixer(options.anderson_depth, options.anderson_restart);
   ConstraintMatrix c_next;
   Eigen::VectorXd g_next;
   Pairing next;

@@ -18,7 +18,7 @@
 /// their coordinates touch enter (|D| ≈ 4|A| in 2D): a step costs O(|A|³), with no
 /// dependence on the mesh beyond the contact zone, against O(n_s |W|) for a plain
 /// iteration (n_s surface dofs, |W| the QP's working set). It pays where few rows
-/// carry the contact: ironing (6 active rows of 50) needs 16 instead of 45
+/// carry the contact: ironing (6 active rows of 50) needs 14 instead of 45
 /// iterations and takes less time; hertz (27 of 79) needs 6 instead of 17 but each
 /// step costs about four plain iterations (docs/results.md), hence the cap on |A|.
 ///
