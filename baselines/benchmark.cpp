@@ -35,6 +35,38 @@ double time_ipopt(const fom::Problem& problem, const std::vector<fom::Param>& pa
   return rom::median(times);
 }
 
+/// The FOM's limit: each query again at its own final pairing (solve_at), in rounds
+/// that alternate a FOM query and a limit query, so that both meet the same load.
+void time_fom_limit(const fom::ActiveSetSolver& solver, const std::vector<fom::Param>& params, int repeats,
+                    BenchReport& r) {
+  const fom::ContactModel& contact = solver.problem().contact();
+  std::vector<fom::FomSolution> solutions;
+  double iterations = 0.0;
+  for (const fom::Param& mu : params) {
+    solutions.push_back(solver.solve(mu));
+    iterations += solutions.back().pairing_iterations;
+    if (solver.solve_at(mu, solutions.back().pairing, contact.restrict_to_surface(solutions.back().u)).status ==
+        Status::InvalidInput)
+      return;
+  }
+  r.fom_pairing_iterations = params.empty() ? 0.0 : iterations / static_cast<double>(params.size());
+  std::vector<double> limit, fom;
+  const auto clock = [](auto&& f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  for (int round = 0; round < repeats; ++round)
+    for (size_t i = 0; i < params.size(); ++i) {
+      const fom::FomSolution& s = solutions[i];
+      const Eigen::VectorXd x_s = contact.restrict_to_surface(s.u);
+      fom.push_back(clock([&] { (void)solver.solve(params[i]); }));
+      limit.push_back(clock([&] { (void)solver.solve_at(params[i], s.pairing, x_s); }));
+    }
+  r.fom_limit_s = rom::median(limit);
+  r.ratios["fom_active_set/fom_limit"] = rom::median(fom) / r.fom_limit_s;
+}
+
 void add_ratios(BenchReport& r) {
   std::map<std::string, double> t;
   for (const BenchMethod& m : r.methods) {
@@ -117,6 +149,7 @@ BenchReport benchmark(const rom::ReducedModel& model, const std::vector<fom::Par
   const rom::InterleavedTiming timing = rom::time_interleaved(fom_solver, solvers, params, options.repeats, clocked);
   r.fom_active_set_s = timing.fom_median_s;
   r.fom_active_set_rounds = timing.fom_round_median_s;
+  time_fom_limit(fom_solver, params, options.repeats, r);
   for (size_t i = 0; i < r.methods.size(); ++i) r.methods[i].timing = timing.online[i];
   add_ratios(r);
   return r;

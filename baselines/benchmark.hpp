@@ -58,13 +58,19 @@ struct BenchReport {
   int queries = 0;                          ///< parameters timed
   double fom_active_set_s = 0.0;            ///< median FOM time per query
   std::vector<double> fom_active_set_rounds;  ///< the FOM median of each round (the machine's noise)
+  /// Median time of the same queries at their known pairing (fom::ActiveSetSolver::
+  /// solve_at: one QP, one back-substitution, the certificate): the FOM's limit, timed
+  /// in rounds interleaved with FOM queries (0 when the stiffness depends on μ).
+  double fom_limit_s = 0.0;
+  double fom_pairing_iterations = 0.0;      ///< mean pairing iterations of the FOM queries
   double fom_ipopt_s = 0.0;                 ///< median Ipopt time per query (0 if not timed)
   int ipopt_queries = 0;                    ///< parameters timed for Ipopt
   std::vector<BenchMethod> methods;         ///< the variants that apply, in order
   /// Variants that do not apply to the problem (key → the InputError's message),
   /// e.g. convex-hull on a non-convex feasible set.
   std::map<std::string, std::string> not_applicable;
-  /// Quotients of the medians: "fom_ipopt/fom_active_set", "fom_active_set/<key>",
+  /// Quotients of the medians: "fom_ipopt/fom_active_set", "fom_active_set/fom_limit",
+  /// "fom_active_set/<key>",
   /// the greedy without its warm start against with it, and every baseline against
   /// both greedy schedules (also without the operators' construction).
   std::map<std::string, double> ratios;

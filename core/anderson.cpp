@@ -4,7 +4,8 @@
 
 namespace contactrom {
 
-AndersonMixer::AndersonMixer(int depth) : m_depth(std::max(depth, 0)) {}
+AndersonMixer::AndersonMixer(int depth, bool restart_on_growth)
+    : m_depth(std::max(depth, 0)), m_restart_on_growth(restart_on_growth) {}
 
 void AndersonMixer::reset(int depth) {
   clear();
@@ -26,7 +27,7 @@ void AndersonMixer::next(const Eigen::VectorXd& x, const Eigen::VectorXd& f, Eig
   size_for(x.size());
   m_r = f - x;  // before `out` is written: it may be x
   if (m_started && m_depth > 0) {
-    if (m_r.norm() > m_r_prev.norm()) restart();  // restart on growth
+    if (m_restart_on_growth && m_r.norm() > m_r_prev.norm()) restart();
     int slot;
     if (m_count < m_depth) {
       slot = (m_oldest + m_count) % m_depth, ++m_count;

@@ -9,8 +9,8 @@ namespace contactrom {
 
 /// \brief Keeps the last `depth` differences of the iterates and their residuals
 /// r = F(x) − x, and extrapolates x_next = F(x) − ΔF γ with γ = argmin |r − ΔR γ|
-/// (normal equations, a pivoted LDLᵀ drops dependent differences). The history is
-/// cleared whenever the residual grows.
+/// (normal equations, a pivoted LDLᵀ drops dependent differences). By default the
+/// history is cleared whenever the residual grows.
 ///
 /// The differences live in two n × depth matrices used as ring buffers, and the
 /// normal equations are always depth × depth (the unused part is the identity with
@@ -19,7 +19,9 @@ namespace contactrom {
 class AndersonMixer {
  public:
   /// \param depth number of differences kept (0: plain fixed-point iteration)
-  explicit AndersonMixer(int depth);
+  /// \param restart_on_growth clear the differences when |F(x) − x| grows (default);
+  ///   false keeps them (the FOM's pairing fixed point, whose early iterates jump)
+  explicit AndersonMixer(int depth, bool restart_on_growth = true);
 
   /// \brief The next iterate into `out`, given the current one `x` and its image
   /// `f` = F(x). `out` may be `x` or `f`.
@@ -46,6 +48,7 @@ class AndersonMixer {
   void size_for(Eigen::Index n);
 
   int m_depth;
+  bool m_restart_on_growth = true;
   int m_count = 0;   // differences held
   int m_oldest = 0;  // ring-buffer column of the oldest one
   bool m_started = false;

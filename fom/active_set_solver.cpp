@@ -268,20 +268,56 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
       contact, m_problem.displacement_scale(), x, contact.search(x), pairing_options(),
       [&](const Pairing& pairing, const ConstraintMatrix& c, const Eigen::VectorXd& g, const Eigen::VectorXd& xk) {
         return qp.solve(pairing, c, g, xk, sol.iterations);
+      },
+      [&](const Pairing& pairing, const ConstraintMatrix& c, const PairedSolution& at, const Pairing& next,
+          Pairing& out) {
+        return newton_pairing(contact, cond.s, pairing, c, at.lambda, at.surface_displacement, next,
+                              m_options.newton_max_active, out);
       });
-  // 4. The displacement u = u0 − K⁻¹ E_s Cᵀλ (one solve with the factor).
+  // 4. The displacement u = u0 − K⁻¹ E_s Cᵀλ (one solve with the factor), certified.
   sol.pairing_iterations = fp.iterations;
-  sol.lambda = fp.solution.lambda;
-  sol.pairing = fp.pairing;
-  sol.active = static_cast<int>((sol.lambda.array() > 0.0).count());
-  sol.u = u0;
-  if (sol.active > 0) sol.u -= cond.surface_response(fp.c.transpose() * sol.lambda);
   sol.status = fp.status;
   if (fp.solution.status != Status::Success)
     sol.message = "dual active-set QP failed: " + std::string(to_string(fp.solution.status));
   else if (fp.status != Status::Success)
     sol.message = pairing_no_convergence_message(fp, pairing_options());
+  finish(cond, u0, fp.pairing, fp.c, fp.solution.lambda, sol);
+  sol.time_s = seconds_since(t0);
+  return sol;
+}
+
+void ActiveSetSolver::finish(const Condensation& cond, const Eigen::VectorXd& u0, const Pairing& pairing,
+                             const ConstraintMatrix& c, const Eigen::VectorXd& lambda, FomSolution& sol) const {
+  sol.lambda = lambda;
+  sol.pairing = pairing;
+  sol.active = static_cast<int>((sol.lambda.array() > 0.0).count());
+  sol.u = u0;
+  if (sol.active > 0) sol.u -= cond.surface_response(c.transpose() * sol.lambda);
   certify_fom_solution(m_problem, sol, m_options.kkt_tolerance);
+}
+
+FomSolution ActiveSetSolver::solve_at(const Param& mu, const Pairing& pairing, const Eigen::VectorXd& x_s) const {
+  m_problem.check_param(mu);
+  FomSolution sol;
+  sol.mu = mu;
+  if (!m_constant || !m_constant_ok) {
+    sol.status = Status::InvalidInput;
+    sol.message = "a solve at a given pairing needs a factorised parameter-independent stiffness";
+    return sol;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const ContactModel& contact = m_problem.contact();
+  const Eigen::VectorXd u0 = m_constant->z_load * m_problem.load_coefficients(mu);
+  const Eigen::VectorXd u0_s = contact.restrict_to_surface(u0);
+  ConstraintMatrix c;
+  Eigen::VectorXd g;
+  contact.assemble(pairing, c, g);
+  WorkingSetQp qp(m_problem, *m_constant, m_options, u0_s, Eigen::VectorXd::Zero(contact.num_constraints()));
+  const PairedSolution at = qp.solve(pairing, c, g, x_s, sol.iterations);
+  sol.pairing_iterations = 1;
+  sol.status = at.status;
+  if (at.status != Status::Success) sol.message = "dual active-set QP failed: " + std::string(to_string(at.status));
+  finish(*m_constant, u0, pairing, c, at.lambda, sol);
   sol.time_s = seconds_since(t0);
   return sol;
 }
@@ -307,6 +343,8 @@ PairingFixedPointOptions ActiveSetSolver::pairing_options() const {
   o.max_iterations = m_options.max_pairing_iterations;
   o.tolerance = m_options.pairing_tolerance;
   o.anderson_depth = m_options.anderson_depth;
+  o.anderson_restart = m_options.anderson_restart;
+  o.newton_start = m_options.newton_start;
   return o;
 }
 

@@ -452,6 +452,119 @@ void NodeToSegmentContact::assemble_rows(const Pairing& p, const std::vector<int
   c.resizeNonZeros(nnz);
 }
 
+bool NodeToSegmentContact::linearise_pairing(const Eigen::VectorXd& u_surface, const Pairing& p,
+                                             const std::vector<int>& rows, PairingLinearisation& out) const {
+  // Row k on segment j = (a, b) of its chain, deformed positions x = X + u:
+  //  position  ξ = (x_k − x_a)·τ / |τ|², τ = x_b − x_a (0 where the search clamped ξ);
+  //  normal    n = m/|m|, m = (1−ξ) N_a + ξ N_b, N_i the normalised sum of the unit
+  //            outward normals ν_e = R τ_e/|τ_e| (R τ = (τ_y, −τ_x)) of the segments
+  //            at node i; its angle θ moves by dθ = t·dm/|m|, t = (−n_y, n_x),
+  //            dN_i = (I − N_i N_iᵀ) Σ dν_e / |m_i|, dν_e = (I − ν_e ν_eᵀ) R dτ_e / |τ_e|.
+  const int nr = static_cast<int>(rows.size()), nsd = static_cast<int>(m_surface_dofs.size());
+  out.per_row = 2;
+  out.q.resize(2 * nr);
+  out.dg.resize(2 * nr);
+  std::vector<Eigen::Triplet<double>> dq, dc;
+  const auto rot = [](const Eigen::Vector2d& v) { return Eigen::Vector2d(v.y(), -v.x()); };    // R
+  const auto rot_t = [](const Eigen::Vector2d& v) { return Eigen::Vector2d(-v.y(), v.x()); };  // Rᵀ
+  for (int r = 0; r < nr; ++r) {
+    const int k = rows[static_cast<size_t>(r)], j = p.segment[static_cast<size_t>(k)];
+    if (j < 0) return false;
+    const Pair& pair = m_pairs[static_cast<size_t>(m_row_pair[static_cast<size_t>(k)])];
+    const int nm = static_cast<int>(pair.master.size()), nseg = nm - 1;
+    const auto master_dof = [&](int i) { return 2 * pair.master_surface[static_cast<size_t>(i)]; };
+    const auto deformed = [&](int i) -> Eigen::Vector2d {
+      return pair.master_x.col(i) + u_surface.segment<2>(master_dof(i));
+    };
+    const double xi = p.xi[static_cast<size_t>(k)], w = m_weights(k);
+    const Eigen::Vector2d n = p.normal.col(k), t(-n.y(), n.x());
+    out.q(2 * r) = j + xi;
+    out.q(2 * r + 1) = std::atan2(n.y(), n.x());
+    // ∂C/∂ξ and ∂C/∂θ at the pairing (entries of the slave node, a and b).
+    const Eigen::Vector2d xs_ref = m_slave_x.col(k), xa_ref = pair.master_x.col(j), xb_ref = pair.master_x.col(j + 1);
+    const int dofs[3] = {2 * k, master_dof(j), master_dof(j + 1)};
+    const Eigen::Vector2d dc_xi[3] = {Eigen::Vector2d::Zero(), -w * n, w * n};
+    const Eigen::Vector2d dc_theta[3] = {-w * t, w * (1.0 - xi) * t, w * xi * t};
+    for (int e = 0; e < 3; ++e)
+      for (int d = 0; d < 2; ++d) {
+        if (dc_xi[e](d) != 0.0) dc.emplace_back(2 * r, dofs[e] + d, dc_xi[e](d));
+        dc.emplace_back(2 * r + 1, dofs[e] + d, dc_theta[e](d));
+      }
+    out.dg(2 * r) = w * n.dot(xa_ref - xb_ref);
+    out.dg(2 * r + 1) = w * t.dot(xs_ref - ((1.0 - xi) * xa_ref + xi * xb_ref));
+
+    // ∂ξ/∂x of the slave node, a and b (zero where the projection is clamped).
+    const Eigen::Vector2d xs = xs_ref + u_surface.segment<2>(2 * k), xa = deformed(j), xb = deformed(j + 1);
+    const Eigen::Vector2d tau = xb - xa, dist = xs - xa;
+    const double len2 = tau.squaredNorm();
+    Eigen::Vector2d gxi[3] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+    if (xi > 0.0 && xi < 1.0) {
+      gxi[0] = tau / len2;
+      gxi[2] = (dist - 2.0 * xi * tau) / len2;
+      gxi[1] = -gxi[0] - gxi[2];
+    }
+    // Nodal normals at a and b and the gradient of θ on the chain nodes a−1 … b+1.
+    Eigen::Vector2d node_m[2], node_n[2];
+    for (int e = 0; e < 2; ++e) {
+      const int i = j + e;
+      node_m[e].setZero();
+      for (int seg = std::max(i - 1, 0); seg <= std::min(i, nseg - 1); ++seg) {
+        const Eigen::Vector2d ts = deformed(seg + 1) - deformed(seg);
+        node_m[e] += rot(ts) / ts.norm();
+      }
+      node_n[e] = node_m[e].normalized();
+    }
+    const Eigen::Vector2d m = (1.0 - xi) * node_n[0] + xi * node_n[1];
+    const double mlen = m.norm();
+    Eigen::Vector2d gtheta_master[4] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(),
+                                        Eigen::Vector2d::Zero()};  // nodes j−1 … j+2
+    const double c_xi = t.dot(node_n[1] - node_n[0]) / mlen;
+    for (int e = 0; e < 2; ++e) {
+      const int i = j + e;
+      const double weight = (e == 0 ? 1.0 - xi : xi) / (mlen * node_m[e].norm());
+      const Eigen::Vector2d v = weight * (t - node_n[e] * node_n[e].dot(t));  // (I − N Nᵀ) t, scaled
+      for (int seg = std::max(i - 1, 0); seg <= std::min(i, nseg - 1); ++seg) {
+        const Eigen::Vector2d ts = deformed(seg + 1) - deformed(seg);
+        const double len = ts.norm();
+        const Eigen::Vector2d nu = rot(ts) / len;
+        const Eigen::Vector2d ws = rot_t(v - nu * nu.dot(v)) / len;  // ∂/∂τ_e of vᵀν_e
+        gtheta_master[seg + 1 - (j - 1)] += ws;
+        gtheta_master[seg - (j - 1)] -= ws;
+      }
+    }
+    for (int d = 0; d < 2; ++d) {
+      for (int e = 0; e < 3; ++e) {
+        if (gxi[e](d) == 0.0) continue;
+        dq.emplace_back(2 * r, dofs[e] + d, gxi[e](d));
+        dq.emplace_back(2 * r + 1, dofs[e] + d, c_xi * gxi[e](d));
+      }
+      for (int e = 0; e < 4; ++e) {
+        const int i = j - 1 + e;
+        if (i < 0 || i >= nm || gtheta_master[e](d) == 0.0) continue;
+        dq.emplace_back(2 * r + 1, master_dof(i) + d, gtheta_master[e](d));
+      }
+    }
+  }
+  out.dq_du.resize(2 * nr, nsd);
+  out.dq_du.setFromTriplets(dq.begin(), dq.end());
+  out.dc.resize(2 * nr, nsd);
+  out.dc.setFromTriplets(dc.begin(), dc.end());
+  return true;
+}
+
+void NodeToSegmentContact::move_pairing(Pairing& p, const std::vector<int>& rows, const Eigen::VectorXd& q) const {
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const int k = rows[r];
+    const int nseg = static_cast<int>(m_pairs[static_cast<size_t>(m_row_pair[static_cast<size_t>(k)])].master.size()) - 1;
+    const double position = std::clamp(q(static_cast<Eigen::Index>(2 * r)), 0.0, static_cast<double>(nseg));
+    const int j = std::min(static_cast<int>(std::floor(position)), nseg - 1);
+    const double theta = q(static_cast<Eigen::Index>(2 * r + 1));
+    p.segment[static_cast<size_t>(k)] = j;
+    p.xi[static_cast<size_t>(k)] = position - j;
+    p.normal.col(k) = Eigen::Vector2d(std::cos(theta), std::sin(theta));
+  }
+}
+
 ObstacleContact::ObstacleContact(const Eigen::VectorXd& x, const Eigen::VectorXd& psi,
                                  const Eigen::VectorXd& weights)
     : m_psi(psi) {

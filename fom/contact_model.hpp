@@ -56,6 +56,22 @@ struct SearchMemory {
   int certified = 0, searched = 0;   ///< rows settled by the memory / by a full search, so far
 };
 
+/// \brief First-order model of a pairing, for a Newton update of the pairing fixed
+/// point (fom/pairing_newton.hpp): k continuous coordinates per listed row (2D node
+/// to segment: the position along the master chain, segment + ξ, and the angle of
+/// the normal), their derivatives with respect to the surface displacement, and the
+/// derivatives of the rows of C and g with respect to them.
+struct PairingLinearisation {
+  int per_row = 0;        ///< coordinates per row, k
+  Eigen::VectorXd q;      ///< the coordinates, row after row (k·|rows|)
+  /// ∂q/∂u_s at the pairing of u_s itself (its closest points), k·|rows| x n_s
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> dq_du;
+  /// ∂C_r/∂q_j: row j is the derivative of the constraint row r of coordinate j
+  /// (at fixed u), k·|rows| x n_s; dg the same for g
+  ConstraintMatrix dc;
+  Eigen::VectorXd dg;
+};
+
 /// \brief Abstract contact model; see the file comment.
 class ContactModel {
  public:
@@ -114,6 +130,21 @@ class ContactModel {
   virtual void assemble_rows(const Pairing& pairing, const std::vector<int>& rows, ConstraintMatrix& c,
                              Eigen::VectorXd& g) const;
 
+  /// \brief The pairing's coordinates and derivatives at the listed rows (all paired)
+  /// for the surface displacement `u_surface` whose pairing (search) is `pairing`;
+  /// see PairingLinearisation. Returns false when the model has none (obstacles,
+  /// node-to-face contact): the pairing fixed point then runs without Newton steps.
+  virtual bool linearise_pairing(const Eigen::VectorXd& u_surface, const Pairing& pairing,
+                                 const std::vector<int>& rows, PairingLinearisation& out) const {
+    (void)u_surface, (void)pairing, (void)rows, (void)out;
+    return false;
+  }
+  /// \brief Sets the listed rows of `pairing` to the coordinates `q` (as
+  /// linearise_pairing() numbers them). Only for models whose linearise_pairing() succeeds.
+  virtual void move_pairing(Pairing& pairing, const std::vector<int>& rows, const Eigen::VectorXd& q) const {
+    (void)pairing, (void)rows, (void)q;
+  }
+
   /// Gather a full dof vector onto the surface dofs.
   Eigen::VectorXd restrict_to_surface(const Eigen::VectorXd& u_full) const;
 
@@ -159,6 +190,12 @@ class NodeToSegmentContact final : public ContactModel {
   void assemble(const Pairing& pairing, ConstraintMatrix& c, Eigen::VectorXd& g) const override;
   void assemble_rows(const Pairing& pairing, const std::vector<int>& rows, ConstraintMatrix& c,
                      Eigen::VectorXd& g) const override;
+
+  /// Coordinates (position segment + ξ along the master chain, normal angle) of the
+  /// rows; dq_du from the closest-point projection and the averaged nodal normals.
+  bool linearise_pairing(const Eigen::VectorXd& u_surface, const Pairing& pairing, const std::vector<int>& rows,
+                         PairingLinearisation& out) const override;
+  void move_pairing(Pairing& pairing, const std::vector<int>& rows, const Eigen::VectorXd& q) const override;
 
   /// Slave node ids of every row, in row order.
   const std::vector<int>& slave_nodes() const { return m_slave; }

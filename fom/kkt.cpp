@@ -44,7 +44,7 @@ KktResiduals kkt_residuals(const Problem& problem, const Param& mu, const Eigen:
   // Stationarity on free dofs: K (u - lift) - f + Cᵀλ, relative to the largest of
   // its three terms (a normwise backward error): relative to ‖f‖ alone, a vanishing
   // load (d = 1e-300) would turn the round-off of K u into a residual of 1e278.
-  const Eigen::VectorXd ku = problem.stiffness(mu) * (u - problem.lifting(mu));
+  const Eigen::VectorXd ku = problem.apply_stiffness(mu, u - problem.lifting(mu));
   Eigen::VectorXd ct = Eigen::VectorXd::Zero(ku.size());
   const Eigen::VectorXd ctl = c.transpose() * lambda;
   const std::vector<int>& surf = contact.surface_dofs();

@@ -15,7 +15,10 @@
 ///     \f$ \lambda \f$ and the surface displacement \f$ F(x) \f$ of the solution;
 ///  3. re-pair at \f$ F(x) \f$ → \f$ C', g' \f$ and stop when the KKT system of the
 ///     solution is unchanged (pairing_change() ≤ `tolerance`);
-///  4. otherwise \f$ x \leftarrow \f$ Anderson mixing of \f$ x, F(x) \f$
+///  4. otherwise, when the caller supplies Newton steps (fom/pairing_newton.hpp) and
+///     the change is at most `newton_start`: the next pairing is the Newton step's,
+///     for as long as each step reduces the change (then Anderson from there);
+///  5. otherwise \f$ x \leftarrow \f$ Anderson mixing of \f$ x, F(x) \f$
 ///     (AndersonMixer, Walker & Ni 2011, type II, depth `anderson_depth`) and go to 1;
 ///     a solve that reports PairedSolution::map_changed (a reduced solver changed
 ///     the columns it solves on, so F itself changed) drops the history first.
@@ -43,7 +46,9 @@
 /// what re-pairing changes — forces and gaps — with the same meaning of `tolerance`.
 #include <Eigen/Dense>
 #include <limits>
+#include <cstddef>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "core/anderson.hpp"
@@ -57,10 +62,16 @@ struct PairingFixedPointOptions {
   int max_iterations = 300;   ///< cap on the solves (pairing iterations). Default 300.
   double tolerance = 1e-12;   ///< stop when pairing_change() ≤ this (relative). Default 1e-12.
   int anderson_depth = 10;    ///< Anderson depth (0: plain fixed-point iteration). Default 10.
+  /// Clear the Anderson history whenever the change |F(x) − x| grows. Default true.
+  bool anderson_restart = true;
   /// Whether the penetration under the new pairing is part of pairing_change() (see
   /// the file comment): true for exact solves, false for reduced solutions, which
   /// penetrate slightly whatever their pairing. Default true.
   bool penetration = true;
+  /// Newton steps on the pairing (when the caller supplies them) once pairing_change()
+  /// is at most this; 0: never. Default 0.1 (from farther away a step may leave the
+  /// active set it linearises; the Anderson iterates get there in a few steps).
+  double newton_start = 0.1;
 };
 
 /// \brief What the solve at a fixed pairing returns to the fixed point.
@@ -107,12 +118,16 @@ double pairing_change(const ConstraintMatrix& c, const Eigen::VectorXd& g, const
 /// \param solve_at `PairedSolution(const Pairing&, const ConstraintMatrix& c, const
 ///   Eigen::VectorXd& g, const Eigen::VectorXd& x)`: the exact solve at the pairing
 ///   whose operator is c, g; x is the iterate the pairing was computed from.
-template <class SolveAtPairing>
+/// \param newton optional `bool(const Pairing& pairing, const ConstraintMatrix& c,
+///   const PairedSolution& solution, const Pairing& next, Pairing& out)`: the pairing
+///   of a Newton step from the solution at `pairing` whose re-pairing is `next`
+///   (false: none this time); nullptr: Anderson steps only.
+template <class SolveAtPairing, class NewtonStep = std::nullptr_t>
 PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, double u_scale, Eigen::VectorXd x,
                                                   Pairing pairing, const PairingFixedPointOptions& options,
-                                                  SolveAtPairing&& solve_at) {
+                                                  SolveAtPairing&& solve_at, NewtonStep&& newton = nullptr) {
   PairingFixedPointResult out;
-  AndersonMixer mixer(options.anderson_depth);
+  AndersonMixer mixer(options.anderson_depth, options.anderson_restart);
   ConstraintMatrix c_next;
   Eigen::VectorXd g_next;
   Pairing next;
@@ -121,6 +136,9 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
   // full search's result.
   SearchMemory memory;
   bool assembled = false;  // out.c, out.g already hold the operator of `pairing`
+  bool newton_on = options.newton_start > 0.0;
+  double newton_change = std::numeric_limits<double>::infinity();  // change when the last Newton step was taken
+  Pairing proposal;
   out.status = Status::NoConvergence;
   for (int it = 0; it < options.max_iterations; ++it) {
     ++out.iterations;
@@ -148,6 +166,20 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
     // At the cap, out keeps the last solve's pairing, operator and solution: the
     // next pairing is not built into it.
     if (it + 1 == options.max_iterations) break;
+    if constexpr (!std::is_same_v<std::decay_t<NewtonStep>, std::nullptr_t>) {
+      if (newton_on && out.residual <= options.newton_start) {
+        if (out.residual >= newton_change) {
+          newton_on = false;  // the last step did not reduce the change: Anderson from here on
+        } else if (newton(pairing, out.c, out.solution, next, proposal)) {
+          newton_change = out.residual;
+          x = f;
+          std::swap(pairing, proposal);
+          assembled = false;
+          mixer.clear();
+          continue;
+        }
+      }
+    }
     if (out.solution.map_changed) mixer.clear();
     x = mixer.next(x, f);
     assembled = x == f;

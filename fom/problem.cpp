@@ -318,6 +318,14 @@ SparseMatrix Problem::stiffness(const Param& mu) const {
   return k;
 }
 
+Eigen::VectorXd Problem::apply_stiffness(const Param& mu, const Eigen::VectorXd& v) const {
+  const Eigen::VectorXd theta = stiffness_coefficients(mu);
+  Eigen::VectorXd kv = m_k_terms[0] * v;
+  if (theta(0) != 1.0) kv *= theta(0);
+  for (int q = 1; q < num_stiffness_terms(); ++q) kv.noalias() += theta(q) * (m_k_terms[q] * v);
+  return kv;
+}
+
 Eigen::VectorXd Problem::lifting(const Param& mu) const {
   const Eigen::VectorXd phi = load_coefficients(mu);
   Eigen::VectorXd l = Eigen::VectorXd::Zero(num_dofs());
@@ -329,7 +337,7 @@ Eigen::VectorXd Problem::rhs(const Param& mu) const {
   const Eigen::VectorXd phi = load_coefficients(mu);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
   for (int k = 0; k < num_load_terms(); ++k) f += phi(k) * m_fext_terms[k];
-  f -= stiffness(mu) * lifting(mu);
+  f -= apply_stiffness(mu, lifting(mu));
   for (int i = 0; i < num_dofs(); ++i)
     if (m_is_dirichlet[i]) f(i) = 0.0;
   return f;

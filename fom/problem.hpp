@@ -66,6 +66,9 @@ class Problem {
   Eigen::VectorXd stiffness_coefficients(const Param& mu) const;
   /// K(μ) on all dofs (Dirichlet rows/columns kept).
   SparseMatrix stiffness(const Param& mu) const;
+  /// \brief K(μ) v = Σ θ_q(μ) (K_q v) on all dofs, without forming K(μ) (a per-query
+  /// residual must not copy the matrix: at 2k dofs that copy costs more than the solve).
+  Eigen::VectorXd apply_stiffness(const Param& mu, const Eigen::VectorXd& v) const;
   bool stiffness_is_constant() const { return m_k_terms.size() == 1 && m_k_coeff[0].is_constant(); }
 
   int num_load_terms() const { return static_cast<int>(m_lift_terms.size()); }

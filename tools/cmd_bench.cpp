@@ -15,6 +15,11 @@
 //                   convention; from a second, clocked solver (OnlineSolverOptions::
 //                   time_operators) timed in the same rounds
 //   fom_active_set_rounds  the FOM median of each round (how noisy the machine was)
+//   fom_limit       the same queries at their known final pairing (one dual QP, one
+//                   back-substitution, the certificate: ActiveSetSolver::solve_at), in
+//                   rounds alternating with FOM queries; ratios["fom_active_set/fom_limit"]
+//                   is the quotient of those rounds' medians
+//   fom_pairing_iterations  mean pairing fixed-point iterations of the FOM queries
 // Queries are the problem's validation parameters (thinned to --queries). The FOM
 // and the ROMs are timed in --repeats interleaved rounds (one pass of each per round,
 // after a warm-up pass), so that a slow spell of the machine hits them alike.
@@ -104,6 +109,8 @@ void run_bench(const BenchArgs& a) {
   j["ipopt_queries"] = r.ipopt_queries;
   j["fom_active_set"] = r.fom_active_set_s;
   j["fom_active_set_rounds"] = r.fom_active_set_rounds;  // per-round medians: the machine's noise
+  j["fom_limit"] = r.fom_limit_s;
+  j["fom_pairing_iterations"] = r.fom_pairing_iterations;
   for (const baselines::BenchMethod& m : r.methods) {
     const std::string& k = m.variant.key;
     j[k] = m.timing.median_core_s;

@@ -152,6 +152,9 @@ BOOST_AUTO_TEST_CASE(stiffness_is_affine_in_the_parameters) {
   for (int i = 4; i < 8; ++i) rot.segment<2>(2 * i) = Vector2d(-p->mesh()->nodes(1, i), p->mesh()->nodes(0, i));
   BOOST_TEST((k * tx).norm() <= 1e-13 * k.norm());
   BOOST_TEST((k * rot).norm() <= 1e-13 * k.norm());
+  // apply_stiffness: the same product without forming K(μ), for any vector.
+  const VectorXd v = VectorXd::LinSpaced(16, -1.0, 2.0);
+  BOOST_TEST((p->apply_stiffness(mu, v) - k * v).norm() <= 1e-14 * (k * v).norm());
 }
 
 BOOST_AUTO_TEST_CASE(rhs_is_the_load_minus_the_lifting_response_off_dirichlet_rows) {
