@@ -300,7 +300,7 @@ FomSolution ActiveSetSolver::solve_at(const Param& mu, const Pairing& pairing, c
   m_problem.check_param(mu);
   FomSolution sol;
   sol.mu = mu;
-  if (!m_constant || !m_constant_ok) {
+  if (!m_constant) {
     sol.status = Status::InvalidInput;
     sol.message = "a solve at a given pairing needs a factorised parameter-independent stiffness";
     return sol;
