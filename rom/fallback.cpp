@@ -2,6 +2,7 @@
 
 #include "core/format.hpp"
 #include "fom/contact_residuals.hpp"
+#include "fom/kkt.hpp"
 
 namespace contactrom::rom {
 
@@ -55,6 +56,7 @@ FallbackAnswer FallbackSolver::solve(const fom::Param& mu) const {
   r.primal_estimate = r.dual_estimate = 0.0;
   const fom::Problem& problem = m_rom.model().problem();
   r.contact = fom::contact_residuals(problem, problem.contact().restrict_to_surface(sol.u), sol.lambda);
+  r.contact_force = fom::contact_force(problem, sol.lambda);
   r.time_s = a.rom_time_s + a.fom_time_s;
   return a;
 }

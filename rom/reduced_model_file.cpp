@@ -295,7 +295,7 @@ FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResu
       const OnlineResult& res = results[i];
       for (int k = 0; k < res.mu.size(); ++k) out << format_number(res.mu(k)) << ',';
       out << to_string(res.status) << ',' << (res.converged ? 1 : 0) << ',' << res.iterations << ','
-          << res.selected.size() << ',' << format_number(fom::contact_force(rom.problem(), res.lambda)) << ','
+          << res.selected.size() << ',' << format_number(res.contact_force) << ','
           << format_number(res.time_s) << ',';
       for (size_t j = 0; j < res.selected.size(); ++j)
         out << (j ? " " : "") << rom.model().dictionary_snapshots()[static_cast<size_t>(res.selected[j])];

@@ -1,6 +1,7 @@
 // `query --fallback fom`: answers come from the ROM or the FOM as the tolerances
 // decide, and the output says which and how long each took.
 #define BOOST_TEST_MODULE cli_query_fallback
+#include <cmath>
 #include <boost/test/unit_test.hpp>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -31,6 +32,11 @@ BOOST_AUTO_TEST_CASE(fallback_answers_are_labelled_and_timed) {
   BOOST_TEST(j["fallbacks"].get<int>() == 2);
   for (const auto& q : j["queries"]) {
     BOOST_TEST(q["source"].get<std::string>() == "fom");
+    // A FOM answer carries the FOM's force, not that of the reduced answer it replaced.
+    const auto fom = run_command(kExe + " fom --problem hertz --json --param " + q["param"].dump());
+    BOOST_REQUIRE_MESSAGE(fom.exit_code == 0, fom.err);
+    const double force = nlohmann::json::parse(fom.out)["contact_force"].get<double>();
+    BOOST_TEST(std::abs(q["contact_force"].get<double>() - force) <= 1e-12 * force);
     BOOST_TEST(q["fom_time_s"].get<double>() > 0.0);
     BOOST_TEST(!q["fallback_reason"].get<std::string>().empty());
   }
