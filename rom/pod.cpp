@@ -63,6 +63,9 @@ bool Pod::uses_svd(Eigen::Index n, Eigen::Index m) const {
     case PodAlgorithm::Snapshots: return false;
     case PodAlgorithm::Auto: break;
   }
+  // A wide set: the method of snapshots' m × m Gram matrix would be no smaller than
+  // the data, and its eigen-decomposition costs O(m³) against the SVD's O(n² m).
+  if (m >= n) return true;
   return static_cast<double>(n) * static_cast<double>(m) <= static_cast<double>(m_options.svd_max_entries);
 }
 

@@ -52,7 +52,7 @@ namespace contactrom::rom {
 
 /// \brief Which algorithm Pod uses (file comment).
 enum class PodAlgorithm {
-  Auto,       ///< SVD when n·m ≤ PodOptions::svd_max_entries, else method of snapshots
+  Auto,       ///< SVD when n·m ≤ PodOptions::svd_max_entries or m ≥ n, else method of snapshots
   Svd,        ///< BDCSVD of the whole matrix (read into memory)
   Snapshots   ///< method of snapshots with a Rayleigh–Ritz step, by blocks of rows
 };
@@ -83,7 +83,9 @@ struct PodOptions {
   /// Algorithm. Default Auto.
   PodAlgorithm algorithm = PodAlgorithm::Auto;
   /// Largest snapshot matrix (entries n·m) that Auto gives to the SVD. Default 2²⁴
-  /// (128 MB): the shipped meshes' databases keep the SVD's results exactly.
+  /// (128 MB): the shipped meshes' databases keep the SVD's results exactly. A wide
+  /// set (m ≥ n snapshots) goes to the SVD at any size: its m × m Gram matrix would be
+  /// no smaller than the data.
   std::int64_t svd_max_entries = std::int64_t{1} << 24;
   /// Bytes of snapshot data read per block by the method of snapshots. Default 64 MiB.
   std::int64_t block_bytes = std::int64_t{64} << 20;

@@ -16,8 +16,9 @@ For every run r:m (hertz, --refine r, --train m; default 0:100,0:1000,0:10000,
            --svd-max snapshot entries n*m, default 1e8), one after the other: POD time,
            whole time, peak memory, rank, and the agreement of the two (largest relative
            difference of the kept singular values, sine of the largest principal angle
-           between the bases).
-  mpi      for the largest run, `mpirun -np 2 contactrom reduce ... --pod snapshots
+           between the bases). A wide set (m >= dofs) runs the SVD only, as
+           `--pod auto` does.
+  mpi      for the last run that is not wide, `mpirun -np 2 contactrom reduce ... --pod snapshots
            --threads 1` against the serial `--pod snapshots --threads 1`: the same
            agreement measures.
 
@@ -95,8 +96,9 @@ def main():
         with h5py.File(db, "r") as f:
             row["dofs"] = int(f["primal"].shape[1])
         row["db_mb"] = os.path.getsize(db) / 2**20
+        wide = m >= row["dofs"]  # `--pod auto` takes the SVD; the Gram matrix would be m x m
         for pod in ["snapshots", "svd"]:
-            if pod == "svd" and row["dofs"] * m > a.svd_max:
+            if (pod == "svd" and row["dofs"] * m > a.svd_max and not wide) or (pod == "snapshots" and wide):
                 continue
             rom = os.path.join(a.out, f"rom_r{refine}_{m}_{pod}.h5")
             out, wall, rss = timed([a.exe, "reduce", "--db", db, "--method", "greedy", "--delta", "1e-8", "--pod", pod,
@@ -109,7 +111,10 @@ def main():
         rows.append(row)
         print(json.dumps(row), flush=True)
 
-    refine, m = runs[-1]
+    tall = [r for r in rows if "pod_snapshots" in r]
+    if not tall:
+        sys.exit("no run has fewer snapshots than dofs: nothing for the method of snapshots under MPI")
+    refine, m = tall[-1]["refine"], tall[-1]["snapshots"]
     db = os.path.join(a.out, f"hertz_r{refine}_{m}.h5")
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     roms = {}
@@ -138,7 +143,11 @@ def main():
     print("\n| refine | dofs | snapshots | POD snapshots | reduce peak RSS | POD svd | reduce peak RSS (svd) | svd/snapshots | rank | max rel. σ diff | subspace |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        s, v, g = r["pod_snapshots"], r.get("pod_svd"), r.get("agreement", {})
+        s, v, g = r.get("pod_snapshots"), r.get("pod_svd"), r.get("agreement", {})
+        if s is None:  # a wide set: the SVD only
+            print(f"| {r['refine']} | {r['dofs']:,} | {r['snapshots']:,} | — | — | {v['pod_s']:.2f} s | "
+                  f"{v['rss_mb']:.0f} MB | — | {v['rank']} | — | — |")
+            continue
         print(f"| {r['refine']} | {r['dofs']:,} | {r['snapshots']:,} | {s['pod_s']:.2f} s | {s['rss_mb']:.0f} MB | "
               + (f"{v['pod_s']:.2f} s | {v['rss_mb']:.0f} MB | {v['pod_s'] / s['pod_s']:.1f}× | {g.get('rank')} | "
                  f"{g.get('sigma_rel', float('nan')):.1e} | {g.get('subspace', float('nan')):.1e} |"

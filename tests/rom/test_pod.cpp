@@ -243,12 +243,18 @@ BOOST_AUTO_TEST_CASE(method_of_snapshots_edge_cases) {
   BOOST_TEST(std::abs(one.basis().col(0).dot(x.normalized())) == 1.0, boost::test_tools::tolerance(1e-14));
 }
 
-BOOST_AUTO_TEST_CASE(auto_takes_the_svd_up_to_the_size_limit) {
+BOOST_AUTO_TEST_CASE(auto_takes_the_svd_up_to_the_size_limit_and_for_wide_sets) {
   PodOptions o;
   o.svd_max_entries = 1000;
   const Pod pod(o);
   BOOST_TEST(pod.uses_svd(100, 10));
   BOOST_TEST(!pod.uses_svd(100, 11));
+  // A wide set goes to the SVD at any size (its Gram matrix would outgrow the data).
+  BOOST_TEST(pod.uses_svd(100, 100));
+  BOOST_TEST(pod.uses_svd(2068, 10000));
+  BOOST_TEST(!pod.uses_svd(2068, 2067));
+  o.algorithm = contactrom::rom::PodAlgorithm::Snapshots;
+  BOOST_TEST(!Pod(o).uses_svd(100, 1000));
   o.algorithm = contactrom::rom::PodAlgorithm::Svd;
   BOOST_TEST(Pod(o).uses_svd(1000, 1000));
 }
