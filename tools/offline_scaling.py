@@ -105,7 +105,7 @@ def main():
                                     "--threads", str(a.threads), "--json", "--out", rom])
             row["pod_" + pod] = {"pod_s": out["pod_time_s"], "reduce_s": wall, "rss_mb": rss, "rank": out["primal_rank"],
                         "rom_mb": out["bytes"] / 2**20}
-        if "pod_svd" in row:
+        if "pod_svd" in row and "pod_snapshots" in row:
             row["agreement"] = agreement(os.path.join(a.out, f"rom_r{refine}_{m}_svd.h5"),
                                          os.path.join(a.out, f"rom_r{refine}_{m}_snapshots.h5"))
         rows.append(row)
