@@ -155,6 +155,10 @@ BOOST_AUTO_TEST_CASE(bench_on_a_database_skips_the_offline_stage) {
   BOOST_TEST(j["snapshots"] == 17);
   BOOST_TEST(j["offline_s"].get<double>() == 0.0);
   BOOST_TEST(j["rom_greedy"].get<double>() > 0.0);
+  // ironing's stiffness is constant: the FOM's limit (solve_at its final pairing) is timed.
+  BOOST_TEST(j["fom_limit"].get<double>() > 0.0);
+  BOOST_TEST(j["fom_pairing_iterations"].get<double>() >= 1.0);
+  BOOST_TEST(j["ratios"].contains("fom_active_set/fom_limit"));
   // The text output: every time and ratio line is a name, blanks, then a number.
   const auto text = run_command(exe + " bench --db " + dbs().ironing + " --repeats 1 --queries 2 --ipopt-queries 1");
   BOOST_REQUIRE(text.exit_code == 0);
@@ -175,6 +179,21 @@ BOOST_AUTO_TEST_CASE(bench_on_a_database_skips_the_offline_stage) {
   const auto r = run_command(exe + " bench --db " + dbs().ironing + " --level 4");
   BOOST_TEST(r.exit_code == 2);
   BOOST_TEST(r.err.find("--problem, not --db") != std::string::npos, r.err);
+}
+
+BOOST_AUTO_TEST_CASE(bench_without_ipopt) {
+  // --ipopt-queries 0 leaves Ipopt out: no fom_ipopt time and no ratio naming it,
+  // the active-set FOM and the ROMs still timed.
+  const json j = run_json("bench --problem rope --repeats 1 --queries 2 --ipopt-queries 0");
+  BOOST_TEST(j["ipopt_queries"].get<int>() == 0);
+  BOOST_TEST(!j.contains("fom_ipopt"));
+  BOOST_TEST(!j["ratios"].contains("fom_ipopt/fom_active_set"));
+  BOOST_TEST(j["fom_active_set"].get<double>() > 0.0);
+  BOOST_TEST(j["ratios"].contains("fom_active_set/rom_greedy"));
+  // rope's stiffness depends on its parameter: no limit query, so no limit keys.
+  BOOST_TEST(!j.contains("fom_limit"));
+  BOOST_TEST(!j.contains("fom_pairing_iterations"));
+  BOOST_TEST(!j["ratios"].contains("fom_active_set/fom_limit"));
 }
 
 BOOST_AUTO_TEST_CASE(bench_reports_every_method_and_consistent_ratios) {
