@@ -59,6 +59,9 @@ void note_allocation() {
 
 }  // namespace
 
+// The replacements must be exported (the build hides symbols by default) so that
+// operator new in libstdc++ and every other library call them.
+#pragma GCC visibility push(default)
 extern "C" {
 void* malloc(size_t size) {
   note_allocation();
@@ -87,6 +90,7 @@ int posix_memalign(void** out, size_t alignment, size_t size) {
 }
 void free(void* p) { __libc_free(p); }
 }
+#pragma GCC visibility pop
 
 using namespace contactrom;
 
