@@ -86,7 +86,8 @@ void ErrorIndicator::build(const ReducedModel& model) {
 }
 
 ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& lambda,
-                                       const fom::Pairing& pairing, const Eigen::VectorXd& u_surface) const {
+                                       const fom::Pairing& pairing, const Eigen::VectorXd& u_surface,
+                                       int pairings) const {
   const auto t0 = std::chrono::steady_clock::now();
   ErrorEstimate e;
   const fom::Problem& problem = m_problem;
@@ -101,14 +102,15 @@ ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::Vector
   thread_local fom::ConstraintMatrix c;
   thread_local Eigen::VectorXd g;
   fom::PairedSolution sol;
-  if (m_options.pairing_iterations <= 1 || !contact.has_pairing()) {
+  const int cap = pairings > 0 ? pairings : m_options.pairing_iterations;
+  if (cap <= 1 || !contact.has_pairing()) {
     contact.assemble(pairing, c, g);
     sol = fom::solve_at_pairing(problem, m_cond, m_options.fom, z_s, pairing, c, g, u_surface, lambda_start,
                                 e.qp_iterations);
     e.pairings = 1;
   } else {
     fom::PairingFixedPointOptions fixed_point = fom::pairing_options(m_options.fom);
-    fixed_point.max_iterations = m_options.pairing_iterations;
+    fixed_point.max_iterations = cap;
     fixed_point.tolerance = m_options.pairing_tolerance;
     fom::PairingFixedPointResult fp = fom::solve_pairing_loop(problem, m_cond, m_options.fom, fixed_point, z_s,
                                                               u_surface, pairing, lambda_start, e.qp_iterations);

@@ -96,8 +96,9 @@ class ErrorIndicator {
   /// \param u_hat reduced coordinates (size r of the model)
   /// \param lambda pressure per constraint row
   /// \param pairing the pairing searched at the answer's surface displacement `u_surface`
+  /// \param pairings cap on the correction's pairings (≤ 0: ErrorIndicatorOptions::pairing_iterations)
   ErrorEstimate estimate(const fom::Param& mu, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& lambda,
-                         const fom::Pairing& pairing, const Eigen::VectorXd& u_surface) const;
+                         const fom::Pairing& pairing, const Eigen::VectorXd& u_surface, int pairings = 0) const;
 
  private:
   void build(const ReducedModel& model);

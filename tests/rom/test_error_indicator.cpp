@@ -87,6 +87,15 @@ BOOST_AUTO_TEST_CASE(dual_estimate_follows_the_pairing_when_the_answer_is_paired
   BOOST_TEST(sharp.max_dual_effectivity <= 1.25);
   BOOST_TEST(sharp.primal_correlation >= 0.9);
   const rom::EstimateQuality own_pairing = quality(1);
+  // The per-solver cap (--option estimate_pairings=1) is that estimate.
+  const auto capped = rom::make_online_solver("greedy", model, rom::options_from_map("greedy", {{"estimate_pairings", "1"}}));
+  rom::ErrorIndicatorOptions one;
+  one.pairing_iterations = 1;
+  const auto explicit_one = rom::make_online_solver("greedy", model, rom::options_from_map("greedy", {{"estimate", "false"}}));
+  explicit_one->set_error_indicator(std::make_shared<const rom::ErrorIndicator>(model, one));
+  const rom::OnlineResult a = capped->solve(params[7]), b = explicit_one->solve(params[7]);
+  BOOST_TEST(a.dual_estimate == b.dual_estimate);
+  BOOST_TEST(a.primal_estimate == b.primal_estimate);
   BOOST_TEST(own_pairing.dual_correlation < sharp.dual_correlation);
   BOOST_TEST(own_pairing.max_dual_effectivity / own_pairing.min_dual_effectivity >
              sharp.max_dual_effectivity / sharp.min_dual_effectivity);
