@@ -79,7 +79,7 @@ void add_ratios(BenchReport& r) {
   for (const BenchMethod& m : r.methods) {
     const std::string& k = m.variant.key;
     r.ratios["fom_active_set/" + k] = r.fom_active_set_s / t[k];
-    if (k == "rom_greedy_with_estimate") {  // the cost of the error estimate
+    if (k.rfind("rom_greedy_with_estimate", 0) == 0) {  // the cost of the error estimate
       if (t.count("rom_greedy")) r.ratios[k + "/rom_greedy"] = t[k] / t["rom_greedy"];
       continue;
     }
@@ -110,6 +110,7 @@ std::vector<BenchVariant> default_bench_variants() {
   for (const char* method : {"greedy", "greedy-nested"}) v.push_back({key_of(method) + "_init_empty", method, {{"init", "empty"}}});
   v.push_back({"rom_cpg_warm", "cpg", {{"init", "cell"}}});
   v.push_back({"rom_greedy_with_estimate", "greedy", {{"estimate", "true"}}});
+  v.push_back({"rom_greedy_with_estimate_1", "greedy", {{"estimate", "true"}, {"estimate_pairings", "1"}}});
   return v;
 }
 

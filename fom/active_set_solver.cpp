@@ -192,6 +192,24 @@ PairedSolution solve_at_pairing(const Problem& problem, const Condensation& cond
   return qp.solve(pairing, c, g, x_s, iterations);
 }
 
+PairingFixedPointResult solve_pairing_loop(const Problem& problem, const Condensation& cond,
+                                           const ActiveSetOptions& options,
+                                           const PairingFixedPointOptions& fixed_point, const Eigen::VectorXd& u0_s,
+                                           const Eigen::VectorXd& x_s, Pairing pairing,
+                                           const Eigen::VectorXd& lambda_start, int& iterations) {
+  const ContactModel& contact = problem.contact();
+  WorkingSetQp qp(problem, cond, options, u0_s, lambda_start);
+  return solve_pairing_fixed_point(
+      contact, problem.displacement_scale(), x_s, std::move(pairing), fixed_point,
+      [&](const Pairing& p, const ConstraintMatrix& c, const Eigen::VectorXd& g, const Eigen::VectorXd& xk) {
+        return qp.solve(p, c, g, xk, iterations);
+      },
+      [&](const Pairing& p, const ConstraintMatrix& c, const PairedSolution& at, const Pairing& next, Pairing& out) {
+        return newton_pairing(contact, cond.s, p, c, at.lambda, at.surface_displacement, next,
+                              options.newton_max_active, out);
+      });
+}
+
 Eigen::MatrixXd unconstrained_load_responses(const Problem& problem, const Param& mu) {
   check_rigid_motions_held(problem);
   Condensation cond;
@@ -261,26 +279,18 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
   // 2. Start from u0, or from a previous solution (its u, λ) if one fits.
   const bool use_warm = warm && warm->lambda.size() == contact.num_constraints() && warm->u.size() == m_problem.num_dofs();
   const Eigen::VectorXd x = use_warm ? contact.restrict_to_surface(warm->u) : u0_s;
-  WorkingSetQp qp(m_problem, cond, m_options, u0_s,
-                  use_warm ? warm->lambda : Eigen::VectorXd::Zero(contact.num_constraints()));
   // 3. The pairing fixed point around the exact dual QP of each pairing.
-  const PairingFixedPointResult fp = solve_pairing_fixed_point(
-      contact, m_problem.displacement_scale(), x, contact.search(x), pairing_options(),
-      [&](const Pairing& pairing, const ConstraintMatrix& c, const Eigen::VectorXd& g, const Eigen::VectorXd& xk) {
-        return qp.solve(pairing, c, g, xk, sol.iterations);
-      },
-      [&](const Pairing& pairing, const ConstraintMatrix& c, const PairedSolution& at, const Pairing& next,
-          Pairing& out) {
-        return newton_pairing(contact, cond.s, pairing, c, at.lambda, at.surface_displacement, next,
-                              m_options.newton_max_active, out);
-      });
+  const PairingFixedPointOptions fixed_point = pairing_options(m_options);
+  const PairingFixedPointResult fp =
+      solve_pairing_loop(m_problem, cond, m_options, fixed_point, u0_s, x, contact.search(x),
+                         use_warm ? warm->lambda : Eigen::VectorXd::Zero(contact.num_constraints()), sol.iterations);
   // 4. The displacement u = u0 − K⁻¹ E_s Cᵀλ (one solve with the factor), certified.
   sol.pairing_iterations = fp.iterations;
   sol.status = fp.status;
   if (fp.solution.status != Status::Success)
     sol.message = "dual active-set QP failed: " + std::string(to_string(fp.solution.status));
   else if (fp.status != Status::Success)
-    sol.message = pairing_no_convergence_message(fp, pairing_options());
+    sol.message = pairing_no_convergence_message(fp, fixed_point);
   finish(cond, u0, fp.pairing, fp.c, fp.solution.lambda, sol);
   sol.time_s = seconds_since(t0);
   return sol;
@@ -338,13 +348,13 @@ void certify_fom_solution(const Problem& problem, FomSolution& sol, double toler
   }
 }
 
-PairingFixedPointOptions ActiveSetSolver::pairing_options() const {
+PairingFixedPointOptions pairing_options(const ActiveSetOptions& options) {
   PairingFixedPointOptions o;
-  o.max_iterations = m_options.max_pairing_iterations;
-  o.tolerance = m_options.pairing_tolerance;
-  o.anderson_depth = m_options.anderson_depth;
-  o.anderson_restart = m_options.anderson_restart;
-  o.newton_start = m_options.newton_start;
+  o.max_iterations = options.max_pairing_iterations;
+  o.tolerance = options.pairing_tolerance;
+  o.anderson_depth = options.anderson_depth;
+  o.anderson_restart = options.anderson_restart;
+  o.newton_start = options.newton_start;
   return o;
 }
 

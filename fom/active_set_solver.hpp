@@ -152,6 +152,25 @@ PairedSolution solve_at_pairing(const Problem& problem, const Condensation& cond
                                 const Eigen::VectorXd& g, const Eigen::VectorXd& x_s,
                                 const Eigen::VectorXd& lambda_start, int& iterations);
 
+/// \brief The pairing fixed point options of the FOM's ActiveSetOptions (cap,
+/// tolerance, Anderson depth and restart, Newton start).
+PairingFixedPointOptions pairing_options(const ActiveSetOptions& options);
+
+/// \brief The FOM's pairing loop, as solve() runs it: the pairing fixed point
+/// (fom/pairing_fixed_point.hpp, Anderson and Newton steps on the pairing) around
+/// the working-set dual QP of each pairing, from the surface displacement `x_s`
+/// paired at `pairing` and the multipliers `lambda_start`, capped by
+/// `fixed_point.max_iterations`. Mesh-size free (S and the surface only). Used by
+/// solve() and by the reduced models' error estimate (rom/error_indicator.hpp),
+/// which starts it from a reduced answer.
+/// \param u0_s unconstrained displacement on the surface dofs
+/// \param iterations incremented by the QPs' active-set iterations
+PairingFixedPointResult solve_pairing_loop(const Problem& problem, const Condensation& cond,
+                                           const ActiveSetOptions& options,
+                                           const PairingFixedPointOptions& fixed_point, const Eigen::VectorXd& u0_s,
+                                           const Eigen::VectorXd& x_s, Pairing pairing,
+                                           const Eigen::VectorXd& lambda_start, int& iterations);
+
 /// \brief Custom active-set FOM solver; see the file comment.
 class ActiveSetSolver final : public FullOrderSolver {
  public:
@@ -180,7 +199,6 @@ class ActiveSetSolver final : public FullOrderSolver {
   /// λ, the pairing and u = u0 − K⁻¹ E_s Cᵀλ into `sol`, certified (certify_fom_solution()).
   void finish(const Condensation& cond, const Eigen::VectorXd& u0, const Pairing& pairing, const ConstraintMatrix& c,
               const Eigen::VectorXd& lambda, FomSolution& sol) const;
-  PairingFixedPointOptions pairing_options() const;
 
   const Problem& m_problem;
   ActiveSetOptions m_options;

@@ -60,6 +60,9 @@ void check_adaptive_options(const AdaptiveOptions& o) {
     throw bad("indicator", quoted(o.indicator, 200), "primal, dual or max");
   if (!(o.model.delta >= 0.0 && o.model.delta <= 1.0))
     throw bad("delta", format_number(o.model.delta), "a POD tolerance in [0, 1], such as 1e-8");
+  if (o.share_count < 1 || o.share_index < 0 || o.share_index >= o.share_count)
+    throw bad("share", std::to_string(o.share_index) + " of " + std::to_string(o.share_count),
+              "an index in [0, count) of a count >= 1");
   check_online_method(o.method);
 }
 
@@ -112,10 +115,17 @@ double AdaptiveTrainer::indicator(const OnlineResult& answer) const {
 std::vector<double> AdaptiveTrainer::evaluate(const SnapshotDatabase& db, const std::vector<fom::Param>& params) const {
   const ReducedModel model(m_problem, db, m_options.model);
   const std::unique_ptr<OnlineSolver> solver = make_online_solver(m_options.method, model, m_options.online);
-  std::vector<double> out(params.size());
-  parallel_for(static_cast<int>(params.size()), m_options.offline.threads,
-               [&](int i) { out[static_cast<size_t>(i)] = indicator(solver->solve(params[static_cast<size_t>(i)])); },
+  // This process's share (every candidate without MPI), then the other shares' values.
+  const int count = m_options.share_count, first = m_options.share_index;
+  const int n = static_cast<int>(params.size()), mine = first < n ? (n - first + count - 1) / count : 0;
+  std::vector<double> out(params.size(), -kInfinity);
+  parallel_for(mine, m_options.offline.threads,
+               [&](int k) {
+                 const size_t q = static_cast<size_t>(first) + static_cast<size_t>(k) * static_cast<size_t>(count);
+                 out[q] = indicator(solver->solve(params[q]));
+               },
                m_options.offline.progress);
+  if (count > 1 && m_options.gather_indicators) m_options.gather_indicators(out);
   return out;
 }
 

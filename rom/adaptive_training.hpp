@@ -14,7 +14,8 @@
 ///     or the listed points; AdaptiveOptions::initial);
 ///  2. build the reduced model of the snapshots so far and answer every candidate
 ///     parameter not yet in the database with it, each answer with its error
-///     estimate (ROM queries only, in parallel);
+///     estimate (ROM queries only, in parallel on threads, and shared out over MPI
+///     ranks with AdaptiveOptions::share_index);
 ///  3. record the round (snapshots, largest and mean indicator) and stop when the
 ///     largest indicator is below the tolerance ε, or the database holds N snapshots;
 ///  4. else solve the FOM at the B worst candidates (generate_snapshots: one
@@ -101,6 +102,16 @@ struct AdaptiveOptions {
   std::function<SnapshotDatabase(const fom::Problem&, const std::vector<fom::Param>&, const std::string&, int,
                                  const OfflineOptions&)>
       generate;
+  /// This process's share of the candidate evaluation: the candidates q (in the
+  /// order of the remaining ones) with q mod `share_count` = `share_index`; the
+  /// others stay −∞ until `gather_indicators` completes the vector (every answer is
+  /// computed independently, so the shares give the serial indicators bit for bit).
+  /// Default 0 of 1, no gather: every candidate here. The CLI, under mpirun: the
+  /// rank, the number of ranks and rom::mpi::max_over_ranks.
+  int share_index = 0;
+  int share_count = 1;  ///< see share_index
+  /// Completes the indicators of a round from every share (see share_index); optional.
+  std::function<void(std::vector<double>&)> gather_indicators;
   /// Called after every round with the database as it stands (its record includes
   /// the round): the CLI writes it there, so that an interrupted run loses at most
   /// one round. Optional.
@@ -108,7 +119,8 @@ struct AdaptiveOptions {
 };
 
 /// \brief Refuses option values outside their ranges (ε > 0 finite, N ≥ 1, M in
-/// [1, 100000], B ≥ 1, indicator primal|dual|max, δ in [0, 1], initial ≥ 0).
+/// [1, 100000], B ≥ 1, indicator primal|dual|max, δ in [0, 1], initial ≥ 0, share
+/// index in [0, count)).
 /// \throws InputError naming the option, the value and what was expected.
 void check_adaptive_options(const AdaptiveOptions& options);
 

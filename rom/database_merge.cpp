@@ -155,6 +155,11 @@ SnapshotDatabase sorted_by_training(const SnapshotDatabase& db, const std::strin
 
 SnapshotDatabase merge_in_training_order(const std::vector<SnapshotDatabase>& databases,
                                          const std::vector<std::string>& names) {
+  for (size_t d = 0; d < databases.size(); ++d)
+    if (databases[d].training_kind == "adaptive")
+      throw InputError("cannot merge " + quoted(names[d], 200) +
+                       ": it is an adaptive database, built in rounds from the indicator; expected parts of a grid "
+                       "run (offline --part), or continue it with offline --adaptive --append");
   const SnapshotDatabase merged = merge_databases(databases, names);
   const auto problem = rebuild_database_problem(databases[0], names[0]);
   return sorted_by_training(merged, names[0], fom::training_set(*problem, merged.training_size));

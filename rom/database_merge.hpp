@@ -36,7 +36,10 @@ SnapshotDatabase merge_databases(const std::vector<SnapshotDatabase>& databases,
 /// \brief merge_databases(), then the snapshots sorted into the order of their
 /// training set (the problem rebuilt from the first database), so that the parts of
 /// `offline --part k/K` given in any order make the database of the whole run.
-/// \throws InputError as merge_databases and sorted_by_training.
+/// \throws InputError as merge_databases and sorted_by_training; naming the file of
+///   an adaptive database (training_kind "adaptive"), which has no training set to
+///   sort into and whose rounds no concatenation keeps (offline --adaptive --append
+///   continues one).
 SnapshotDatabase merge_in_training_order(const std::vector<SnapshotDatabase>& databases,
                                          const std::vector<std::string>& names);
 

@@ -86,7 +86,8 @@ void ErrorIndicator::build(const ReducedModel& model) {
 }
 
 ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& lambda,
-                                       const fom::Pairing& pairing, const Eigen::VectorXd& u_surface) const {
+                                       const fom::Pairing& pairing, const Eigen::VectorXd& u_surface,
+                                       int pairings) const {
   const auto t0 = std::chrono::steady_clock::now();
   ErrorEstimate e;
   const fom::Problem& problem = m_problem;
@@ -94,22 +95,28 @@ ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::Vector
   if (!m_available || u_hat.size() != m_rank || lambda.size() != contact.num_constraints()) return e;
   const Eigen::VectorXd phi = problem.load_coefficients(mu);
 
-  // 1. The FOM's condensed problem at the answer's pairing, from the answer.
+  // 1. The FOM's condensed problem from the answer: at its pairing, then re-paired
+  // by the FOM's pairing loop until the correction's forces and gaps settle.
+  const Eigen::VectorXd z_s = m_z_s * phi;
+  const Eigen::VectorXd lambda_start = lambda.cwiseMax(0.0);
   thread_local fom::ConstraintMatrix c;
   thread_local Eigen::VectorXd g;
-  thread_local fom::Pairing current;
-  current = pairing;
-  contact.assemble(current, c, g);
-  const Eigen::VectorXd z_s = m_z_s * phi;
-  fom::PairedSolution sol = fom::solve_at_pairing(problem, m_cond, m_options.fom, z_s, current, c, g, u_surface,
-                                                  lambda.cwiseMax(0.0), e.qp_iterations);
-  for (int k = 1; k < m_options.pairing_iterations && sol.status == Status::Success && contact.has_pairing(); ++k) {
-    fom::Pairing next = contact.search_rows(sol.surface_displacement, nullptr, &current);
-    if (next.same_as(current, 1e-12)) break;
-    current = std::move(next);
-    contact.assemble(current, c, g);
-    sol = fom::solve_at_pairing(problem, m_cond, m_options.fom, z_s, current, c, g, sol.surface_displacement,
-                                sol.lambda, e.qp_iterations);
+  fom::PairedSolution sol;
+  const int cap = pairings > 0 ? pairings : m_options.pairing_iterations;
+  if (cap <= 1 || !contact.has_pairing()) {
+    contact.assemble(pairing, c, g);
+    sol = fom::solve_at_pairing(problem, m_cond, m_options.fom, z_s, pairing, c, g, u_surface, lambda_start,
+                                e.qp_iterations);
+    e.pairings = 1;
+  } else {
+    fom::PairingFixedPointOptions fixed_point = fom::pairing_options(m_options.fom);
+    fixed_point.max_iterations = cap;
+    fixed_point.tolerance = m_options.pairing_tolerance;
+    fom::PairingFixedPointResult fp = fom::solve_pairing_loop(problem, m_cond, m_options.fom, fixed_point, z_s,
+                                                              u_surface, pairing, lambda_start, e.qp_iterations);
+    sol = std::move(fp.solution);
+    c = std::move(fp.c);
+    e.pairings = fp.iterations;
   }
   if (sol.status != Status::Success) {
     e.status = Status::NumericalIssue;

@@ -2,7 +2,7 @@
 /// \file error_indicator.hpp
 /// \brief A posteriori estimate of the errors of a reduced answer without the FOM
 /// solve: the answer is corrected by the exact condensed contact problem of the
-/// FOM on the contact surface, at the answer's own pairing, and the estimates are
+/// FOM on the contact surface, from the answer's own pairing, and the estimates are
 /// the errors of the answer against that correction, in the norms of the true
 /// errors (relative H¹ for the displacement, relative L²(Γc) for the pressure).
 /// Derivation in docs/theory.md ("Error estimate of a reduced answer").
@@ -16,17 +16,20 @@
 /// \f$ V = [\Phi,\ \tilde L - Z] \f$.
 ///
 /// Per answer (û, λ_r) at μ, pairing P searched at its surface displacement u_s:
-///  1. C, g at P; the FOM dual QP at that pairing (fom::solve_at_pairing: working set
-///     of the rows within a margin of contact, warm-started by λ_r) gives λ_c;
-///     optionally re-paired at its displacement a few times;
+///  1. C, g at P; the FOM dual QP at that pairing (working set of the rows within a
+///     margin of contact, warm-started by λ_r), re-paired at its own displacement by
+///     the FOM's pairing loop until the contact forces and gaps change by at most
+///     ErrorIndicatorOptions::pairing_tolerance (1 %), gives λ_c and C;
 ///  2. \f$ u_c = z(\mu) - K^{-1}E_s C^T\lambda_c \f$, never formed: with
 ///     \f$ y = C^T\lambda_c \f$ and \f$ a = (\hat u, \phi(\mu)) \f$,
 ///     \f$ \|u_r - u_c\|_H^2 = a^T V^T H V a + 2 a^T V^T H K^{-1}E_s y + y^T E_s^T K^{-1} H K^{-1} E_s y \f$;
 ///  3. primal estimate \f$ \|u_r - u_c\|_H / \|u_c\|_H \f$, dual estimate
 ///     \f$ \|\lambda_r - \lambda_c\|_{L^2(\Gamma_c)} / \|\lambda_c\|_{L^2(\Gamma_c)} \f$
 ///     (absolute when \f$ u_c \f$ is near zero, as the true errors).
-/// Cost: the dual QP on the working set (Delassus block \f$ C_W S C_W^T \f$) and
-/// quadratic forms on the support of y: no mesh-size operation.
+/// Cost: one dual QP on the working set (Delassus block \f$ C_W S C_W^T \f$) per
+/// pairing (one when the answer's pairing is already the FOM's, to the tolerance;
+/// more where it is not, i.e. on the answers that are wrong) and quadratic forms on
+/// the support of y: no mesh-size operation.
 ///
 /// Requires a stiffness independent of the parameters (one factorisation serves
 /// every query); otherwise available() is false and the estimates are NaN.
@@ -46,10 +49,16 @@ class ReducedModel;
 
 /// \brief Options of ErrorIndicator (documented defaults).
 struct ErrorIndicatorOptions {
-  /// Pairings the correction is solved at: 1 = the answer's own pairing only; k > 1
-  /// re-pairs at the corrected displacement up to k − 1 times (stopping when the
-  /// pairing no longer changes). Default 1.
-  int pairing_iterations = 1;
+  /// Cap on the pairings the correction is solved at: 1 = the answer's own pairing
+  /// only; k > 1 runs the FOM's pairing loop (fom::solve_pairing_loop: Anderson and
+  /// Newton steps) from the answer's pairing and surface displacement until
+  /// re-pairing changes the correction by at most `pairing_tolerance`, or k solves.
+  /// Default 20.
+  int pairing_iterations = 20;
+  /// Relative change of the correction's contact forces and gaps under re-pairing
+  /// (fom::pairing_change) at which the loop stops: the estimates need the correction
+  /// to a few per cent, not to the FOM's 1e-12. Default 1e-2.
+  double pairing_tolerance = 1e-2;
   /// Options of the FOM's dual QP (working-set margin, QP tolerances). Default: the FOM's.
   fom::ActiveSetOptions fom;
 };
@@ -64,6 +73,7 @@ struct ErrorEstimate {
   /// when the indicator is unavailable or the answer has no fields.
   Status status = Status::InvalidInput;
   int qp_iterations = 0;  ///< active-set iterations of the correction
+  int pairings = 0;       ///< pairings the correction was solved at
   double time_s = 0.0;    ///< wall time of the estimate
 };
 
@@ -86,8 +96,9 @@ class ErrorIndicator {
   /// \param u_hat reduced coordinates (size r of the model)
   /// \param lambda pressure per constraint row
   /// \param pairing the pairing searched at the answer's surface displacement `u_surface`
+  /// \param pairings cap on the correction's pairings (≤ 0: ErrorIndicatorOptions::pairing_iterations)
   ErrorEstimate estimate(const fom::Param& mu, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& lambda,
-                         const fom::Pairing& pairing, const Eigen::VectorXd& u_surface) const;
+                         const fom::Pairing& pairing, const Eigen::VectorXd& u_surface, int pairings = 0) const;
 
  private:
   void build(const ReducedModel& model);

@@ -80,6 +80,11 @@ SnapshotDatabase generate_snapshots_on_every_rank(const fom::Problem& problem, c
                                                   const std::string& training_kind, int training_size,
                                                   const OfflineOptions& options = {});
 
+/// \brief Element-wise maximum of `values` over the ranks, on every rank
+/// (collective; same size everywhere): the adaptive stage's indicators, each
+/// computed on one rank and −∞ on the others (AdaptiveOptions::gather_indicators).
+void max_over_ranks(std::vector<double>& values);
+
 /// \brief Whether `ok` holds on every rank (collective; an agreement step, e.g.
 /// after rank 0 wrote the file, so that every rank exits with the same outcome).
 bool all_ranks_ok(bool ok);

@@ -175,7 +175,7 @@ std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const 
   if (options.penetration_tolerance >= 0) tolerances.penetration = options.penetration_tolerance;
   if (options.complementarity_tolerance >= 0) tolerances.complementarity = options.complementarity_tolerance;
   solver->set_contact_tolerances(tolerances);
-  if (options.estimate) solver->set_error_indicator(model.error_indicator());
+  if (options.estimate) solver->set_error_indicator(model.error_indicator(), options.estimate_pairings);
   return solver;
 }
 

@@ -34,7 +34,11 @@ const OptionTable<ContactCheckOptions>& contact_check_table() {
                 "largest separation under pressure (units of U) of an answer reported success; < 0: the problem's "
                 "[rom] value, else 5e-2")
         .flag("estimate", &ContactCheckOptions::estimate,
-              "estimate the primal and dual errors of every answer at the full order on the contact surface");
+              "estimate the primal and dual errors of every answer at the full order on the contact surface")
+        .integer("estimate_pairings", &ContactCheckOptions::estimate_pairings,
+                 "cap on the pairings of the estimate's correction; 1: the answer's own pairing only (cheaper, "
+                 "coarser on sliding contact)",
+                 1, 1000);
     return o;
   }();
   return t;
@@ -54,13 +58,13 @@ fom::ContactTolerances OnlineSolver::contact_tolerances() const {
 OnlineResult OnlineSolver::solve(const fom::Param& mu) const {
   OnlineResult res = solve_reduced(mu);
   const fom::Pairing* pairing = check_contact(model(), contact_tolerances(), res);
-  if (m_indicator && pairing) estimate_errors(*m_indicator, *pairing, res);
+  if (m_indicator && pairing) estimate_errors(*m_indicator, *pairing, res, m_estimate_pairings);
   return res;
 }
 
-void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairing, OnlineResult& res) {
+void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairing, OnlineResult& res, int pairings) {
   const Eigen::VectorXd u_s = indicator.problem().contact().restrict_to_surface(res.u);
-  const ErrorEstimate e = indicator.estimate(res.mu, res.u_hat, res.lambda, pairing, u_s);
+  const ErrorEstimate e = indicator.estimate(res.mu, res.u_hat, res.lambda, pairing, u_s, pairings);
   res.primal_estimate = e.primal;
   res.dual_estimate = e.dual;
   res.absolute_estimates = e.absolute;

@@ -107,8 +107,12 @@ class OnlineSolver {
   virtual int dual_basis_size() const { return model().dictionary_size(); }
   /// Tolerances of the contact check (default: the problem's, fom::default_contact_tolerances).
   fom::ContactTolerances contact_tolerances() const;
-  /// Estimates the errors of every answer with `indicator` (nullptr: none).
-  void set_error_indicator(std::shared_ptr<const ErrorIndicator> indicator) { m_indicator = std::move(indicator); }
+  /// Estimates the errors of every answer with `indicator` (nullptr: none), its
+  /// correction capped at `pairings` pairings (≤ 0: the indicator's
+  /// ErrorIndicatorOptions::pairing_iterations).
+  void set_error_indicator(std::shared_ptr<const ErrorIndicator> indicator, int pairings = 0) {
+    m_indicator = std::move(indicator), m_estimate_pairings = pairings;
+  }
   /// Sets the tolerances of the contact check.
   void set_contact_tolerances(const fom::ContactTolerances& tolerances) { m_tolerances = tolerances, m_tolerances_set = true; }
 
@@ -120,6 +124,7 @@ class OnlineSolver {
   fom::ContactTolerances m_tolerances;
   bool m_tolerances_set = false;
   std::shared_ptr<const ErrorIndicator> m_indicator;
+  int m_estimate_pairings = 0;
 };
 
 /// \brief The full-order contact check of an online answer: sets `res.contact` and
@@ -132,7 +137,8 @@ const fom::Pairing* check_contact(const ReducedModel& model, const fom::ContactT
 /// \brief The error estimate of an answer (OnlineResult::primal_estimate, dual_estimate,
 /// absolute_estimates, estimate_time_s, added to time_s), at the pairing that
 /// check_contact() searched at it.
-void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairing, OnlineResult& res);
+void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairing, OnlineResult& res,
+                     int pairings = 0);
 
 /// \brief How the threshold τ is applied to the dictionary violations.
 enum class TauScaling {
@@ -171,6 +177,10 @@ struct ContactCheckOptions {
   /// Estimate the errors of every answer (OnlineResult::primal_estimate and
   /// dual_estimate; rom/error_indicator.hpp). Default true.
   bool estimate = true;
+  /// Cap on the pairings of the estimate's correction (ErrorIndicatorOptions::
+  /// pairing_iterations): 1 = the answer's own pairing only, cheaper and coarser
+  /// where the answer's pairing is wrong (sliding contact). Default 20.
+  int estimate_pairings = 20;
 };
 
 /// \brief Binding table of ContactCheckOptions.

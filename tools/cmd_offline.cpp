@@ -168,8 +168,9 @@ void report_round(const fom::Problem& problem, const rom::AdaptiveRound& r) {
 
 void run_adaptive(const OfflineArgs& a) {
 #ifdef CONTACTROM_HAVE_MPI
-  // Under mpirun every rank runs the loop (the same candidates and indicators); the FOM
-  // batches are distributed over the ranks and every rank gets the whole batch.
+  // Under mpirun every rank runs the loop: each answers its share of the candidates,
+  // the indicators are gathered on every rank, the FOM batches are distributed over
+  // the ranks and every rank gets the whole batch.
   const bool distributed = rom::mpi::active() && rom::mpi::world_size() > 1;
   const Ranks ranks{rom::mpi::world_rank(), rom::mpi::world_size()};
 #else
@@ -193,7 +194,12 @@ void run_adaptive(const OfflineArgs& a) {
   rom::AdaptiveOptions options = adaptive_options(a, appending ? &existing : nullptr);
   if (!appending && a.tolerance < 0) throw InputError("offline --adaptive needs --tolerance EPS (e.g. 0.05)");
 #ifdef CONTACTROM_HAVE_MPI
-  if (distributed) options.generate = rom::mpi::generate_snapshots_on_every_rank;
+  if (distributed) {
+    options.generate = rom::mpi::generate_snapshots_on_every_rank;
+    options.share_index = ranks.rank;
+    options.share_count = ranks.size;
+    options.gather_indicators = rom::mpi::max_over_ranks;
+  }
 #endif
   options.on_round = [&](const rom::AdaptiveRound& r, const rom::SnapshotDatabase& db) {
     // atomically, on rank 0: the file always holds whole rounds

@@ -6,12 +6,14 @@
 #include <boost/test/unit_test.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <stdexcept>
 
 #include "common/run_command.hpp"
 #include "fom/active_set_solver.hpp"
 #include "fom/problem.hpp"
 #include "rom/adaptive_training.hpp"
+#include "rom/database_merge.hpp"
 #include "rom/online_evaluation.hpp"
 #include "rom/online_methods.hpp"
 
@@ -158,6 +160,35 @@ BOOST_AUTO_TEST_CASE(an_interrupted_run_continued_from_its_file_equals_an_uninte
   other = small_options();
   other.indicator = "dual";
   BOOST_CHECK_THROW(rom::AdaptiveTrainer(*problem, other).resume(partial, path), InputError);
+}
+
+BOOST_AUTO_TEST_CASE(merge_refuses_an_adaptive_database_by_name) {
+  const auto problem = fom::make_problem("hertz");
+  rom::AdaptiveOptions o = small_options();
+  o.max_snapshots = 4;
+  const rom::SnapshotDatabase adaptive = rom::AdaptiveTrainer(*problem, o).run();
+  const rom::SnapshotDatabase grid = rom::generate_snapshots(*problem, 3);
+  for (const auto& [dbs, names] :
+       {std::pair{std::vector{grid, adaptive}, std::vector<std::string>{"grid.h5", "run.h5"}},
+        std::pair{std::vector{adaptive}, std::vector<std::string>{"run.h5"}}}) {
+    try {
+      rom::merge_in_training_order(dbs, names);
+      BOOST_ERROR("an adaptive database was merged");
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      BOOST_TEST(msg.find("'run.h5'") != std::string::npos, msg);
+      BOOST_TEST(msg.find("adaptive database") != std::string::npos, msg);
+      BOOST_TEST(msg.find('\n') == std::string::npos, msg);
+    }
+  }
+  // The CLI: exit 2 with that one line.
+  const std::string dir = test::temp_dir();
+  rom::write_database(dir + "/run.h5", adaptive);
+  const auto r = test::run_command(std::string(CONTACTROM_EXE) + " merge " + dir + "/run.h5 --out " + dir + "/out.h5");
+  BOOST_TEST(r.exit_code == 2);
+  BOOST_TEST(r.err.find("adaptive database") != std::string::npos, r.err);
+  BOOST_TEST(std::count(r.err.begin(), r.err.end(), '\n') == 1, r.err);
+  BOOST_TEST(!std::ifstream(dir + "/out.h5").good());
 }
 
 BOOST_AUTO_TEST_CASE(thread_count_does_not_change_the_database) {
