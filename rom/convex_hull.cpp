@@ -401,22 +401,29 @@ ConvexHullSolver::ConvexHullSolver(const ReducedModel& model, const Options& opt
     : m_dictionary((check_convex_hull_applicable(model.problem()), model), options) {}
 
 ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
-  ConvexHullResult res = run(mu);
-  check_contact(model(), contact_tolerances(), res.online);
+  ConvexHullResult res;
+  res.online = run_query(mu, [&](OnlineResult& on) { solve_hull(mu, res, on); });
   return res;
 }
 
-ConvexHullResult ConvexHullSolver::run(const fom::Param& mu) const {
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
+void ConvexHullSolver::solve_reduced(const fom::Param& mu, OnlineResult& res) const {
+  ConvexHullResult details;
+  solve_hull(mu, details, res);
+}
+
+Eigen::VectorXd ConvexHullSolver::reconstruct_primal(const OnlineResult& res) const {
+  // u = u_off(μ) + D_p α over the support (mesh-size work, for output only).
+  VectorXd u = model().problem().lifting(res.mu);
+  for (std::size_t i = 0; i < res.selected.size(); ++i)
+    u.noalias() += res.coefficients(static_cast<Index>(i)) * m_dictionary.primal().col(res.selected[i]);
+  return u;
+}
+
+void ConvexHullSolver::solve_hull(const fom::Param& mu, ConvexHullResult& res, OnlineResult& on) const {
   const MonolithicDictionary& dict = m_dictionary;
   const ConvexHullOptions& opt = dict.options();
   const ReducedModel& model = dict.model();
   const fom::ContactModel& contact = model.problem().contact();
-
-  ConvexHullResult res;
-  OnlineResult& on = res.online;
-  on.mu = mu;
 
   // The pairing fixed point around the exact projected solve at each pairing.
   PairedHullSolve solve_at(dict, mu);
@@ -470,14 +477,6 @@ ConvexHullResult ConvexHullSolver::run(const fom::Param& mu) const {
   } else if (status != Status::Success) {
     on.message = std::string("convex-hull solve failed (") + to_string(status) + ")";
   }
-  const auto t1 = clock::now();
-  on.time_s = std::chrono::duration<double>(t1 - t0).count();
-
-  // Full field u = u_lift(μ) + D_p α (mesh-size work, for output only).
-  on.u = model.problem().lifting(mu);
-  for (Index j : support) on.u.noalias() += res.alpha(j) * dict.primal().col(j);
-  on.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
-  return res;
 }
 
 const OptionTable<ConvexHullOptions>& convex_hull_option_table() {
