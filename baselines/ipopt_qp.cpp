@@ -319,155 +319,242 @@ double IpoptQpSolver::setup_time() const { return m_impl->setup_time; }
 
 const IpoptOptions& IpoptQpSolver::options() const { return m_impl->options; }
 
-FomSolution IpoptQpSolver::solve(const Param& mu, const FomSolution* warm) const {
-  const fom::Problem& problem = m_impl->problem;
-  problem.check_param(mu);
-  const auto t0 = std::chrono::steady_clock::now();
-  const fom::ContactModel& contact = problem.contact();
-  const std::vector<int>& free = problem.free_dofs();
-  const int nf = static_cast<int>(free.size()), nc = contact.num_constraints();
-  const IpoptOptions& opt = m_impl->options;
-
-  FomSolution sol;
-  sol.mu = mu;
-  sol.lambda = Eigen::VectorXd::Zero(nc);
-
-  std::unique_ptr<FreeStiffness> own_k;
-  if (!m_impl->constant_k)
-    own_k = extract_free_stiffness(problem.stiffness(mu), free, m_impl->free_index, contact.has_pairing());
-  QpData qp;
-  qp.k = m_impl->constant_k ? m_impl->constant_k.get() : own_k.get();
-  const Eigen::VectorXd f = problem.rhs(mu), lift = problem.lifting(mu);
-  qp.f.resize(nf);
-  for (int i = 0; i < nf; ++i) qp.f(i) = f(free[i]);
-  const Eigen::VectorXd lift_s = contact.restrict_to_surface(lift);
-
-  // Starting point and the configuration that seeds the pairing: the warm solution if
-  // it fits, else (as in the active-set solver) the unconstrained solution, else u0 = 0.
-  // The pairing fixed point is not globally convergent: started from the reference
-  // configuration, `ironing` falls into a 2-cycle.
-  const bool warm_fits = warm && warm->u.size() == problem.num_dofs() && warm->lambda.size() == nc &&
-                         warm->u.allFinite() && warm->lambda.allFinite();
-  qp.x0 = Eigen::VectorXd::Zero(nf);
-  if (warm_fits) {
-    for (int i = 0; i < nf; ++i) qp.x0(i) = warm->u(free[i]) - lift(free[i]);
-  } else if (qp.k->ldlt && qp.k->ldlt->info() == Eigen::Success) {
-    const Eigen::VectorXd x = qp.k->ldlt->solve(qp.f);
-    if (x.allFinite()) qp.x0 = x;
+/// One solve at μ: the QP data and the iterate shared by the Ipopt solves of the
+/// pairing fixed point (fom/pairing_fixed_point.hpp), which calls it once per pairing.
+class IpoptQpSolver::Query {
+ public:
+  Query(const Impl& impl, const Param& mu, const FomSolution* warm)
+      : m_impl(impl),
+        m_problem(impl.problem),
+        m_contact(impl.problem.contact()),
+        m_free(impl.problem.free_dofs()),
+        m_nf(static_cast<int>(m_free.size())),
+        m_nc(m_contact.num_constraints()),
+        m_lift(m_problem.lifting(mu)),
+        m_lift_s(m_contact.restrict_to_surface(m_lift)),
+        m_gap(Eigen::VectorXd::Constant(m_nc, std::numeric_limits<double>::infinity())) {
+    m_sol.mu = mu;
+    m_sol.lambda = Eigen::VectorXd::Zero(m_nc);
+    set_up_qp(mu);
+    start(warm);
   }
-  Eigen::VectorXd u = lift;
-  for (int i = 0; i < nf; ++i) u(free[i]) += qp.x0(i);
-  // x: the surface displacement that chooses the pairing (Anderson-extrapolated below).
-  Eigen::VectorXd x = contact.restrict_to_surface(u);
-  Pairing pairing = (warm_fits && warm->pairing.segment.size() == static_cast<size_t>(nc)) ? warm->pairing
-                                                                                          : contact.search(x);
-  if (warm_fits) sol.lambda = warm->lambda;
-  bool have_multipliers = warm_fits;
-  Eigen::VectorXd gap = Eigen::VectorXd::Constant(nc, std::numeric_limits<double>::infinity());
-  // One exact Ipopt solve per pairing; the shared pairing fixed point
-  // (fom/pairing_fixed_point.hpp) re-pairs, accelerates and decides when to stop.
-  auto solve_at = [&](const Pairing& pairing, const ConstraintMatrix&, const Eigen::VectorXd&,
-                      const Eigen::VectorXd&) {
-    fom::PairedSolution out;
-    m_impl->build_constraints(pairing, lift_s, qp);
-    qp.lambda0.resize(0);
-    if (opt.warm_start && have_multipliers && !qp.kept_rows.empty()) {
-      qp.lambda0.resize(static_cast<Eigen::Index>(qp.kept_rows.size()));
-      for (size_t r = 0; r < qp.kept_rows.size(); ++r) qp.lambda0(r) = sol.lambda(qp.kept_rows[r]);
-    }
 
-    Ipopt::ApplicationReturnStatus ipopt_status = Ipopt::Internal_Error;
+  /// Surface displacement that chooses the first pairing, and that pairing.
+  const Eigen::VectorXd& surface_start() const { return m_surface_start; }
+  const Pairing& first_pairing() const { return m_first_pairing; }
+
+  /// One exact Ipopt solve at `pairing` (the pairing fixed point's step).
+  fom::PairedSolution operator()(const Pairing& pairing, const ConstraintMatrix&, const Eigen::VectorXd&,
+                                 const Eigen::VectorXd&) {
+    m_impl.build_constraints(pairing, m_lift_s, m_qp);
+    warm_multipliers();
+    IpoptRun run = run_ipopt();
+    m_sol.iterations += run.nlp->iterations();
+    ++m_sol.pairing_iterations;
+    const bool have_iterate = take_iterate(*run.nlp, pairing);
+    fom::PairedSolution out;
+    out.status = map_status(run.status, run.nlp->nlp_error(), m_impl.options.acceptable_tol);
+    if (out.status != Status::Success || !have_iterate) {
+      if (out.status == Status::Success) out.status = Status::NumericalIssue;
+      report_failure(run);
+      return out;
+    }
+    out.surface_displacement = m_contact.restrict_to_surface(m_u);
+    out.lambda = carried_forces();
+    return out;
+  }
+
+  /// The answer after the pairing fixed point: status, active rows, and the FOM
+  /// check of the returned iterate.
+  FomSolution finish(const fom::PairingFixedPointResult& fp, const fom::PairingFixedPointOptions& fixed_point) {
+    const IpoptOptions& opt = m_impl.options;
+    m_sol.status = fp.status;
+    if (fp.status != Status::Success && fp.solution.status == Status::Success)  // the cap, not a failed solve
+      m_sol.message = fom::pairing_no_convergence_message(fp, fixed_point);
+    m_sol.u = m_u;
+    m_sol.active = count_active_rows();
+    // Ipopt's own success is measured in its scaled problem; a solution whose FOM KKT
+    // residuals are large is not reported as one. (Complementarity is left out:
+    // relative to Σ w|λ|, it is meaningless when every pressure is round-off, e.g. a
+    // body pulled away from the obstacle.)
+    fom::certify_fom_solution(m_problem, m_sol, opt.kkt_tolerance, false);
+    const fom::KktResiduals& k = m_sol.kkt;
+    if (m_sol.status != Status::Success) {
+      // Report how far the returned iterate is from a KKT point (fom/kkt.hpp residuals).
+      std::ostringstream msg;
+      msg.precision(3);
+      msg << "; KKT residuals of the returned iterate: stationarity " << k.stationarity << ", penetration "
+          << k.penetration << ", negative pressure " << k.negative_pressure << ", complementarity "
+          << k.complementarity;
+      m_sol.message += msg.str();
+    }
+    return std::move(m_sol);
+  }
+
+ private:
+  struct IpoptRun {
+    Ipopt::SmartPtr<ContactQpNlp> nlp;
+    Ipopt::ApplicationReturnStatus status = Ipopt::Internal_Error;
     std::string error;
+  };
+
+  /// K_ff (the offline one when K does not depend on μ) and f_f.
+  void set_up_qp(const Param& mu) {
+    if (!m_impl.constant_k)
+      m_own_k = extract_free_stiffness(m_problem.stiffness(mu), m_free, m_impl.free_index, m_contact.has_pairing());
+    m_qp.k = m_impl.constant_k ? m_impl.constant_k.get() : m_own_k.get();
+    const Eigen::VectorXd f = m_problem.rhs(mu);
+    m_qp.f.resize(m_nf);
+    for (int i = 0; i < m_nf; ++i) m_qp.f(i) = f(m_free[i]);
+  }
+
+  /// Starting point and the configuration that seeds the pairing: the warm solution
+  /// if it fits, else (as in the active-set solver) the unconstrained solution, else
+  /// u0 = 0. The pairing fixed point is not globally convergent: started from the
+  /// reference configuration, `ironing` falls into a 2-cycle.
+  void start(const FomSolution* warm) {
+    const bool warm_fits = warm && warm->u.size() == m_problem.num_dofs() && warm->lambda.size() == m_nc &&
+                           warm->u.allFinite() && warm->lambda.allFinite();
+    m_qp.x0 = Eigen::VectorXd::Zero(m_nf);
+    if (warm_fits) {
+      for (int i = 0; i < m_nf; ++i) m_qp.x0(i) = warm->u(m_free[i]) - m_lift(m_free[i]);
+    } else if (m_qp.k->ldlt && m_qp.k->ldlt->info() == Eigen::Success) {
+      const Eigen::VectorXd x = m_qp.k->ldlt->solve(m_qp.f);
+      if (x.allFinite()) m_qp.x0 = x;
+    }
+    set_displacement();
+    // The surface displacement that chooses the pairing (Anderson-extrapolated by
+    // the fixed point).
+    m_surface_start = m_contact.restrict_to_surface(m_u);
+    m_first_pairing = (warm_fits && warm->pairing.segment.size() == static_cast<size_t>(m_nc))
+                          ? warm->pairing
+                          : m_contact.search(m_surface_start);
+    if (warm_fits) m_sol.lambda = warm->lambda;
+    m_have_multipliers = warm_fits;
+  }
+
+  /// u = u_lift + x on the free dofs.
+  void set_displacement() {
+    m_u = m_lift;
+    for (int i = 0; i < m_nf; ++i) m_u(m_free[i]) += m_qp.x0(i);
+  }
+
+  /// The last multipliers of the kept rows, when warm starts are on.
+  void warm_multipliers() {
+    m_qp.lambda0.resize(0);
+    if (!m_impl.options.warm_start || !m_have_multipliers || m_qp.kept_rows.empty()) return;
+    m_qp.lambda0.resize(static_cast<Eigen::Index>(m_qp.kept_rows.size()));
+    for (size_t r = 0; r < m_qp.kept_rows.size(); ++r) m_qp.lambda0(r) = m_sol.lambda(m_qp.kept_rows[r]);
+  }
+
+  /// Ipopt on the current QP (one process-wide lock: Ipopt's MUMPS is not reentrant).
+  IpoptRun run_ipopt() const {
+    IpoptRun run;
     // Ipopt's own reference-counted smart pointer requires heap allocation by `new`.
-    Ipopt::SmartPtr<ContactQpNlp> nlp = new ContactQpNlp(qp);
+    run.nlp = new ContactQpNlp(m_qp);
     try {
       std::lock_guard<std::mutex> lock(ipopt_mutex());
       Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-      m_impl->set_options(*app, qp.lambda0.size() > 0);
-      ipopt_status = app->Initialize("");  // "": never read an ipopt.opt from the working directory
-      if (ipopt_status == Ipopt::Solve_Succeeded) ipopt_status = app->OptimizeTNLP(Ipopt::GetRawPtr(nlp));
+      m_impl.set_options(*app, m_qp.lambda0.size() > 0);
+      run.status = app->Initialize("");  // "": never read an ipopt.opt from the working directory
+      if (run.status == Ipopt::Solve_Succeeded) run.status = app->OptimizeTNLP(Ipopt::GetRawPtr(run.nlp));
     } catch (const std::exception& e) {
-      error = e.what();
-      ipopt_status = Ipopt::NonIpopt_Exception_Thrown;
+      run.error = e.what();
+      run.status = Ipopt::NonIpopt_Exception_Thrown;
     } catch (...) {
-      error = "unknown exception";
-      ipopt_status = Ipopt::Unrecoverable_Exception;
+      run.error = "unknown exception";
+      run.status = Ipopt::Unrecoverable_Exception;
     }
-    sol.iterations += nlp->iterations();
-    ++sol.pairing_iterations;
-    const bool have_iterate = nlp->finalized() && nlp->x().size() == nf && nlp->lambda().size() == qp.b.size() &&
-                              nlp->x().allFinite() && nlp->lambda().allFinite();
-    if (have_iterate) {
-      // Ipopt's Lagrangian is f + λᵀ g(x): for g(x) ≤ g_u its multipliers are ≥ 0 and
-      // K_ff x − f_f + Aᵀ λ = 0, the sign convention of the contact pressures.
-      qp.x0 = nlp->x();
-      sol.lambda.setZero();
-      for (size_t r = 0; r < qp.kept_rows.size(); ++r) sol.lambda(qp.kept_rows[r]) = nlp->lambda()(r);
-      have_multipliers = true;
-      u = lift;
-      for (int i = 0; i < nf; ++i) u(free[i]) += qp.x0(i);
-      sol.pairing = pairing;  // the pairing of the constraint operator λ was solved with
-      // Gaps (length units) of the kept rows under that operator: b − A x, per tributary length.
-      gap.setConstant(std::numeric_limits<double>::infinity());
-      Eigen::VectorXd ax = Eigen::VectorXd::Zero(qp.b.size());
-      for (size_t e = 0; e < qp.a_val.size(); ++e) ax(qp.a_row[e]) += qp.a_val[e] * qp.x0(qp.a_col[e]);
-      for (size_t r = 0; r < qp.kept_rows.size(); ++r) {
-        const int s = qp.kept_rows[r];
-        gap(s) = (qp.b(r) - ax(r)) / contact.weights()(s);
-      }
+    return run;
+  }
+
+  /// Takes Ipopt's iterate, if it has a finite one: x, the multipliers, u, the
+  /// pairing of the constraint operator λ was solved with, and the gaps.
+  bool take_iterate(const ContactQpNlp& nlp, const Pairing& pairing) {
+    const bool have_iterate = nlp.finalized() && nlp.x().size() == m_nf && nlp.lambda().size() == m_qp.b.size() &&
+                              nlp.x().allFinite() && nlp.lambda().allFinite();
+    if (!have_iterate) return false;
+    // Ipopt's Lagrangian is f + λᵀ g(x): for g(x) ≤ g_u its multipliers are ≥ 0 and
+    // K_ff x − f_f + Aᵀ λ = 0, the sign convention of the contact pressures.
+    m_qp.x0 = nlp.x();
+    m_sol.lambda.setZero();
+    for (size_t r = 0; r < m_qp.kept_rows.size(); ++r) m_sol.lambda(m_qp.kept_rows[r]) = nlp.lambda()(r);
+    m_have_multipliers = true;
+    set_displacement();
+    m_sol.pairing = pairing;
+    // Gaps (length units) of the kept rows under that operator: b − A x, per tributary length.
+    m_gap.setConstant(std::numeric_limits<double>::infinity());
+    Eigen::VectorXd ax = Eigen::VectorXd::Zero(m_qp.b.size());
+    for (size_t e = 0; e < m_qp.a_val.size(); ++e) ax(m_qp.a_row[e]) += m_qp.a_val[e] * m_qp.x0(m_qp.a_col[e]);
+    for (size_t r = 0; r < m_qp.kept_rows.size(); ++r) {
+      const int s = m_qp.kept_rows[r];
+      m_gap(s) = (m_qp.b(r) - ax(r)) / m_contact.weights()(s);
     }
-    out.status = map_status(ipopt_status, nlp->nlp_error(), opt.acceptable_tol);
-    if (out.status != Status::Success || !have_iterate) {
-      if (out.status == Status::Success) out.status = Status::NumericalIssue;
-      std::ostringstream msg;
-      msg << "Ipopt returned " << ipopt_status_name(ipopt_status) << " after " << nlp->iterations()
-          << " iterations in pairing iteration " << sol.pairing_iterations;
-      if (!error.empty()) msg << " (" << error << ")";
-      sol.message = msg.str();
-      return out;
-    }
-    out.surface_displacement = contact.restrict_to_surface(u);
-    // The stopping test reads the rows that carry force: an interior-point method
-    // leaves multipliers ≈ barrier parameter / slack on the others.
-    out.lambda = sol.lambda;
-    const double lmax = sol.lambda.size() ? sol.lambda.maxCoeff() : 0.0;
-    for (int s = 0; s < nc; ++s)
-      if (!(sol.lambda(s) > opt.active_tolerance * lmax)) out.lambda(s) = 0.0;
-    return out;
-  };
+    return true;
+  }
+
+  void report_failure(const IpoptRun& run) {
+    std::ostringstream msg;
+    msg << "Ipopt returned " << ipopt_status_name(run.status) << " after " << run.nlp->iterations()
+        << " iterations in pairing iteration " << m_sol.pairing_iterations;
+    if (!run.error.empty()) msg << " (" << run.error << ")";
+    m_sol.message = msg.str();
+  }
+
+  /// The pressures the stopping test reads: the rows that carry force (an
+  /// interior-point method leaves multipliers ≈ barrier parameter / slack on the others).
+  Eigen::VectorXd carried_forces() const {
+    Eigen::VectorXd lambda = m_sol.lambda;
+    const double lmax = m_sol.lambda.size() ? m_sol.lambda.maxCoeff() : 0.0;
+    for (int s = 0; s < m_nc; ++s)
+      if (!(m_sol.lambda(s) > m_impl.options.active_tolerance * lmax)) lambda(s) = 0.0;
+    return lambda;
+  }
+
+  /// Interior-point multipliers are never exactly zero: a row is active when its
+  /// pressure is significant (relative to the largest) and it touches (gap relative
+  /// to the displacement scale), both to active_tolerance.
+  int count_active_rows() const {
+    const double tol = m_impl.options.active_tolerance;
+    const double lmax = m_sol.lambda.size() ? m_sol.lambda.maxCoeff() : 0.0;
+    const double gap_tol = tol * m_problem.displacement_scale();
+    int active = 0;
+    for (int s = 0; s < m_nc; ++s)
+      if (m_sol.lambda(s) > tol * lmax && m_gap(s) <= gap_tol) ++active;
+    return active;
+  }
+
+  const Impl& m_impl;
+  const fom::Problem& m_problem;
+  const fom::ContactModel& m_contact;
+  const std::vector<int>& m_free;
+  const int m_nf, m_nc;
+  const Eigen::VectorXd m_lift, m_lift_s;
+  std::unique_ptr<FreeStiffness> m_own_k;  // K_ff at μ when K depends on μ
+  QpData m_qp;
+  FomSolution m_sol;
+  Eigen::VectorXd m_u;  // the current iterate
+  Eigen::VectorXd m_gap;  // gaps of the last iterate (∞ off the kept rows)
+  Eigen::VectorXd m_surface_start;
+  Pairing m_first_pairing;
+  bool m_have_multipliers = false;
+};
+
+FomSolution IpoptQpSolver::solve(const Param& mu, const FomSolution* warm) const {
+  m_impl->problem.check_param(mu);
+  const auto t0 = std::chrono::steady_clock::now();
+  const IpoptOptions& opt = m_impl->options;
+  Query query(*m_impl, mu, warm);
+  // One exact Ipopt solve per pairing; the shared pairing fixed point re-pairs,
+  // accelerates and decides when to stop.
   fom::PairingFixedPointOptions fixed_point;
   fixed_point.max_iterations = opt.max_pairing_iterations;
   fixed_point.tolerance = opt.pairing_tolerance;
   fixed_point.anderson_depth = opt.anderson_depth;
   const fom::PairingFixedPointResult fp =
-      fom::solve_pairing_fixed_point(contact, problem.displacement_scale(), x, pairing, fixed_point, solve_at);
-  sol.status = fp.status;
-  if (fp.status != Status::Success && fp.solution.status == Status::Success)  // the cap, not a failed solve
-    sol.message = fom::pairing_no_convergence_message(fp, fixed_point);
-  sol.u = u;
-  const double lmax = sol.lambda.size() ? sol.lambda.maxCoeff() : 0.0;
-  // Interior-point multipliers are never exactly zero: a row is active when its pressure
-  // is significant (relative to the largest) and it touches (gap relative to the
-  // displacement scale), both to active_tolerance.
-  const double gap_tol = opt.active_tolerance * problem.displacement_scale();
-  sol.active = 0;
-  for (int s = 0; s < nc; ++s)
-    if (sol.lambda(s) > opt.active_tolerance * lmax && gap(s) <= gap_tol) ++sol.active;
-  // Ipopt's own success is measured in its scaled problem; a solution whose FOM KKT
-  // residuals are large is not reported as one. (Complementarity is left out:
-  // relative to Σ w|λ|, it is meaningless when every pressure is round-off, e.g. a
-  // body pulled away from the obstacle.)
-  fom::certify_fom_solution(problem, sol, opt.kkt_tolerance, false);
-  const fom::KktResiduals& k = sol.kkt;
-  if (sol.status != Status::Success) {
-    // Report how far the returned iterate is from a KKT point (fom/kkt.hpp residuals).
-    std::ostringstream msg;
-    msg.precision(3);
-    msg << "; KKT residuals of the returned iterate: stationarity " << k.stationarity << ", penetration "
-        << k.penetration << ", negative pressure " << k.negative_pressure << ", complementarity "
-        << k.complementarity;
-    sol.message += msg.str();
-  }
+      fom::solve_pairing_fixed_point(m_impl->problem.contact(), m_impl->problem.displacement_scale(),
+                                     query.surface_start(), query.first_pairing(), fixed_point, query);
+  FomSolution sol = query.finish(fp, fixed_point);
   sol.time_s = seconds_since(t0);
   return sol;
 }

@@ -82,6 +82,7 @@ class IpoptQpSolver final : public fom::FullOrderSolver {
 
  private:
   struct Impl;
+  class Query;  // one solve: the starting point, the Ipopt solve per pairing, the wrap-up
   std::unique_ptr<Impl> m_impl;
 };
 

@@ -21,7 +21,7 @@ const rom::OptionTable<ReducedActiveSetOptions>& reduced_active_set_option_table
     rom::OptionTable<O> o;
     o.include(rom::active_set_settings_table())
         .choice("init", &O::init, "starting point: empty, primal or cell",
-                {{"empty", rom::WarmStart::Empty}, {"primal", rom::WarmStart::Primal}, {"cell", rom::WarmStart::Cell}})
+                rom::warm_start_words({rom::WarmStart::Empty, rom::WarmStart::Primal, rom::WarmStart::Cell}))
         .choice("inner_solve", &O::inner_solve, "saddle-point solve: nonnegative or equality (textbook PDAS)",
                 {{"nonnegative", InnerSolve::NonNegative}, {"equality", InnerSolve::Equality}})
         .choice("rebuild", &O::rebuild, "contact operators rebuilt on the changed rows only (partial) or all (full)",
@@ -73,7 +73,8 @@ ReducedActiveSet::ReducedActiveSet(std::string name, const rom::ReducedModel& mo
     for (size_t i = 0; i < m_columns.size(); ++i) position[static_cast<size_t>(m_columns[i])] = static_cast<int>(i);
     m_starts.resize(static_cast<size_t>(m));
     for (int c = 0; c < m; ++c) {
-      const rom::OnlineResult res = solve_from(model.dictionary_parameters()[static_cast<size_t>(c)], rom::WarmStart::Empty);
+      rom::OnlineResult res;
+      solve_from(model.dictionary_parameters()[static_cast<size_t>(c)], rom::WarmStart::Empty, res);
       Start& t = m_starts[static_cast<size_t>(c)];
       t.u_hat = res.u_hat;
       for (int p : res.selected) t.active.push_back(position[static_cast<size_t>(p)]);
@@ -81,71 +82,186 @@ ReducedActiveSet::ReducedActiveSet(std::string name, const rom::ReducedModel& mo
   }
 }
 
-rom::OnlineResult ReducedActiveSet::solve_reduced(const fom::Param& mu) const { return solve_from(mu, m_options.init); }
+void ReducedActiveSet::solve_reduced(const fom::Param& mu, rom::OnlineResult& res) const {
+  solve_from(mu, m_options.init, res);
+}
 
-rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmStart init) const {
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
-  const fom::Problem& problem = m_model.problem();
-  const fom::ContactModel& contact = problem.contact();
-  const Eigen::MatrixXd& phi_s = m_model.surface_basis();
-  const int r = m_model.primal_rank(), mw = static_cast<int>(m_w.cols()), nc = static_cast<int>(m_w.rows());
+/// One query: the start at μ, the operators at the rebuild point x, the primal–dual
+/// active set on them, and the storage its steps reuse.
+struct ReducedActiveSet::Query : rom::ActiveSetStart {
+  Query(const ReducedActiveSet& solver, const fom::Param& mu)
+      : rom::ActiveSetStart(solver.m_model, mu),
+        solver(solver),
+        ops(solver.m_options.rebuild == rom::OperatorRebuild::Partial),
+        operators(solver.m_options.time_operators),
+        in_active(static_cast<size_t>(solver.m_w.cols()), 0),
+        nnls(solver.m_options.nnls) {}
 
-  rom::OnlineResult res;
-  res.mu = mu;
-
-  // K̂(μ)⁻¹ as in the greedy: the offline factor when K̂(μ) = θ₀(μ) K̂₀.
-  const rom::ReducedStiffnessInverse k_inv(m_model, mu);
-  if (!k_inv.ok()) {
-    res.status = Status::NumericalIssue;
-    res.message = "Cholesky factorisation of the reduced stiffness failed";
-    res.u_hat = Eigen::VectorXd::Zero(r);
-    res.lambda = Eigen::VectorXd::Zero(nc);
-    res.u = m_model.reconstruct_primal(res.u_hat, mu);
-    res.time_s = std::chrono::duration<double>(clock::now() - t0).count();
-    return res;
-  }
-
-  const Eigen::VectorXd f_hat = m_model.reduced_rhs(mu);
-  const Eigen::VectorXd lift_s = m_model.surface_lifting(mu);
-  const Eigen::VectorXd u_free = k_inv.solve(f_hat);
-
-  const rom::RowMajorMatrix& phi_s_rows = m_model.surface_basis_rows();
-  // Starting point: u_free (paper); the interpolated reduced coordinates of the
-  // training snapshots around μ (init = primal), the first active set then being the
-  // set of columns violated there; or (init = cell) this method's own solutions at
-  // those training parameters: their interpolated û and the union of their active sets.
+  const ReducedActiveSet& solver;
+  rom::SupportOperators ops;    // pairing, C_R, g_R at the rebuild point
+  rom::OperatorClock operators;  // time spent building the contact operators (optional)
   Eigen::VectorXd u_hat, lambda_i, u_s, v, violation, rhs;
-  std::vector<int> start;  // positions in W
-  int nearest = -1;        // training snapshot nearest to the start (−1: cold)
-  if (init == rom::WarmStart::Cell && !m_starts.empty()) {
-    u_hat.setZero(r);
-    const std::vector<rom::ReducedModel::StencilPoint> stencil = m_model.interpolation_stencil(mu);
+  std::vector<int> start;  // the warm start's active set (positions in W)
+  std::vector<int> active, next, solved;  // positions in W
+  rom::SelectionHistory seen;             // active sets met on the current operators
+  std::vector<char> in_active;
+  rom::RowMajorMatrix c_hat_i;
+  Eigen::MatrixXd z, schur;
+  NnlsQp nnls;
+  bool first = true;  // the warm start's set not used yet
+  int solves = 0;
+
+  /// Starting point: u_free (paper); the interpolated reduced coordinates of the
+  /// training snapshots around μ (init = primal), the first active set then being the
+  /// set of columns violated there; or (init = cell) this method's own solutions at
+  /// those training parameters: their interpolated û and the union of their active sets.
+  void start_at(const fom::Param& mu, rom::WarmStart init) {
+    u_hat = u_start;
+    if (init != rom::WarmStart::Cell || solver.m_starts.empty()) return;
+    u_hat.setZero(solver.m_model.primal_rank());
+    const std::vector<rom::ReducedModel::StencilPoint> stencil = solver.m_model.interpolation_stencil(mu);
     for (const auto& s : stencil) {
-      const Start& t = m_starts[static_cast<size_t>(s.column)];
+      const Start& t = solver.m_starts[static_cast<size_t>(s.column)];
       u_hat.noalias() += s.weight * t.u_hat;
       start.insert(start.end(), t.active.begin(), t.active.end());
     }
     nearest = rom::ReducedModel::nearest_column(stencil);
     std::sort(start.begin(), start.end());
     start.erase(std::unique(start.begin(), start.end()), start.end());
-  } else {
-    std::vector<int> unused;
-    rom::warm_start_point(m_model, init == rom::WarmStart::Primal ? init : rom::WarmStart::Empty, mu, u_free,
-                          unused, u_hat, &nearest);
   }
-  rom::RowMajorMatrix c_hat_i;
-  Eigen::MatrixXd z, schur;
-  rom::SupportOperators ops(m_options.rebuild == rom::OperatorRebuild::Partial);  // pairing, C_R, g_R at û
+
+  /// u_s = Φ_s x + u_off,s.
+  void surface_displacement(const Eigen::VectorXd& x) {
+    u_s.noalias() = solver.m_model.surface_basis() * x;
+    u_s += lift_s;
+  }
+
+  /// Step 1: the operators at x (surface rows only).
+  void rebuild_operators(const Eigen::VectorXd& x) {
+    operators.start();
+    surface_displacement(x);
+    ops.rebuild(solver.m_model.problem().contact(), solver.m_support, u_s);
+    operators.stop();
+  }
+
+  /// The physical test of the last solve at the operators just rebuilt at û itself:
+  /// its gaps within the contact tolerances.
+  bool gaps_within(const fom::ContactTolerances& tolerances, rom::SupportRows::ResidualsScratch& scratch) const {
+    const fom::Problem& problem = solver.m_model.problem();
+    return solver.m_support
+        .residuals(ops.c, ops.g, u_s, solved, lambda_i, problem.contact().weights(), problem.displacement_scale(), scratch)
+        .gaps_within(tolerances);
+  }
+
+  /// Step 2: û(x) by the primal–dual active set on the frozen operators, until its
+  /// set is stable and every column is within τ at û. Returns false on a non-finite
+  /// solve.
+  bool solve_on_frozen_operators(rom::OnlineResult& res) {
+    bool solved_here = false;
+    seen.clear();
+    while (solves < solver.m_options.max_solves) {
+      if (!next_active_set(solved_here)) break;
+      solve_saddle_point();
+      solved = active;
+      solved_here = true;
+      res.iterations = ++solves;
+      if (!(u_hat.allFinite() && lambda_i.allFinite())) return false;
+    }
+    return true;
+  }
+
+  /// The next active set from the violation of every column at û,
+  /// Ĉû − ĝ = Wᵀ(C_R u_s − g_R): the columns whose multiplier left the cone drop out,
+  /// every violated column comes in. With the non-negative inner solve a zero
+  /// multiplier on a still-violated column keeps it (dropping and re-adding it would
+  /// cycle). Returns false when the set is stable with every column within τ, or when
+  /// it was met before on these operators (the primal–dual steps cycle: a column
+  /// whose multiplier is zero leaves and is violated again; û(x) is then the last
+  /// solve and the outer loop goes on from there).
+  bool next_active_set(bool solved_here) {
+    const int mw = static_cast<int>(solver.m_w.cols());
+    const double threshold = solver.m_threshold;
+    const bool nonnegative = solver.m_options.inner_solve == InnerSolve::NonNegative;
+    surface_displacement(u_hat);
+    solver.m_support.violation(ops.c, ops.g, u_s, v, violation);
+    next.clear();
+    if (first) next = start;  // the warm start's set (empty otherwise)
+    for (size_t i = 0; i < active.size(); ++i) {
+      const double l = lambda_i(static_cast<Eigen::Index>(i));
+      const bool keep = nonnegative ? (l > 0.0 || violation(active[i]) > threshold) : l >= 0.0;
+      if (keep) next.push_back(active[i]);
+    }
+    if (!first || start.empty())
+      for (int p = 0; p < mw; ++p)
+        if (!in_active[p] && violation(p) > threshold) next.push_back(p);
+    const double worst = mw ? violation.maxCoeff() : -std::numeric_limits<double>::infinity();
+    if (solved_here && next == active && worst <= threshold) return false;
+    std::sort(next.begin(), next.end());
+    if (seen.revisits(next, [](int p) { return p; })) return false;
+    first = false;
+    for (int p : active) in_active[p] = 0;
+    active.swap(next);
+    for (int p : active) in_active[p] = 1;
+    return true;
+  }
+
+  /// The saddle-point system on the active set I by its Schur complement
+  /// S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ: û = u_free − K̂⁻¹Ĉ_Iᵀ λ̂_I.
+  void solve_saddle_point() {
+    const int na = static_cast<int>(active.size());
+    if (na == 0) {
+      u_hat = u_free;
+      lambda_i.resize(0);
+      return;
+    }
+    const rom::ReducedModel& model = solver.m_model;
+    c_hat_i.resize(na, model.primal_rank());
+    rhs.resize(na);
+    // Rows of Ĉ_I = W_Iᵀ C_R Φ_s and entries of ĝ_I = W_Iᵀ (g_R − C_R u_off,s),
+    // as in the greedy: from the rows where each active column is non-zero.
+    operators.start();
+    for (int i = 0; i < na; ++i)
+      rhs(i) = solver.m_support.reduced_row(active[i], ops.c, ops.g, model.surface_basis_rows(), lift_s, c_hat_i.row(i));
+    operators.stop();
+    k_inv.apply(c_hat_i.transpose(), z);  // K̂⁻¹ Ĉ_Iᵀ
+    schur.noalias() = c_hat_i * z;
+    rhs = c_hat_i * u_free - rhs;
+    if (solver.m_options.inner_solve == InnerSolve::NonNegative) {
+      // min ½ λᵀ S λ − rhsᵀ λ, λ ≥ 0: the saddle-point system on I with the sign
+      // condition imposed (Lawson–Hanson; dependent rows are never freed together).
+      nnls.compute(schur);
+      lambda_i = nnls.solve(rhs);
+      if (nnls.info() == Status::InvalidInput) lambda_i = Eigen::VectorXd::Constant(na, std::numeric_limits<double>::quiet_NaN());
+    } else {
+      lambda_i = rom::schur_multipliers(schur, rhs, solver.m_options.singular_tolerance);
+    }
+    u_hat.noalias() = u_free - z * lambda_i;
+  }
+
+  /// The answer: û, and the support, the columns of the last solve with a non-zero
+  /// multiplier, as dictionary columns.
+  void report(rom::OnlineResult& res) const {
+    res.u_hat = u_hat;
+    res.coefficients.resize(static_cast<Eigen::Index>(solved.size()));
+    for (size_t i = 0; i < solved.size(); ++i) {
+      const double l = lambda_i(static_cast<Eigen::Index>(i));
+      if (l == 0.0) continue;
+      res.coefficients(static_cast<Eigen::Index>(res.selected.size())) = l;
+      res.selected.push_back(solver.m_columns[solved[i]]);
+    }
+    res.coefficients.conservativeResize(static_cast<Eigen::Index>(res.selected.size()));
+    res.lambda = solver.m_model.reconstruct_dual(res.selected, res.coefficients);
+    res.operator_time_s = operators.total();
+  }
+};
+
+void ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmStart init, rom::OnlineResult& res) const {
+  Query q(*this, mu);
+  if (!q.begin(m_model, mu, init == rom::WarmStart::Primal ? init : rom::WarmStart::Empty, res)) return;
+  q.start_at(mu, init);
   // Warm-started, the first search starts from the one made offline at the nearest
   // training snapshot, as the greedy's does (same pairing as a full search).
-  if (nearest >= 0) ops.seed(m_model.snapshot_search_memory(nearest));
-  std::vector<int> active, next, solved;  // positions in W
-  rom::SelectionHistory seen;             // active sets met on the current operators
-  std::vector<char> in_active(mw, 0);
-  NnlsQp nnls(m_options.nnls);
-  const bool nonnegative = m_options.inner_solve == InnerSolve::NonNegative;
-  rom::OperatorClock operators(m_options.time_operators);
+  q.seed(m_model, q.ops);
 
   // The fixed point x ↦ û(x) of the greedy's default schedule (rom::GreedySchedule::
   // FixedPoint), with this method's own solve on the frozen operators: operators
@@ -153,24 +269,15 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
   // x Anderson-accelerated (one history over the query) until the contact surface
   // moves by at most surface_step; then the physical test at û's own pairing.
   const fom::ContactTolerances tolerances = contact_tolerances();
-  const double scale = problem.displacement_scale();
   rom::SupportRows::ResidualsScratch scratch;
   AndersonMixer mixer(m_options.anderson_depth);
-  Eigen::VectorXd x = u_hat;  // where the operators are built
-  bool pending = false, failed_test = false, first = true;
-  int solves = 0;
+  Eigen::VectorXd x = q.u_hat;  // where the operators are built
+  bool pending = false, failed_test = false;
   for (int rebuild = 0;; ++rebuild) {
-    // 1. Operators at x (surface rows only); where x = û, the physical test at û's own pairing.
-    operators.start();
-    u_s.noalias() = phi_s * x;
-    u_s += lift_s;
-    ops.rebuild(contact, m_support, u_s);
-    operators.stop();
+    q.rebuild_operators(x);
     if (pending) {
-      const fom::ContactResiduals r =
-          m_support.residuals(ops.c, ops.g, u_s, solved, lambda_i, contact.weights(), scale, scratch);
       // Failing twice in a row: a fixed point of the reduced problem (see the greedy).
-      if (r.gaps_within(tolerances) || failed_test) {
+      if (q.gaps_within(tolerances, scratch) || failed_test) {
         res.converged = true;
         break;
       }
@@ -179,111 +286,25 @@ rom::OnlineResult ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmSt
       failed_test = false;
     }
     pending = false;
-    if (rebuild >= m_options.max_iterations || solves >= m_options.max_solves) break;
-
-    // 2. û(x): primal–dual active set on the frozen operators, until its set is stable
-    //    and every column is within τ at û.
-    bool finite = true, solved_here = false;
-    seen.clear();
-    while (solves < m_options.max_solves) {
-      // Violation of every column at the current û, Ĉû − ĝ = Wᵀ(C_R u_s − g_R).
-      u_s.noalias() = phi_s * u_hat;
-      u_s += lift_s;
-      m_support.violation(ops.c, ops.g, u_s, v, violation);
-      // Drop the columns whose multiplier left the cone, add every violated column.
-      // With the non-negative inner solve a zero multiplier on a still-violated
-      // column keeps it (dropping and re-adding it would cycle).
-      next.clear();
-      if (first) next = start;  // the warm start's set (empty otherwise)
-      for (size_t i = 0; i < active.size(); ++i) {
-        const double l = lambda_i(static_cast<Eigen::Index>(i));
-        const bool keep = nonnegative ? (l > 0.0 || violation(active[i]) > m_threshold) : l >= 0.0;
-        if (keep) next.push_back(active[i]);
-      }
-      if (!first || start.empty())
-        for (int p = 0; p < mw; ++p)
-          if (!in_active[p] && violation(p) > m_threshold) next.push_back(p);
-      const double worst = mw ? violation.maxCoeff() : -std::numeric_limits<double>::infinity();
-      if (solved_here && next == active && worst <= m_threshold) break;
-      // A set met before on these operators: the primal–dual steps cycle (a column
-      // whose multiplier is zero leaves and is violated again); û(x) is taken as the
-      // last solve and the outer loop goes on from there.
-      std::sort(next.begin(), next.end());
-      if (seen.revisits(next, [](int p) { return p; })) break;
-      first = false;
-      for (int p : active) in_active[p] = 0;
-      active.swap(next);
-      for (int p : active) in_active[p] = 1;
-
-      // Saddle-point system on I by its Schur complement S = Ĉ_I K̂⁻¹ Ĉ_Iᵀ.
-      const int na = static_cast<int>(active.size());
-      if (na == 0) {
-        u_hat = u_free;
-        lambda_i.resize(0);
-      } else {
-        c_hat_i.resize(na, r);
-        rhs.resize(na);
-        // Rows of Ĉ_I = W_Iᵀ C_R Φ_s and entries of ĝ_I = W_Iᵀ (g_R − C_R u_lift,s),
-        // as in the greedy: from the rows where each active column is non-zero.
-        operators.start();
-        for (int i = 0; i < na; ++i) rhs(i) = m_support.reduced_row(active[i], ops.c, ops.g, phi_s_rows, lift_s, c_hat_i.row(i));
-        operators.stop();
-        k_inv.apply(c_hat_i.transpose(), z);  // K̂⁻¹ Ĉ_Iᵀ
-        schur.noalias() = c_hat_i * z;
-        rhs = c_hat_i * u_free - rhs;
-        if (nonnegative) {
-          // min ½ λᵀ S λ − rhsᵀ λ, λ ≥ 0: the saddle-point system on I with the sign
-          // condition imposed (Lawson–Hanson; dependent rows are never freed together).
-          nnls.compute(schur);
-          lambda_i = nnls.solve(rhs);
-          if (nnls.info() == Status::InvalidInput) lambda_i = Eigen::VectorXd::Constant(na, std::numeric_limits<double>::quiet_NaN());
-        } else {
-          lambda_i = rom::schur_multipliers(schur, rhs, m_options.singular_tolerance);
-        }
-        u_hat.noalias() = u_free - z * lambda_i;
-      }
-      solved = active;
-      solved_here = true;
-      res.iterations = ++solves;
-      if (!(finite = u_hat.allFinite() && lambda_i.allFinite())) break;
-    }
-    if (!finite) {
+    if (rebuild >= m_options.max_iterations || q.solves >= m_options.max_solves) break;
+    if (!q.solve_on_frozen_operators(res)) {
       res.status = Status::NumericalIssue;
       res.message = "reduced saddle-point solve produced a non-finite value";
       break;
     }
-    // 3. The next point: û itself once the surface moved by at most surface_step
-    //    (then tested at its own pairing), else the Anderson extrapolation.
-    if (rom::surface_step(m_model, u_hat, x) <= m_options.surface_step) {
+    // Step 3: the next point: û itself once the surface moved by at most
+    // surface_step (then tested at its own pairing), else the Anderson extrapolation.
+    if (rom::surface_step(m_model, q.u_hat, x) <= m_options.surface_step) {
       pending = true;
-      x = u_hat;
+      x = q.u_hat;
     } else {
-      mixer.next(x, u_hat, x);
+      mixer.next(x, q.u_hat, x);
     }
   }
-
-  res.u_hat = u_hat;
-  // Report the support: columns of the last solve with a non-zero multiplier.
-  res.coefficients.resize(static_cast<Eigen::Index>(solved.size()));
-  for (size_t i = 0; i < solved.size(); ++i) {
-    const double l = lambda_i(static_cast<Eigen::Index>(i));
-    if (l == 0.0) continue;
-    res.coefficients(static_cast<Eigen::Index>(res.selected.size())) = l;
-    res.selected.push_back(m_columns[solved[i]]);
-  }
-  res.coefficients.conservativeResize(static_cast<Eigen::Index>(res.selected.size()));
-  res.lambda = m_model.reconstruct_dual(res.selected, res.coefficients);
-  if (res.status == Status::Success && !res.converged) {
-    res.status = Status::NoConvergence;
+  q.report(res);
+  if (res.status == Status::Success && !res.converged)
     res.message = m_name + " active set did not converge in " + std::to_string(m_options.max_iterations) +
                   " operator rebuilds (or " + std::to_string(m_options.max_solves) + " solves)";
-  }
-  const auto t1 = clock::now();
-  res.time_s = std::chrono::duration<double>(t1 - t0).count();
-  res.operator_time_s = operators.total();
-  res.u = m_model.reconstruct_primal(u_hat, mu);
-  res.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
-  return res;
 }
 
 double reduced_penetration(const rom::ReducedModel& model, const std::vector<int>& columns, const Eigen::VectorXd& u) {

@@ -162,8 +162,11 @@ class ReducedActiveSet : public rom::OnlineSolver {
     std::vector<int> active;
   };
   std::vector<Start> m_starts;
-  rom::OnlineResult solve_from(const fom::Param& mu, rom::WarmStart init) const;
-  rom::OnlineResult solve_reduced(const fom::Param& mu) const override;
+  struct Query;
+  /// The query at μ from the starting point `init` (the constructor's cold solves use
+  /// WarmStart::Empty).
+  void solve_from(const fom::Param& mu, rom::WarmStart init, rom::OnlineResult& res) const;
+  void solve_reduced(const fom::Param& mu, rom::OnlineResult& res) const override;
 };
 
 /// \brief Reduced-level penetration \f$ \max_p D_d[:,p]^T (C(u)\,u - g(u)) \f$ over the

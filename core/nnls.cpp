@@ -1,5 +1,7 @@
 #include "core/nnls.hpp"
 
+#include "core/lawson_hanson.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -113,6 +115,59 @@ VectorXd NnlsQp::solve(const VectorXd& c) { return run(c, nullptr); }
 
 VectorXd NnlsQp::solve(const VectorXd& c, const VectorXd& x0) { return run(c, &x0); }
 
+namespace {
+
+/// The Gram-form QP min ½xᵀGx − cᵀx, x ≥ 0, as a Lawson–Hanson problem: the passive
+/// set is held by the updated Cholesky factor of G_PP.
+class GramQpProblem final : public LawsonHansonProblem {
+ public:
+  GramQpProblem(const MatrixXd& gram, const VectorXd& c, GramCholesky& factor, const NnlsOptions& options)
+      : m_gram(gram), m_c(c), m_factor(factor), m_options(options), m_c_scale(c.lpNorm<Eigen::Infinity>()) {}
+
+  const std::vector<Index>& passive() const override { return m_factor.indices(); }
+
+  /// w = c − Gx; the threshold is tolerance · max(‖c‖∞, ‖Gx‖∞).
+  double descent(const VectorXd& x, VectorXd& w) override {
+    m_gx.setZero(m_gram.cols());
+    for (const Index j : m_factor.indices()) m_gx.noalias() += m_gram.col(j) * x(j);
+    w = m_c - m_gx;
+    m_scale = std::max(m_c_scale, m_gx.lpNorm<Eigen::Infinity>());
+    return m_options.tolerance * m_scale;
+  }
+
+  bool free(Index j) override { return m_factor.append(m_gram, j, m_options.dependence_tolerance); }
+  void bind(Index position) override { m_factor.remove(position); }
+
+  bool solve_passive(VectorXd& z) override {
+    const auto& free_set = m_factor.indices();
+    z.resize(m_factor.size());
+    for (Index i = 0; i < z.size(); ++i) z(i) = m_c(free_set[static_cast<std::size_t>(i)]);
+    m_factor.solve_in_place(z);
+    return z.allFinite();
+  }
+
+  /// Converged, unless a refused variable still descends far above rounding level:
+  /// c then has a component outside range(G) that cannot be reached.
+  Status converged(const VectorXd& w, const std::vector<char>& refused) override {
+    const double unbounded_threshold = std::sqrt(m_options.tolerance) * m_scale;
+    for (Index j = 0; j < w.size(); ++j) {
+      if (refused[static_cast<std::size_t>(j)] && w(j) > unbounded_threshold) return Status::NumericalIssue;
+    }
+    return Status::Success;
+  }
+
+ private:
+  const MatrixXd& m_gram;
+  const VectorXd& m_c;
+  GramCholesky& m_factor;
+  const NnlsOptions& m_options;
+  const double m_c_scale;
+  double m_scale = 0.0;  ///< max(‖c‖∞, ‖Gx‖∞) at the last descent()
+  VectorXd m_gx;
+};
+
+}  // namespace
+
 VectorXd NnlsQp::run(const VectorXd& c, const VectorXd* x0) {
   const Index n = m_gram.cols();
   m_iterations = 0;
@@ -125,136 +180,20 @@ VectorXd NnlsQp::run(const VectorXd& c, const VectorXd* x0) {
   m_info = Status::Success;
   if (n == 0) return x;
 
-  const int max_iterations = m_options.max_iterations > 0 ? m_options.max_iterations : static_cast<int>(3 * n);
-  const double dep_tol = m_options.dependence_tolerance;
-  const double c_scale = c.lpNorm<Eigen::Infinity>();
-
-  std::vector<char> is_free(static_cast<std::size_t>(n), 0);
-  // Variables refused since the free set last changed: numerically dependent on
-  // the free ones, or whose least-squares value came out non-positive although
-  // their gradient said they should enter (possible only through rounding).
-  std::vector<char> refused(static_cast<std::size_t>(n), 0);
-  const auto clear_refused = [&] { std::fill(refused.begin(), refused.end(), 0); };
-
+  LawsonHansonOptions loop;
+  loop.max_iterations = m_options.max_iterations > 0 ? m_options.max_iterations : static_cast<int>(3 * n);
   // Warm start: free the positive entries of x0 that are independent of the
   // previously freed ones; x stays feasible (x >= 0) throughout.
-  bool start_with_inner_loop = false;
   if (x0) {
     for (Index j = 0; j < n; ++j) {
-      if ((*x0)(j) > 0.0 && m_factor.append(m_gram, j, dep_tol)) {
-        x(j) = (*x0)(j);
-        is_free[static_cast<std::size_t>(j)] = 1;
-      }
+      if ((*x0)(j) > 0.0 && m_factor.append(m_gram, j, m_options.dependence_tolerance)) x(j) = (*x0)(j);
     }
-    start_with_inner_loop = m_factor.size() > 0;
+    loop.start_with_passive_solve = m_factor.size() > 0;
   }
-
-  VectorXd z;
-  VectorXd w(n);
-  Index newly_freed = -1;
-  while (true) {
-    if (!start_with_inner_loop) {
-      // ---- Outer loop: optimality test on the bound variables (w = c - Gx). ----
-      VectorXd gx = VectorXd::Zero(n);
-      for (const Index j : m_factor.indices()) gx.noalias() += m_gram.col(j) * x(j);
-      w = c - gx;
-      const double threshold = m_options.tolerance * std::max(c_scale, gx.lpNorm<Eigen::Infinity>());
-      Index best = -1;
-      for (Index j = 0; j < n; ++j) {
-        const auto sj = static_cast<std::size_t>(j);
-        if (is_free[sj] || refused[sj]) continue;
-        if (best < 0 || w(j) > w(best)) best = j;
-      }
-      if (best < 0 || w(best) <= threshold) {
-        // Converged, unless a refused variable still descends far above rounding
-        // level: c then has a component outside range(G) that cannot be reached.
-        const double unbounded_threshold = std::sqrt(m_options.tolerance) * std::max(c_scale, gx.lpNorm<Eigen::Infinity>());
-        for (Index j = 0; j < n; ++j) {
-          if (refused[static_cast<std::size_t>(j)] && w(j) > unbounded_threshold) m_info = Status::NumericalIssue;
-        }
-        break;
-      }
-      if (m_iterations >= max_iterations) {
-        m_info = Status::NoConvergence;
-        break;
-      }
-      ++m_iterations;
-      if (!m_factor.append(m_gram, best, dep_tol)) {
-        refused[static_cast<std::size_t>(best)] = 1;
-        continue;
-      }
-      is_free[static_cast<std::size_t>(best)] = 1;
-      newly_freed = best;
-    }
-    start_with_inner_loop = false;
-
-    // ---- Inner loop: least squares on the free set, stepping back to keep x >= 0. ----
-    bool stop = false;
-    while (true) {
-      const auto& free_set = m_factor.indices();
-      const Index k = m_factor.size();
-      z.resize(k);
-      for (Index i = 0; i < k; ++i) z(i) = c(free_set[static_cast<std::size_t>(i)]);
-      m_factor.solve_in_place(z);
-      if (!z.allFinite()) {
-        m_info = Status::NumericalIssue;
-        stop = true;
-        break;
-      }
-      if (newly_freed >= 0) {
-        // Lawson–Hanson (Lemma 23.17): with w_j > 0 the entering variable is
-        // positive in exact arithmetic. If rounding says otherwise, undo the entry
-        // instead of taking a zero-length step that would cycle.
-        const Index j = newly_freed;
-        newly_freed = -1;
-        if (!(z(k - 1) > 0.0)) {
-          m_factor.remove(k - 1);
-          is_free[static_cast<std::size_t>(j)] = 0;
-          refused[static_cast<std::size_t>(j)] = 1;
-          break;
-        }
-        clear_refused();
-      }
-      if (k == 0 || z.minCoeff() > 0.0) {
-        for (Index i = 0; i < k; ++i) x(free_set[static_cast<std::size_t>(i)]) = z(i);
-        break;
-      }
-      // Longest step from x towards z that keeps x >= 0; the blocking variable
-      // leaves the free set (together with any other that reached zero).
-      double step = 1.0;
-      Index blocking = -1;
-      for (Index i = 0; i < k; ++i) {
-        if (z(i) > 0.0) continue;
-        const double xi = x(free_set[static_cast<std::size_t>(i)]);
-        const double ratio = xi / (xi - z(i));
-        if (blocking < 0 || ratio < step) {
-          step = ratio;
-          blocking = i;
-        }
-      }
-      for (Index i = 0; i < k; ++i) {
-        const Index j = free_set[static_cast<std::size_t>(i)];
-        x(j) += step * (z(i) - x(j));
-      }
-      x(free_set[static_cast<std::size_t>(blocking)]) = 0.0;
-      for (Index i = k - 1; i >= 0; --i) {
-        const Index j = m_factor.indices()[static_cast<std::size_t>(i)];
-        if (x(j) <= 0.0) {
-          x(j) = 0.0;
-          is_free[static_cast<std::size_t>(j)] = 0;
-          m_factor.remove(i);
-        }
-      }
-      clear_refused();
-      if (m_iterations >= max_iterations) {
-        m_info = Status::NoConvergence;
-        stop = true;
-        break;
-      }
-      ++m_iterations;
-    }
-    if (stop) break;
-  }
+  GramQpProblem problem(m_gram, c, m_factor, m_options);
+  const LawsonHansonResult result = lawson_hanson(problem, x, loop);
+  m_info = result.status;
+  m_iterations = result.iterations;
   return x;
 }
 

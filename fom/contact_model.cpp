@@ -155,81 +155,195 @@ void NodeToSegmentContact::search_all(const Eigen::VectorXd& u_surface, const st
   for (size_t q = 0; q < m_pairs.size(); ++q) {
     const Pair& pair = m_pairs[q];
     const int pq = static_cast<int>(q);
+    PairRequest request;
+    request.pair_index = pq;
+    request.hint = hint;
+    request.memory = memory;
     if (!rows) {
-      search_pair(pair, u_surface, nullptr, pair.row_end - pair.row_begin, hint, p, memory, pq);
+      request.num_rows = pair.row_end - pair.row_begin;
+      search_pair(request, u_surface, p);
       continue;
     }
     const size_t first = r;
     while (r < rows->size() && (*rows)[r] < pair.row_end) ++r;
-    if (r > first)
-      search_pair(pair, u_surface, rows->data() + first, static_cast<int>(r - first), hint, p, memory, pq);
+    request.listed_rows = rows->data() + first;
+    request.num_rows = static_cast<int>(r - first);
+    if (r > first) search_pair(request, u_surface, p);
   }
 }
 
-void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& u_surface, const int* rows,
-                                       int nrows, const Pairing* hint, Pairing& p, SearchMemory* memory,
-                                       int pair_index) const {
-  const int nm = static_cast<int>(pair.master.size());
-  // Per-thread scratch arrays: a search takes a few microseconds inside the online
-  // loops, where allocating them on every call would be a visible share.
-  thread_local struct {
+/// One pair's search: closest master segment and normal of every requested row.
+/// The geometry of the deformed master chain lives in per-thread scratch arrays: a
+/// search takes a few microseconds inside the online loops, where allocating them
+/// on every call would be a visible share.
+class NodeToSegmentContact::PairSearch {
+ public:
+  PairSearch(const NodeToSegmentContact& contact, const PairRequest& request, const Eigen::VectorXd& u_surface, Pairing& p)
+      : m_contact(contact),
+        m_pair(contact.m_pairs[static_cast<size_t>(request.pair_index)]),
+        m_request(request),
+        m_memory(request.memory),
+        m_u(u_surface),
+        m_p(p),
+        m_nm(static_cast<int>(m_pair.master.size())),
+        m_nseg(std::max(m_nm - 1, 0)),
+        m_s(scratch()),
+        m_lowest(m_nseg) {
+    m_s.xm.resize(2, m_nm);
+    m_s.seg_t.resize(2, m_nseg);
+    m_s.mid.resize(2, m_nseg);
+    m_s.inv_len2.resize(m_nseg);
+    m_s.half.resize(m_nseg);
+  }
+
+  /// Rows settled from the memory: each among its recorded segment and the
+  /// neighbours, certified by the clearance. False (and nothing paired) when the
+  /// memory holds no record of the pair or one row fails.
+  bool certify_from_memory() {
+    if (!m_memory || !m_memory->recorded[static_cast<size_t>(m_request.pair_index)] || m_nseg == 0) return false;
+    const double b = largest_master_move();
+    // Only the segments the recorded ones and their neighbours reach (the normals
+    // use one more on each side).
+    int c_min = m_nseg, c_max = -1;
+    for (int r = 0; r < m_request.num_rows; ++r) {
+      const int c = m_memory->centre[static_cast<size_t>(row(r))];
+      if (c >= 0) c_min = std::min(c_min, c), c_max = std::max(c_max, c);
+    }
+    if (c_max >= 0) prepare(std::max(c_min - 2, 0), std::min(c_max + 3, m_nseg), false);
+    bool settled = true;
+    for (int r = 0; r < m_request.num_rows && settled; ++r) {
+      settled = certify_row(row(r), b);
+    }
+    if (settled) {
+      m_memory->certified += m_request.num_rows;
+      return true;
+    }
+    m_lowest = m_nseg, m_highest = -1;  // start again, in full
+    for (int r = 0; r < m_request.num_rows; ++r) m_p.segment[row(r)] = -1;
+    return false;
+  }
+
+  /// Exact closest segment per row, pruned by bounding circles of blocks of
+  /// segments and of each segment; recorded in the memory when there is one.
+  void pruned_search() {
+    prepare(0, m_nseg, true);
+    bound_blocks();
+    if (m_memory)  // rows of the pair left out of this search lose their record
+      std::fill(m_memory->centre.begin() + m_pair.row_begin, m_memory->centre.begin() + m_pair.row_end, -1);
+    // The segment of the previous slave node is tried first (neighbouring slave
+    // nodes have neighbouring pairs).
+    int guess = 0;
+    for (int r = 0; r < m_request.num_rows; ++r) {
+      const int k = row(r);
+      const Pairing* hint = m_request.hint;
+      if (hint && hint->segment.size() == m_p.segment.size() && hint->segment[k] >= 0) guess = hint->segment[k];
+      Tried tried;
+      const Best best = closest_segment(slave_position(k), guess, tried);
+      if (best.seg >= 0) guess = best.seg;
+      pair_row(k, best);
+      if (m_memory) record_row(k, best, tried);
+    }
+    if (m_memory) record_pair();
+  }
+
+  /// Nodal normals of the deformed master surface (average of the adjacent
+  /// segments' outward normals) where rows are paired, nodes lowest … highest+1:
+  /// interpolating them along a segment gives a normal field that is continuous
+  /// across master nodes, so the constraint row does not jump when a slave node
+  /// passes from one segment to the next.
+  void nodal_normals() {
+    if (m_highest < 0) return;
+    Eigen::Matrix2Xd& node_normal = m_s.node_normal;
+    node_normal.resize(2, m_nm);
+    node_normal.middleCols(m_lowest, m_highest + 2 - m_lowest).setZero();
+    for (int j = std::max(m_lowest - 1, 0); j <= std::min(m_highest + 1, m_nseg - 1); ++j) {
+      const Eigen::Vector2d t = m_s.seg_t.col(j);
+      // Chains run with their body on the left: (t_y, −t_x) points out of the master body.
+      const Eigen::Vector2d n = (1.0 / t.norm()) * Eigen::Vector2d(t.y(), -t.x());
+      if (j >= m_lowest) node_normal.col(j) += n;
+      if (j + 1 <= m_highest + 1) node_normal.col(j + 1) += n;
+    }
+    for (int j = m_lowest; j <= m_highest + 1; ++j) node_normal.col(j).normalize();
+    for (int r = 0; r < m_request.num_rows; ++r) {
+      const int k = row(r), j = m_p.segment[k];
+      if (j < 0) continue;
+      const double xi = m_p.xi[k];
+      m_p.normal.col(k) = ((1.0 - xi) * node_normal.col(j) + xi * node_normal.col(j + 1)).normalized();
+    }
+  }
+
+ private:
+  struct Scratch {
     Eigen::Matrix2Xd xm, node_normal, seg_t, mid, block_c;
     Eigen::VectorXd inv_len2, half, block_r;
-  } scratch;
-  // Deformed master nodes and, for the distances, per segment: tangent t, midpoint,
-  // 1/|t|² and the radius of a circle about the midpoint holding the segment
-  // (½(|t_x|+|t_y|) ≥ ½|t|, no root); `prepare` fills segments j0 … j1−1 (the
-  // circles only for a full search).
-  const int nseg = std::max(nm - 1, 0);
-  Eigen::Matrix2Xd& xm = scratch.xm;
-  Eigen::Matrix2Xd& seg_t = scratch.seg_t;
-  Eigen::Matrix2Xd& mid = scratch.mid;
-  Eigen::VectorXd& inv_len2 = scratch.inv_len2;
-  Eigen::VectorXd& half = scratch.half;
-  xm.resize(2, nm);
-  seg_t.resize(2, nseg);
-  mid.resize(2, nseg);
-  inv_len2.resize(nseg);
-  half.resize(nseg);
-  auto prepare = [&](int j0, int j1, bool circles) {
-    for (int j = j0; j <= std::min(j1, nm - 1); ++j)
-      xm.col(j) = pair.master_x.col(j) + u_surface.segment<2>(2 * pair.master_surface[static_cast<size_t>(j)]);
-    for (int j = j0; j < j1; ++j) {
-      const Eigen::Vector2d t = xm.col(j + 1) - xm.col(j);
-      seg_t.col(j) = t;
-      inv_len2(j) = 1.0 / t.squaredNorm();
-      if (!circles) continue;  // the settled rows need no pruning
-      mid.col(j) = 0.5 * (xm.col(j + 1) + xm.col(j));
-      half(j) = 0.5 * (std::abs(t.x()) + std::abs(t.y()));
-    }
   };
+  static Scratch& scratch() {
+    thread_local Scratch s;
+    return s;
+  }
 
-  // Closest point of slave position (px, py) on segment j, kept when closer than
-  // the best so far; ties (a slave node exactly at a master node) go to the lower
-  // segment index. The distance itself (a square root on the critical path) is
-  // taken only where it is used: by the pruning of a full search after each
-  // improvement, by the certificate of a settled row once.
+  /// Closest point found so far. The distance itself (a square root on the
+  /// critical path) is taken only where it is used: by the pruning of a full search
+  /// after each improvement, by the certificate of a settled row once.
   struct Best {
     double dist2 = std::numeric_limits<double>::max(), root = std::numeric_limits<double>::max();
     int seg = -1;
     double xi = 0.0, raw = 0.0;
   };
-  auto try_segment = [&](double px, double py, int j, Best& best) {
-    const double dx = px - xm(0, j), dy = py - xm(1, j), tx = seg_t(0, j), ty = seg_t(1, j);
-    const double raw = (dx * tx + dy * ty) * inv_len2(j);
+  /// The four nearest segments tried, by squared distance (for the clearance: at
+  /// least one of them is not the closest segment or one of its two neighbours).
+  struct Tried {
+    static constexpr int kept = 4;
+    int seg[kept];
+    double d2[kept];
+    int count = 0;
+    void insert(int j, double d2_j) {
+      for (int t = 0; t < std::min(count, kept); ++t)  // insertion into the sorted four
+        if (d2_j < d2[t]) std::swap(d2_j, d2[t]), std::swap(j, seg[t]);
+      if (count < kept) seg[count] = j, d2[count] = d2_j;
+      ++count;
+    }
+  };
+
+  int row(int r) const { return m_request.listed_rows ? m_request.listed_rows[r] : m_pair.row_begin + r; }
+
+  Eigen::Vector2d slave_position(int k) const {
+    const Eigen::Matrix2Xd& x = m_contact.m_slave_x;
+    return Eigen::Vector2d(x(0, k) + m_u(2 * k), x(1, k) + m_u(2 * k + 1));
+  }
+
+  /// Deformed master nodes and, per segment j0 … j1−1: tangent t, 1/|t|², and (for
+  /// the pruning of a full search) the midpoint and the radius ½(|t_x|+|t_y|) ≥ ½|t|
+  /// of a circle about it holding the segment (no root).
+  void prepare(int j0, int j1, bool circles) {
+    for (int j = j0; j <= std::min(j1, m_nm - 1); ++j)
+      m_s.xm.col(j) = m_pair.master_x.col(j) + m_u.segment<2>(2 * m_pair.master_surface[static_cast<size_t>(j)]);
+    for (int j = j0; j < j1; ++j) {
+      const Eigen::Vector2d t = m_s.xm.col(j + 1) - m_s.xm.col(j);
+      m_s.seg_t.col(j) = t;
+      m_s.inv_len2(j) = 1.0 / t.squaredNorm();
+      if (!circles) continue;  // the settled rows need no pruning
+      m_s.mid.col(j) = 0.5 * (m_s.xm.col(j + 1) + m_s.xm.col(j));
+      m_s.half(j) = 0.5 * (std::abs(t.x()) + std::abs(t.y()));
+    }
+  }
+
+  /// Closest point of slave position (px, py) on segment j, kept when closer than
+  /// the best so far; ties (a slave node exactly at a master node) go to the lower
+  /// segment index. Returns the squared distance.
+  double try_segment(double px, double py, int j, Best& best) const {
+    const double dx = px - m_s.xm(0, j), dy = py - m_s.xm(1, j), tx = m_s.seg_t(0, j), ty = m_s.seg_t(1, j);
+    const double raw = (dx * tx + dy * ty) * m_s.inv_len2(j);
     const double xi = raw < 0.0 ? 0.0 : (raw > 1.0 ? 1.0 : raw);
     const double ex = dx - xi * tx, ey = dy - xi * ty;
     const double dist2 = ex * ex + ey * ey;
     if (dist2 < best.dist2 * (1.0 - 1e-14) || (best.seg >= 0 && dist2 <= best.dist2 * (1.0 + 1e-14) && j < best.seg))
       best = {dist2, best.root, j, xi, raw};
     return dist2;
-  };
-  auto slave_position = [&](int k) {
-    return Eigen::Vector2d(m_slave_x(0, k) + u_surface(2 * k), m_slave_x(1, k) + u_surface(2 * k + 1));
-  };
-  int lowest = nseg, highest = -1;
-  // Stores row k's closest segment in the pairing.
-  auto pair_row = [&](int k, const Best& best) {
+  }
+
+  /// Stores row k's closest segment in the pairing.
+  void pair_row(int k, const Best& best) {
     // A projection beyond either end of the master chain is no contact pair, except
     // within kChainEndExtension of the end segment's length: there the slave node is
     // paired with the chain's end (ξ clamped, the end segment's normal), i.e. with
@@ -237,168 +351,130 @@ void NodeToSegmentContact::search_pair(const Pair& pair, const Eigen::VectorXd& 
     // shared by both surfaces) put slave corner nodes exactly at a master end, where
     // round-off alone would otherwise switch the pair on and off between iterations.
     if (best.seg < 0 || (best.seg == 0 && best.raw < -kChainEndExtension) ||
-        (best.seg == nm - 2 && best.raw > 1.0 + kChainEndExtension))
+        (best.seg == m_nm - 2 && best.raw > 1.0 + kChainEndExtension))
       return;
-    p.segment[k] = best.seg;
-    p.xi[k] = best.xi;
-    lowest = std::min(lowest, best.seg);
-    highest = std::max(highest, best.seg);
-  };
+    m_p.segment[k] = best.seg;
+    m_p.xi[k] = best.xi;
+    m_lowest = std::min(m_lowest, best.seg);
+    m_highest = std::max(m_highest, best.seg);
+  }
 
-  // With a record of an earlier search: every row settled among its recorded
-  // segment and the neighbours, or the whole pair searched again below.
-  bool settled = memory && memory->recorded[static_cast<size_t>(pair_index)] && nseg > 0;
-  if (settled) {
-    const Eigen::Matrix2Xd& ref = memory->master_reference[static_cast<size_t>(pair_index)];
-    double b2 = 0.0;  // largest master-node movement since the record, squared
-    for (int j = 0; j < nm; ++j)
-      b2 = std::max(b2, (u_surface.segment<2>(2 * pair.master_surface[static_cast<size_t>(j)]) - ref.col(j)).squaredNorm());
-    const double b = std::sqrt(b2);
-    // Only the segments the recorded ones and their neighbours reach (the normals
-    // below use one more on each side).
-    int c_min = nseg, c_max = -1;
-    for (int r = 0; r < nrows; ++r) {
-      const int c = memory->centre[static_cast<size_t>(rows ? rows[r] : pair.row_begin + r)];
-      if (c >= 0) c_min = std::min(c_min, c), c_max = std::max(c_max, c);
+  /// Largest movement of a master node since the record.
+  double largest_master_move() const {
+    const Eigen::Matrix2Xd& ref = m_memory->master_reference[static_cast<size_t>(m_request.pair_index)];
+    double b2 = 0.0;
+    for (int j = 0; j < m_nm; ++j)
+      b2 = std::max(b2, (m_u.segment<2>(2 * m_pair.master_surface[static_cast<size_t>(j)]) - ref.col(j)).squaredNorm());
+    return std::sqrt(b2);
+  }
+
+  /// Row k settled among its recorded segment c and the neighbours: the slave node
+  /// moved by a and no master node by more than b since the record, so every other
+  /// segment is at least clearance − a − b away; paired when that exceeds the
+  /// distance found.
+  bool certify_row(int k, double b) {
+    const int c = m_memory->centre[static_cast<size_t>(k)];
+    if (c < 0) return false;
+    const Eigen::Vector2d x = slave_position(k);
+    Best best;
+    try_segment(x.x(), x.y(), c, best);
+    if (c > 0) try_segment(x.x(), x.y(), c - 1, best);
+    if (c + 1 < m_nseg) try_segment(x.x(), x.y(), c + 1, best);
+    best.root = std::sqrt(best.dist2);
+    const double a = (m_u.segment<2>(2 * k) - m_memory->slave_reference.col(k)).norm();
+    if (!(m_memory->clearance[static_cast<size_t>(k)] - a - b > best.root * (1.0 + 1e-12))) return false;
+    pair_row(k, best);
+    return true;
+  }
+
+  /// Bounding circles (centre, radius) of blocks of m_block consecutive segments.
+  void bound_blocks() {
+    const int block = m_contact.m_block;
+    m_nblock = (m_nseg + block - 1) / block;
+    m_s.block_c.resize(2, m_nblock);
+    m_s.block_r.resize(m_nblock);
+    for (int b = 0; b < m_nblock; ++b) {
+      const int j0 = b * block, j1 = std::min(m_nseg, j0 + block);  // vertices j0..j1
+      m_s.block_c.col(b) = m_s.xm.middleCols(j0, j1 - j0 + 1).rowwise().mean();
+      double r2 = 0.0;
+      for (int j = j0; j <= j1; ++j) r2 = std::max(r2, (m_s.xm.col(j) - m_s.block_c.col(b)).squaredNorm());
+      m_s.block_r(b) = std::sqrt(r2);
     }
-    if (c_max >= 0) prepare(std::max(c_min - 2, 0), std::min(c_max + 3, nseg), false);
-    for (int r = 0; r < nrows && settled; ++r) {
-      const int k = rows ? rows[r] : pair.row_begin + r, c = memory->centre[static_cast<size_t>(k)];
-      if (c < 0) {
-        settled = false;
+  }
+
+  /// Closest segment to x: the guess and its neighbours first (a good first
+  /// distance prunes the rest), then every block whose circle may hold a closer
+  /// point (plus the margin when recording, so that skipped segments are known to
+  /// be at least that much farther), and within it every segment whose circle may.
+  Best closest_segment(const Eigen::Vector2d& x, int guess, Tried& tried) const {
+    const double px = x.x(), py = x.y();
+    const double margin = m_memory ? m_pair.margin : 0.0;
+    const int block = m_contact.m_block;
+    Best best;
+    const auto visit = [&](int j) {
+      const double d2 = try_segment(px, py, j, best);
+      if (best.seg == j) best.root = std::sqrt(d2);  // closer than before: the pruning's radius
+      if (m_memory) tried.insert(j, d2);
+    };
+    if (m_nseg > 0) {
+      visit(guess);
+      if (guess > 0) visit(guess - 1);
+      if (guess + 1 < m_nseg) visit(guess + 1);
+    }
+    for (int b = 0; b < m_nblock; ++b) {
+      const double bx = px - m_s.block_c(0, b), by = py - m_s.block_c(1, b), reach = best.root + margin + m_s.block_r(b);
+      if (bx * bx + by * by > reach * reach * (1.0 + 1e-12)) continue;
+      const int j1 = std::min(m_nseg, (b + 1) * block);
+      for (int j = b * block; j < j1; ++j) {
+        if (j >= guess - 1 && j <= guess + 1) continue;
+        const double mx = px - m_s.mid(0, j), my = py - m_s.mid(1, j), sreach = best.root + margin + m_s.half(j);
+        if (mx * mx + my * my > sreach * sreach * (1.0 + 1e-12)) continue;
+        visit(j);
+      }
+    }
+    return best;
+  }
+
+  /// Records row k: its segment and clearance. Skipped segments are farther than
+  /// best + margin (the pruning used a best that was at least the final one);
+  /// tried ones are known.
+  void record_row(int k, const Best& best, const Tried& tried) {
+    double clearance = best.root + m_pair.margin;
+    for (int t = 0; t < std::min(tried.count, Tried::kept); ++t)
+      if (std::abs(tried.seg[t] - best.seg) > 1) {
+        clearance = std::min(clearance, std::sqrt(tried.d2[t]));
         break;
       }
-      const Eigen::Vector2d x = slave_position(k);
-      Best best;
-      try_segment(x.x(), x.y(), c, best);
-      if (c > 0) try_segment(x.x(), x.y(), c - 1, best);
-      if (c + 1 < nseg) try_segment(x.x(), x.y(), c + 1, best);
-      best.root = std::sqrt(best.dist2);
-      const double a = (u_surface.segment<2>(2 * k) - memory->slave_reference.col(k)).norm();
-      settled = memory->clearance[static_cast<size_t>(k)] - a - b > best.root * (1.0 + 1e-12);
-
-      if (settled) pair_row(k, best);
-    }
-    if (settled) {
-      memory->certified += nrows;
-    } else {  // start again, in full
-      lowest = nseg, highest = -1;
-      for (int r = 0; r < nrows; ++r) p.segment[rows ? rows[r] : pair.row_begin + r] = -1;
-    }
+    m_memory->centre[static_cast<size_t>(k)] = best.seg;
+    m_memory->clearance[static_cast<size_t>(k)] = clearance;
+    m_memory->slave_reference.col(k) = m_u.segment<2>(2 * k);
   }
 
-  if (!settled) {
-    prepare(0, nseg, true);
-    // Bounding circles of blocks of m_block consecutive segments (centre, radius):
-    // a block is skipped when its circle is farther than the best distance found
-    // (plus the margin when recording, so that skipped segments are known to be
-    // at least that much farther).
-    const int nblock = (nseg + m_block - 1) / m_block;
-    Eigen::Matrix2Xd& block_c = scratch.block_c;
-    Eigen::VectorXd& block_r = scratch.block_r;
-    block_c.resize(2, nblock);
-    block_r.resize(nblock);
-    for (int b = 0; b < nblock; ++b) {
-      const int j0 = b * m_block, j1 = std::min(nseg, j0 + m_block);  // vertices j0..j1
-      block_c.col(b) = xm.middleCols(j0, j1 - j0 + 1).rowwise().mean();
-      double r2 = 0.0;
-      for (int j = j0; j <= j1; ++j) r2 = std::max(r2, (xm.col(j) - block_c.col(b)).squaredNorm());
-      block_r(b) = std::sqrt(r2);
-    }
-    const double margin = memory ? pair.margin : 0.0;
-    if (memory)  // rows of the pair left out of this search lose their record
-      std::fill(memory->centre.begin() + pair.row_begin, memory->centre.begin() + pair.row_end, -1);
-    // The four nearest segments tried, by squared distance (for the clearance: at
-    // least one of them is not the closest segment or one of its two neighbours).
-    constexpr int kept = 4;
-    int tried_seg[kept];
-    double tried_d2[kept];
+  /// Records the master nodes' displacements of the pair.
+  void record_pair() {
+    Eigen::Matrix2Xd& ref = m_memory->master_reference[static_cast<size_t>(m_request.pair_index)];
+    ref.resize(2, m_nm);
+    for (int j = 0; j < m_nm; ++j) ref.col(j) = m_u.segment<2>(2 * m_pair.master_surface[static_cast<size_t>(j)]);
+    m_memory->recorded[static_cast<size_t>(m_request.pair_index)] = 1;
+    m_memory->searched += m_request.num_rows;
+  }
 
-    // Exact closest segment per slave node. Squared distances only; the segment of
-    // the previous slave node is tried first (neighbouring slave nodes have
-    // neighbouring pairs), then every block whose circle may hold a closer point,
-    // then within it every segment whose circle (centre mid, radius half) may.
-    int guess = 0;
-    for (int r = 0; r < nrows; ++r) {
-      const int k = rows ? rows[r] : pair.row_begin + r;
-      const Eigen::Vector2d x = slave_position(k);
-      const double px = x.x(), py = x.y();
-      Best best;
-      int ntried = 0;
-      auto visit = [&](int j) {
-        double d2 = try_segment(px, py, j, best);
-        if (best.seg == j) best.root = std::sqrt(d2);  // closer than before: the pruning's radius
-        if (!memory) return;
-        for (int t = 0; t < std::min(ntried, kept); ++t)  // insertion into the sorted four
-          if (d2 < tried_d2[t]) std::swap(d2, tried_d2[t]), std::swap(j, tried_seg[t]);
-        if (ntried < kept) tried_seg[ntried] = j, tried_d2[ntried] = d2;
-        ++ntried;
-      };
-      if (hint && hint->segment.size() == p.segment.size() && hint->segment[k] >= 0) guess = hint->segment[k];
-      if (nseg > 0) {
-        // The guess and its neighbours first: a good first distance prunes the rest.
-        visit(guess);
-        if (guess > 0) visit(guess - 1);
-        if (guess + 1 < nseg) visit(guess + 1);
-      }
-      for (int b = 0; b < nblock; ++b) {
-        const double bx = px - block_c(0, b), by = py - block_c(1, b), reach = best.root + margin + block_r(b);
-        if (bx * bx + by * by > reach * reach * (1.0 + 1e-12)) continue;
-        const int j1 = std::min(nseg, (b + 1) * m_block);
-        for (int j = b * m_block; j < j1; ++j) {
-          if (j >= guess - 1 && j <= guess + 1) continue;
-          const double mx = px - mid(0, j), my = py - mid(1, j), sreach = best.root + margin + half(j);
-          if (mx * mx + my * my > sreach * sreach * (1.0 + 1e-12)) continue;
-          visit(j);
-        }
-      }
-      if (best.seg >= 0) guess = best.seg;
-      pair_row(k, best);
-      if (!memory) continue;
-      // Clearance: skipped segments are farther than best + margin (the pruning
-      // above used a best that was at least the final one); tried ones are known.
-      double clearance = best.root + margin;
-      for (int t = 0; t < std::min(ntried, kept); ++t)
-        if (std::abs(tried_seg[t] - best.seg) > 1) {
-          clearance = std::min(clearance, std::sqrt(tried_d2[t]));
-          break;
-        }
-      memory->centre[static_cast<size_t>(k)] = best.seg;
-      memory->clearance[static_cast<size_t>(k)] = clearance;
-      memory->slave_reference.col(k) = u_surface.segment<2>(2 * k);
-    }
-    if (memory) {
-      Eigen::Matrix2Xd& ref = memory->master_reference[static_cast<size_t>(pair_index)];
-      ref.resize(2, nm);
-      for (int j = 0; j < nm; ++j) ref.col(j) = u_surface.segment<2>(2 * pair.master_surface[static_cast<size_t>(j)]);
-      memory->recorded[static_cast<size_t>(pair_index)] = 1;
-      memory->searched += nrows;
-    }
-  }
-  if (highest < 0) return;
+  const NodeToSegmentContact& m_contact;
+  const Pair& m_pair;
+  const PairRequest& m_request;
+  SearchMemory* m_memory;  // the request's (nullptr: none)
+  const Eigen::VectorXd& m_u;
+  Pairing& m_p;
+  const int m_nm, m_nseg;
+  Scratch& m_s;
+  int m_nblock = 0;
+  int m_lowest, m_highest = -1;  // range of the segments paired
+};
 
-  // Nodal normals of the deformed master surface (average of the adjacent
-  // segments' outward normals) where rows are paired, nodes lowest … highest+1:
-  // interpolating them along a segment gives a normal field that is continuous
-  // across master nodes, so the constraint row does not jump when a slave node
-  // passes from one segment to the next.
-  Eigen::Matrix2Xd& node_normal = scratch.node_normal;
-  node_normal.resize(2, nm);
-  node_normal.middleCols(lowest, highest + 2 - lowest).setZero();
-  for (int j = std::max(lowest - 1, 0); j <= std::min(highest + 1, nseg - 1); ++j) {
-    const Eigen::Vector2d t = seg_t.col(j);
-    // Chains run with their body on the left: (t_y, −t_x) points out of the master body.
-    const Eigen::Vector2d n = (1.0 / t.norm()) * Eigen::Vector2d(t.y(), -t.x());
-    if (j >= lowest) node_normal.col(j) += n;
-    if (j + 1 <= highest + 1) node_normal.col(j + 1) += n;
-  }
-  for (int j = lowest; j <= highest + 1; ++j) node_normal.col(j).normalize();
-  for (int r = 0; r < nrows; ++r) {
-    const int k = rows ? rows[r] : pair.row_begin + r, j = p.segment[k];
-    if (j < 0) continue;
-    const double xi = p.xi[k];
-    p.normal.col(k) = ((1.0 - xi) * node_normal.col(j) + xi * node_normal.col(j + 1)).normalized();
-  }
+void NodeToSegmentContact::search_pair(const PairRequest& request, const Eigen::VectorXd& u_surface, Pairing& p) const {
+  PairSearch search(*this, request, u_surface, p);
+  if (!search.certify_from_memory()) search.pruned_search();
+  search.nodal_normals();
 }
 
 void NodeToSegmentContact::assemble(const Pairing& p, ConstraintMatrix& c, Eigen::VectorXd& g) const {

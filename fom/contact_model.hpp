@@ -211,9 +211,20 @@ class NodeToSegmentContact final : public ContactModel {
     Eigen::Matrix2Xd master_x;          // reference coordinates
     double margin = 0.0;                // pruning margin of a recorded search: half the mean segment length
   };
-  /// Search of one pair's rows (all of them when rows is nullptr).
-  void search_pair(const Pair& pair, const Eigen::VectorXd& u_surface, const int* rows, int nrows,
-                   const Pairing* hint, Pairing& p, SearchMemory* memory, int pair_index) const;
+  /// \brief What one pair's search is asked.
+  struct PairRequest {
+    int pair_index = 0;
+    /// The rows to search: `listed_rows[0 … num_rows)` (ascending, all of this pair),
+    /// or, when `listed_rows` is nullptr, every row of the pair.
+    const int* listed_rows = nullptr;
+    int num_rows = 0;
+    const Pairing* hint = nullptr;   ///< pairing whose segments are tried first (none: nullptr)
+    SearchMemory* memory = nullptr;  ///< memory to certify from and record into (none: nullptr)
+  };
+  /// One pair's search (contact_model.cpp): the certificate of the memory, else the
+  /// pruned search, then the nodal normals.
+  class PairSearch;
+  void search_pair(const PairRequest& request, const Eigen::VectorXd& u_surface, Pairing& p) const;
   /// Both search_rows: every pair's run of the listed rows.
   void search_all(const Eigen::VectorXd& u_surface, const std::vector<int>* rows, const Pairing* hint,
                   SearchMemory* memory, Pairing& p) const;

@@ -24,6 +24,12 @@ std::string format_bound(double v) {
   return buf;
 }
 
+std::string integer_range_text(long long lower, long long upper) {
+  return "an integer in [" + std::to_string(lower) + ", " + std::to_string(upper) + "]";
+}
+
+}  // namespace
+
 std::string trim_blanks(const std::string& text) {
   const char* blanks = " \t\r\n";
   const size_t begin = text.find_first_not_of(blanks);
@@ -31,12 +37,6 @@ std::string trim_blanks(const std::string& text) {
   const size_t end = text.find_last_not_of(blanks);
   return text.substr(begin, end - begin + 1);
 }
-
-std::string integer_range_text(long long lower, long long upper) {
-  return "an integer in [" + std::to_string(lower) + ", " + std::to_string(upper) + "]";
-}
-
-}  // namespace
 
 bool Interval::contains(double value) const {
   const bool above = lower_open ? value > lower : value >= lower;
@@ -118,34 +118,7 @@ std::vector<std::string> split_list(const std::string& text, const std::string& 
 }
 
 fom::Param parse_problem_param(const fom::Problem& problem, const std::string& text) {
-  const std::string expected = "; expected " + problem.range_text();
-  std::vector<std::string> items;
-  try {
-    items = split_list(text, "--param");
-  } catch (const InputError& e) {
-    throw InputError(std::string(e.what()) + " (" + problem.range_text() + ")");
-  }
-  if (static_cast<int>(items.size()) != problem.num_params())
-    throw InputError("problem " + quoted(problem.name(), 200) + " takes " + std::to_string(problem.num_params()) +
-                     " parameter value(s), but --param " + quoted(text) + " has " + std::to_string(items.size()) +
-                     expected);
-  fom::Param mu(problem.num_params());
-  for (int i = 0; i < problem.num_params(); ++i) {
-    const std::string what = "parameter " + problem.param_names()[i] + " =";
-    double value = 0.0;
-    try {
-      value = parse_number(items[i], what);
-    } catch (const InputError& e) {
-      throw InputError(std::string(e.what()) + expected);
-    }
-    const Interval range{problem.param_lower()(i), problem.param_upper()(i), problem.parameters().lower_open[i] != 0, false};
-    if (!range.contains(value))
-      throw InputError(what + " " + quoted(trim_blanks(items[i])) + " is outside the range of " + quoted(problem.name(), 200) + "" +
-                       expected);
-    mu(i) = value;
-  }
-  problem.check_param(mu);
-  return mu;
+  return problem.parameters().parse(text, problem.name());
 }
 
 }  // namespace contactrom

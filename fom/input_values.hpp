@@ -56,9 +56,13 @@ long long parse_integer(const std::string& text, const std::string& what, long l
 /// ("0.1," or ",0.1" or "0.1,,0.2"), naming `what` and quoting `text`.
 std::vector<std::string> split_list(const std::string& text, const std::string& what);
 
+/// \brief `text` without its leading and trailing blanks (space, tab, CR, LF).
+std::string trim_blanks(const std::string& text);
+
 /// \brief Parses "V" or "V1,V2,..." into a parameter of `problem`: the number of
 /// values and each value's range are checked, and a value outside its range is
-/// quoted exactly as written.
+/// quoted exactly as written. The same parser as fom::parse_param
+/// (fom::ParameterSpace::parse).
 fom::Param parse_problem_param(const fom::Problem& problem, const std::string& text);
 
 }  // namespace contactrom

@@ -7,6 +7,7 @@
 
 #include "core/format.hpp"
 #include "core/errors.hpp"
+#include "fom/input_values.hpp"
 
 namespace contactrom::fom {
 
@@ -62,27 +63,31 @@ std::string ParameterSpace::range_text() const {
 }
 
 Param ParameterSpace::parse(const std::string& text, const std::string& problem_name) const {
-  std::vector<double> values;
-  size_t start = 0;
-  for (;;) {
-    const size_t end = text.find(',', start);
-    const std::string item = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
-    const char* begin = item.c_str();
-    char* stop = nullptr;
-    const double v = std::strtod(begin, &stop);
-    const char* rest = stop;
-    while (*rest && std::isspace(static_cast<unsigned char>(*rest))) ++rest;
-    bool blank = true;
-    for (char ch : item) blank = blank && std::isspace(static_cast<unsigned char>(ch));
-    if (blank || stop == begin || *rest || !std::isfinite(v))
-      throw InputError("parameter value " + quoted(item, 200) + " in " + quoted(text, 200) + " is not a finite number; expected " +
-                       range_text());
-    values.push_back(v);
-    if (end == std::string::npos) break;
-    start = end + 1;
+  const std::string expected = "; expected " + range_text();
+  std::vector<std::string> items;
+  try {
+    items = split_list(text, "--param");
+  } catch (const InputError& e) {
+    throw InputError(std::string(e.what()) + " (" + range_text() + ")");
   }
-  Param mu = Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
-  check(mu, problem_name);
+  if (static_cast<int>(items.size()) != size())
+    throw InputError("problem " + quoted(problem_name, 200) + " takes " + std::to_string(size()) +
+                     " parameter value(s), but --param " + quoted(text) + " has " + std::to_string(items.size()) +
+                     expected);
+  Param mu(size());
+  for (int i = 0; i < size(); ++i) {
+    const std::string what = "parameter " + names[i] + " =";
+    try {
+      mu(i) = parse_number(items[i], what);
+    } catch (const InputError& e) {
+      throw InputError(std::string(e.what()) + expected);
+    }
+    const Interval range{lower(i), upper(i), lower_open[i] != 0, false};
+    // A value outside its range is quoted exactly as written.
+    if (!range.contains(mu(i)))
+      throw InputError(what + " " + quoted(trim_blanks(items[i])) + " is outside the range of " + quoted(problem_name, 200) +
+                       expected);
+  }
   return mu;
 }
 

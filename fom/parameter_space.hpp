@@ -31,8 +31,11 @@ struct ParameterSpace {
   void check(const Param& mu, const std::string& problem_name) const;
   /// Human-readable ranges, e.g. "d in (0, 0.3]" or "d_x in [0, 4], d_y in [0.1, 0.3]".
   std::string range_text() const;
-  /// \brief Parses "V" or "V1,V2,..." (one value per parameter, in order) and checks the range.
-  /// \throws InputError for an empty item, a non-number, a wrong count or a value out of range.
+  /// \brief Parses "V" or "V1,V2,..." (one value per parameter, in order) and checks the range:
+  /// the one parser of parameter text (fom::parse_param, parse_problem_param).
+  /// \throws InputError for an empty item, a non-number (trailing characters, NaN,
+  ///   infinite, overflowing or underflowing to 0), a wrong count, or a value out of
+  ///   range (quoted exactly as written).
   Param parse(const std::string& text, const std::string& problem_name) const;
 };
 

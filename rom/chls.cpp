@@ -1,5 +1,7 @@
 #include "rom/chls.hpp"
 
+#include "core/lawson_hanson.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -35,6 +37,51 @@ VectorXd affine_least_squares(const MatrixXd& a, const VectorXd& b, const std::v
   z(k - 1) = 1.0 - y.sum();
   return z;
 }
+
+/// Least squares on the simplex as a Lawson–Hanson problem: the passive set keeps
+/// 1ᵀα = 1 (eliminated in affine_least_squares), so the descent of a bound column
+/// is measured against the common value of w = Aᵀ(b − Aα) on the passive set (its
+/// multiplier).
+class SimplexProblem final : public LawsonHansonProblem {
+ public:
+  SimplexProblem(const MatrixXd& a, const VectorXd& b, Index start, double tolerance)
+      : m_a(a), m_b(b), m_passive{start},
+        m_tolerance_scale(tolerance * a.colwise().norm().maxCoeff()), m_b_norm(b.norm()) {}
+
+  const std::vector<Index>& passive() const override { return m_passive; }
+
+  /// w_j − w_P with w = Aᵀ(b − Aα) and w_P its mean on the passive set; the threshold
+  /// is tolerance · max_i‖a_i‖ · max(‖b‖, ‖Aα‖).
+  double descent(const VectorXd& alpha, VectorXd& w) override {
+    m_ax.noalias() = m_a * alpha;
+    w.noalias() = m_a.transpose() * (m_b - m_ax);
+    double w_passive = 0.0;
+    for (const Index p : m_passive) w_passive += w(p);
+    w_passive /= static_cast<double>(m_passive.size());
+    w.array() -= w_passive;
+    return m_tolerance_scale * std::max(m_b_norm, m_ax.norm());
+  }
+
+  bool free(Index j) override {
+    m_passive.push_back(j);
+    return true;
+  }
+  void bind(Index position) override { m_passive.erase(m_passive.begin() + position); }
+
+  bool solve_passive(VectorXd& z) override {
+    if (m_passive.empty()) return false;  // cannot happen in exact arithmetic (α sums to 1)
+    z = affine_least_squares(m_a, m_b, m_passive);
+    return z.allFinite();
+  }
+
+ private:
+  const MatrixXd& m_a;
+  const VectorXd& m_b;
+  std::vector<Index> m_passive;
+  const double m_tolerance_scale;
+  const double m_b_norm;
+  VectorXd m_ax;
+};
 
 }  // namespace
 
@@ -75,11 +122,6 @@ VectorXd SimplexLeastSquares::solve(const VectorXd& b_in) {
     b = &reduced_b;
   }
 
-  const VectorXd col_norms = a->colwise().norm();
-  const double max_col_norm = col_norms.maxCoeff();
-  const double b_norm = b->norm();
-  const int cap = m_options.max_iterations > 0 ? m_options.max_iterations : static_cast<int>(3 * n + 10);
-
   // Start at the nearest vertex of the simplex.
   Index j0 = 0;
   double best = std::numeric_limits<double>::infinity();
@@ -89,90 +131,15 @@ VectorXd SimplexLeastSquares::solve(const VectorXd& b_in) {
   }
   VectorXd alpha = VectorXd::Zero(n);
   alpha(j0) = 1.0;
-  std::vector<Index> passive{j0};
-  std::vector<char> in_passive(static_cast<std::size_t>(n), 0), excluded(static_cast<std::size_t>(n), 0);
-  in_passive[static_cast<std::size_t>(j0)] = 1;
 
-  m_info = Status::Success;
-  VectorXd w, ax, z;
-  while (true) {
-    ax.noalias() = *a * alpha;
-    w.noalias() = a->transpose() * (*b - ax);
-    double w_passive = 0.0;
-    for (Index p : passive) w_passive += w(p);
-    w_passive /= static_cast<double>(passive.size());
-    const double threshold = m_options.tolerance * max_col_norm * std::max(b_norm, ax.norm());
-
-    Index enter = -1;
-    double gain = threshold;
-    for (Index j = 0; j < n; ++j) {
-      const auto js = static_cast<std::size_t>(j);
-      if (!in_passive[js] && !excluded[js] && w(j) - w_passive > gain) gain = w(j) - w_passive, enter = j;
-    }
-    if (enter < 0) break;  // KKT: no bound column lowers the objective
-    if (m_iterations >= cap) {
-      m_info = Status::NoConvergence;
-      break;
-    }
-    ++m_iterations;
-    passive.push_back(enter);
-    in_passive[static_cast<std::size_t>(enter)] = 1;
-
-    bool first = true;
-    while (true) {
-      z = affine_least_squares(*a, *b, passive);
-      if (!z.allFinite()) {
-        m_info = Status::NumericalIssue;
-        break;
-      }
-      if ((z.array() > 0.0).all()) {
-        alpha.setZero();
-        for (std::size_t i = 0; i < passive.size(); ++i) alpha(passive[i]) = z(static_cast<Index>(i));
-        std::fill(excluded.begin(), excluded.end(), 0);
-        break;
-      }
-      if (first && z(z.size() - 1) <= 0.0) {
-        // The entering column does not come out positive: only rounding can do this
-        // (e.g. an affinely dependent column); do not try it again from this iterate.
-        passive.pop_back();
-        in_passive[static_cast<std::size_t>(enter)] = 0;
-        excluded[static_cast<std::size_t>(enter)] = 1;
-        break;
-      }
-      first = false;
-      // Step from α towards z as far as α ≥ 0 allows; the blocking coefficients leave P.
-      double t = 1.0;
-      Index blocking = -1;
-      for (std::size_t i = 0; i < passive.size(); ++i) {
-        const double zi = z(static_cast<Index>(i)), ai = alpha(passive[i]);
-        if (zi <= 0.0 && ai / (ai - zi) < t) t = ai / (ai - zi), blocking = passive[i];
-      }
-      for (std::size_t i = 0; i < passive.size(); ++i)
-        alpha(passive[i]) += t * (z(static_cast<Index>(i)) - alpha(passive[i]));
-      std::vector<Index> kept;
-      for (Index p : passive) {
-        // The blocking coefficient, and any left at rounding level (α is on the
-        // simplex, so 1e-15 is relative), are bound.
-        if (p == blocking || alpha(p) <= 1e-15) {
-          alpha(p) = 0.0;
-          in_passive[static_cast<std::size_t>(p)] = 0;
-          ++m_iterations;
-        } else {
-          kept.push_back(p);
-        }
-      }
-      if (kept.empty()) {  // cannot happen in exact arithmetic (α keeps summing to 1)
-        m_info = Status::NumericalIssue;
-        break;
-      }
-      passive.swap(kept);
-      if (m_iterations >= cap) {
-        m_info = Status::NoConvergence;
-        break;
-      }
-    }
-    if (m_info != Status::Success) break;
-  }
+  SimplexProblem problem(*a, *b, j0, m_options.tolerance);
+  LawsonHansonOptions loop;
+  loop.max_iterations = m_options.max_iterations > 0 ? m_options.max_iterations : static_cast<int>(3 * n + 10);
+  // α lies on the simplex, so a coefficient at rounding level is relative to its sum.
+  loop.bind_tolerance = 1e-15;
+  const LawsonHansonResult result = lawson_hanson(problem, alpha, loop);
+  m_info = result.status;
+  m_iterations = result.iterations;
 
   // Renormalise the (already exact up to rounding) sum after the ratio steps, which
   // accumulate rounding in α; then report the residual.

@@ -253,9 +253,11 @@ void check_convex_hull_applicable(const fom::Problem& problem) {
                    "pairing changes little over the parameter range)");
 }
 
-MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const ConvexHullOptions& options)
-    : m_model(model), m_options(options) {
-  const auto t0 = std::chrono::steady_clock::now();
+namespace {
+
+/// Refuses a reduced model or options the monolithic dictionary cannot be built
+/// from; returns the energy tolerance δ of the SVD basis.
+double checked_basis_delta(const ReducedModel& model, const ConvexHullOptions& options) {
   // A convex combination of training solutions pairs each primal snapshot with its
   // whole pressure: a dictionary split by contact pair has no such columns.
   for (int p = 0; p < model.dictionary_size(); ++p)
@@ -263,7 +265,6 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
       throw InputError("convex-hull needs one dictionary column per snapshot; the reduced model of '" +
                        model.problem().name() + "' splits its " + std::to_string(model.problem().contact().num_pairs()) +
                        " contact pairs (build it with ReducedModelOptions::split_pairs = false)");
-  const fom::Problem& problem = model.problem();
   const double delta = options.basis_delta < 0.0 ? model.delta() : options.basis_delta;
   if (!(delta >= 0.0) || !std::isfinite(delta))
     throw InputError("convex-hull basis tolerance " + std::to_string(delta) + " invalid; expected >= 0");
@@ -277,42 +278,49 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
   if (options.max_pairing_iterations < 1)
     throw InputError("convex-hull pairing iteration cap " + std::to_string(options.max_pairing_iterations) +
                      " invalid; expected >= 1");
-
-  // The monolithic dictionary holds the training solutions as the database stores
-  // them, d_p = u_j − u_lift(μ_j) (Dirichlet lifting, so that u = u_lift(μ) + D_p α
-  // is a convex combination of the snapshots up to the Dirichlet data): the reduced
-  // model measures its snapshots from its own offset u_off, which is undone here.
   if (!model.has_primal_snapshots())
     throw InputError("convex-hull combines the primal training snapshots, which this reduced model of '" +
-                     problem.name() + "' does not keep (build it with keep_primal_snapshots = true)");
-  MatrixXd dp = model.primal_snapshots();
-  const MatrixXd& dd = model.dictionary();
-  const Index m = dp.cols();
-  const int nt = problem.num_load_terms();
-  const std::vector<VectorXd>& offset = model.offset_terms();
-  const std::vector<VectorXd>& lifting = problem.lifting_terms();
-  std::vector<VectorXd> offset_minus_lift;
-  for (int k = 0; k < nt; ++k) offset_minus_lift.push_back(offset[static_cast<std::size_t>(k)] - lifting[static_cast<std::size_t>(k)]);
-  for (Index c = 0; c < m; ++c) {
-    const VectorXd phi = problem.load_coefficients(model.dictionary_parameters()[static_cast<std::size_t>(c)]);
-    for (int k = 0; k < nt; ++k) dp.col(c) += phi(k) * offset_minus_lift[static_cast<std::size_t>(k)];
-  }
-  m_num_dofs = static_cast<int>(dp.rows());
-  m_mono.resize(dp.rows() + dd.rows(), m);
-  m_mono << dp, dd;
-  m_dd = dd;  // contiguous copy for the online contact block
+                     model.problem().name() + "' does not keep (build it with keep_primal_snapshots = true)");
+  return delta;
+}
 
-  // Projection basis B of the residual test space.
+/// Per load term k: u_off,k − u_lift,k, the reduced model's offset less the Dirichlet lifting.
+std::vector<VectorXd> offset_minus_lifting(const ReducedModel& model) {
+  const fom::Problem& problem = model.problem();
+  std::vector<VectorXd> out;
+  for (int k = 0; k < problem.num_load_terms(); ++k)
+    out.push_back(model.offset_terms()[static_cast<std::size_t>(k)] - problem.lifting_terms()[static_cast<std::size_t>(k)]);
+  return out;
+}
+
+/// The training solutions as the database stores them, d_p = u_j − u_lift(μ_j)
+/// (Dirichlet lifting, so that u = u_lift(μ) + D_p α is a convex combination of the
+/// snapshots up to the Dirichlet data): the reduced model measures its snapshots
+/// from its own offset u_off, which is undone here.
+MatrixXd lifted_snapshots(const ReducedModel& model, const std::vector<VectorXd>& offset_minus_lift) {
+  MatrixXd dp = model.primal_snapshots();
+  for (Index c = 0; c < dp.cols(); ++c) {
+    const VectorXd phi = model.problem().load_coefficients(model.dictionary_parameters()[static_cast<std::size_t>(c)]);
+    for (std::size_t k = 0; k < offset_minus_lift.size(); ++k) dp.col(c) += phi(static_cast<Index>(k)) * offset_minus_lift[k];
+  }
+  return dp;
+}
+
+/// Projection basis B of the residual test space: the SVD basis of D_p at δ, or
+/// orth(D_p R) for a random R of L columns; zero on the Dirichlet rows.
+MatrixXd make_projection_basis(const MatrixXd& dp, const fom::Problem& problem, const ConvexHullOptions& options,
+                               double delta) {
   Pod svd(PodOptions{delta, 0});
   svd.compute(dp);
   if (svd.info() != Status::Success)
     throw InputError("SVD of the primal dictionary of " + quoted(problem.name(), 200) + " failed (" + to_string(svd.info()) + ")");
+  MatrixXd b;
   if (options.basis == ProjectionBasis::Svd) {
-    m_b = svd.basis();
+    b = svd.basis();
   } else {
     const int l = options.rank_l > 0 ? options.rank_l : svd.rank();
     std::mt19937_64 gen(options.seed);
-    MatrixXd r(m, l);
+    MatrixXd r(dp.cols(), l);
     for (Index j = 0; j < r.cols(); ++j)  // column by column: R's columns do not depend on L
       for (Index i = 0; i < r.rows(); ++i) r(i, j) = uniform01(gen);
     // orth(D_p R): left singular vectors above the numerical rank (Pod with δ = 0).
@@ -320,28 +328,55 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
     orth.compute(dp * r);
     if (orth.info() != Status::Success)
       throw InputError("orthogonalisation of the randomised primal dictionary failed (" + std::string(to_string(orth.info())) + ")");
-    m_b = orth.basis();
+    b = orth.basis();
   }
-  if (m_b.cols() == 0)
+  if (b.cols() == 0)
     throw InputError(dp.norm() > 0.0 && options.basis == ProjectionBasis::Svd
                          ? "the SVD of the primal dictionary of " + quoted(problem.name(), 200) + " keeps no mode at delta " +
                                format_number(delta) + ": no projection basis; expected a delta below 1"
                          : "the primal dictionary of " + quoted(problem.name(), 200) + " is zero: no projection basis");
   const std::vector<char>& dirichlet = problem.is_dirichlet();
-  for (Index i = 0; i < m_b.rows(); ++i)
-    if (dirichlet[static_cast<std::size_t>(i)]) m_b.row(i).setZero();
+  for (Index i = 0; i < b.rows(); ++i)
+    if (dirichlet[static_cast<std::size_t>(i)]) b.row(i).setZero();
+  return b;
+}
 
+/// The rows `rows` of m.
+MatrixXd rows_of(const MatrixXd& m, const std::vector<int>& rows) {
+  MatrixXd out(static_cast<Index>(rows.size()), m.cols());
+  for (std::size_t a = 0; a < rows.size(); ++a) out.row(static_cast<Index>(a)) = m.row(rows[a]);
+  return out;
+}
+
+/// The columns `columns` as one matrix.
+MatrixXd as_matrix(const std::vector<VectorXd>& columns, Index rows) {
+  MatrixXd out(rows, static_cast<Index>(columns.size()));
+  for (std::size_t k = 0; k < columns.size(); ++k) out.col(static_cast<Index>(k)) = columns[k];
+  return out;
+}
+
+}  // namespace
+
+MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const ConvexHullOptions& options)
+    : m_model(model), m_options(options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const fom::Problem& problem = model.problem();
+  const double delta = checked_basis_delta(model, options);
+  const std::vector<VectorXd> offset_minus_lift = offset_minus_lifting(model);
+  const MatrixXd dp = lifted_snapshots(model, offset_minus_lift);
+  const MatrixXd& dd = model.dictionary();
+  const int nt = problem.num_load_terms();
+  m_num_dofs = static_cast<int>(dp.rows());
+  m_mono.resize(dp.rows() + dd.rows(), dp.cols());
+  m_mono << dp, dd;
+  m_dd = dd;  // contiguous copy for the online contact block
+  m_b = make_projection_basis(dp, problem, options, delta);
+
+  // Their surface rows, for the contact block.
   const std::vector<int>& surf = problem.contact().surface_dofs();
-  const auto ns = static_cast<Index>(surf.size());
-  m_b_s.resize(ns, m_b.cols());
-  m_dp_s.resize(ns, m);
-  m_lift_s.resize(ns, nt);
-  for (Index a = 0; a < ns; ++a) {
-    const auto dof = surf[static_cast<std::size_t>(a)];
-    m_b_s.row(a) = m_b.row(dof);
-    m_dp_s.row(a) = dp.row(dof);
-    for (int k = 0; k < nt; ++k) m_lift_s(a, k) = lifting[static_cast<std::size_t>(k)](dof);
-  }
+  m_b_s = rows_of(m_b, surf);
+  m_dp_s = rows_of(dp, surf);
+  m_lift_s = rows_of(as_matrix(problem.lifting_terms(), dp.rows()), surf);
 
   // Parameter-independent pieces of Bᵀ r(α) (K_q symmetric, so Bᵀ K_q = (K_q B)ᵀ).
   m_bf.resize(m_b.cols(), nt);
@@ -362,7 +397,7 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
   if (!contact.has_pairing()) {  // C and g do not depend on u: the contact block is constant
     fom::ConstraintMatrix c;
     VectorXd g;
-    contact.assemble(contact.search(VectorXd::Zero(ns)), c, g);
+    contact.assemble(contact.search(VectorXd::Zero(static_cast<Index>(surf.size()))), c, g);
     m_bc_const = projected_contact(c);
     m_has_constant_contact = true;
   }
@@ -401,22 +436,29 @@ ConvexHullSolver::ConvexHullSolver(const ReducedModel& model, const Options& opt
     : m_dictionary((check_convex_hull_applicable(model.problem()), model), options) {}
 
 ConvexHullResult ConvexHullSolver::solve_detailed(const fom::Param& mu) const {
-  ConvexHullResult res = run(mu);
-  check_contact(model(), contact_tolerances(), res.online);
+  ConvexHullResult res;
+  res.online = run_query(mu, [&](OnlineResult& on) { solve_hull(mu, res, on); });
   return res;
 }
 
-ConvexHullResult ConvexHullSolver::run(const fom::Param& mu) const {
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
+void ConvexHullSolver::solve_reduced(const fom::Param& mu, OnlineResult& res) const {
+  ConvexHullResult details;
+  solve_hull(mu, details, res);
+}
+
+Eigen::VectorXd ConvexHullSolver::reconstruct_primal(const OnlineResult& res) const {
+  // u = u_off(μ) + D_p α over the support (mesh-size work, for output only).
+  VectorXd u = model().problem().lifting(res.mu);
+  for (std::size_t i = 0; i < res.selected.size(); ++i)
+    u.noalias() += res.coefficients(static_cast<Index>(i)) * m_dictionary.primal().col(res.selected[i]);
+  return u;
+}
+
+void ConvexHullSolver::solve_hull(const fom::Param& mu, ConvexHullResult& res, OnlineResult& on) const {
   const MonolithicDictionary& dict = m_dictionary;
   const ConvexHullOptions& opt = dict.options();
   const ReducedModel& model = dict.model();
   const fom::ContactModel& contact = model.problem().contact();
-
-  ConvexHullResult res;
-  OnlineResult& on = res.online;
-  on.mu = mu;
 
   // The pairing fixed point around the exact projected solve at each pairing.
   PairedHullSolve solve_at(dict, mu);
@@ -470,14 +512,6 @@ ConvexHullResult ConvexHullSolver::run(const fom::Param& mu) const {
   } else if (status != Status::Success) {
     on.message = std::string("convex-hull solve failed (") + to_string(status) + ")";
   }
-  const auto t1 = clock::now();
-  on.time_s = std::chrono::duration<double>(t1 - t0).count();
-
-  // Full field u = u_lift(μ) + D_p α (mesh-size work, for output only).
-  on.u = model.problem().lifting(mu);
-  for (Index j : support) on.u.noalias() += res.alpha(j) * dict.primal().col(j);
-  on.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
-  return res;
 }
 
 const OptionTable<ConvexHullOptions>& convex_hull_option_table() {

@@ -241,8 +241,10 @@ class ConvexHullSolver final : public OnlineSolver {
   const Options& options() const { return m_dictionary.options(); }
 
  private:
-  OnlineResult solve_reduced(const fom::Param& mu) const override { return run(mu).online; }
-  ConvexHullResult run(const fom::Param& mu) const;  // solve_detailed() before the contact check
+  void solve_reduced(const fom::Param& mu, OnlineResult& res) const override;
+  Eigen::VectorXd reconstruct_primal(const OnlineResult& res) const override;
+  /// The step of solve_detailed(): the answer `on` and the statistics `res`.
+  void solve_hull(const fom::Param& mu, ConvexHullResult& res, OnlineResult& on) const;
   MonolithicDictionary m_dictionary;
 };
 

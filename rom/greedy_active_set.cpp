@@ -45,36 +45,12 @@ bool revisits(SelectionHistory& seen, const std::vector<int>& before, const std:
 
 }  // namespace
 
-void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Param& mu,
-                      const Eigen::VectorXd& u_free, std::vector<int>& columns, Eigen::VectorXd& u_hat,
-                      int* nearest) {
-  columns.clear();
-  if (nearest) *nearest = -1;
-  if (init == WarmStart::Empty || model.dictionary_size() == 0) {
-    u_hat = u_free;
-    return;
-  }
-  std::vector<ReducedModel::StencilPoint> stencil = model.interpolation_stencil(mu);
-  const int heaviest = ReducedModel::nearest_column(stencil);
-  if (nearest) *nearest = heaviest;
-  if (init == WarmStart::Nearest) stencil = {{heaviest, 1.0}};
-  // (A quadratic stencil for û, tried on hertz 30, needed more pairing updates on
-  // average: the solutions are not smooth in μ where nodes enter contact.)
-  if (init != WarmStart::Primal)
-    for (const auto& s : stencil)
-      for (int c : model.sibling_columns(s.column)) columns.push_back(c);
-  const Eigen::MatrixXd& coords = model.snapshot_coordinates();
-  u_hat.setZero(model.primal_rank());
-  for (const auto& s : stencil) u_hat.noalias() += s.weight * coords.col(s.column);
-}
-
 const OptionTable<GreedyOptions>& greedy_option_table() {
   static const OptionTable<GreedyOptions> t = [] {
     OptionTable<GreedyOptions> o;
     o.include(active_set_settings_table())
         .choice("init", &GreedyOptions::init, "starting point: empty (paper Alg. 1), cell, nearest or primal",
-                {{"empty", WarmStart::Empty}, {"cell", WarmStart::Cell}, {"nearest", WarmStart::Nearest},
-                 {"primal", WarmStart::Primal}})
+                warm_start_words({WarmStart::Empty, WarmStart::Cell, WarmStart::Nearest, WarmStart::Primal}))
         .choice(
             "schedule", &GreedyOptions::schedule,
             "fixed-point (exact reduced solves, Anderson on the rebuild point), interleaved (one change per "
@@ -127,9 +103,9 @@ GreedyActiveSet::GreedyActiveSet(const ReducedModel& model, const Options& optio
       m_support(model.dictionary()) {}
 
 /// Per-query quantities shared by both schedules.
-struct GreedyActiveSet::Query {
+struct GreedyActiveSet::Query : ActiveSetStart {
   Query(const GreedyActiveSet& solver, const fom::Param& mu)
-      : solver(solver), k_inv(solver.m_model, mu), operators(solver.m_options.time_operators), ops(thread_operators()) {
+      : ActiveSetStart(solver.m_model, mu), solver(solver), operators(solver.m_options.time_operators), ops(thread_operators()) {
     ops.reset(solver.m_options.rebuild == OperatorRebuild::Partial);
     if (solver.m_options.best_iterate_on_failure) {  // sized here, so that offer() does not allocate
       const int m = solver.m_model.dictionary_size();
@@ -145,13 +121,7 @@ struct GreedyActiveSet::Query {
     return ops;
   }
   const GreedyActiveSet& solver;
-  ReducedStiffnessInverse k_inv;  // K̂(μ)⁻¹
   OperatorClock operators;  // time spent building the contact operators (optional)
-  Eigen::VectorXd lift_s;  // surface lifting u_off,s(μ)
-  Eigen::VectorXd u_free;  // unconstrained reduced solution K̂⁻¹ f̂
-  Eigen::VectorXd u_start;  // starting û (GreedyOptions::init)
-  std::vector<int> start_columns;  // starting selection
-  int nearest = -1;  // training snapshot nearest to the start (−1: none)
   SupportOperators& ops;  // pairing, C_R and g_R at the last rebuild point, and the search memory
   // Outcome, filled by the schedule: final û, the selection and its multipliers.
   Eigen::VectorXd u_hat, lambda_i;
@@ -228,31 +198,10 @@ void numerical_issue(OnlineResult& res) {
 
 }  // namespace
 
-OnlineResult GreedyActiveSet::solve_reduced(const fom::Param& mu) const {
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
-  const int r = m_model.primal_rank(), nc = static_cast<int>(m_model.dictionary().rows());
-
-  OnlineResult res;
-  res.mu = mu;
-
-  // K̂(μ)⁻¹ through the offline factor when K̂(μ) = θ₀(μ) K̂₀, else a per-query
-  // factorisation of the r × r matrix.
+void GreedyActiveSet::solve_reduced(const fom::Param& mu, OnlineResult& res) const {
   Query q(*this, mu);
-  if (!q.k_inv.ok()) {
-    res.status = Status::NumericalIssue;
-    res.message = "Cholesky factorisation of the reduced stiffness failed";
-    res.u_hat = Eigen::VectorXd::Zero(r);
-    res.lambda = Eigen::VectorXd::Zero(nc);
-    res.u = m_model.reconstruct_primal(res.u_hat, mu);
-    res.time_s = std::chrono::duration<double>(clock::now() - t0).count();
-    return res;
-  }
-  q.lift_s = m_model.surface_lifting(mu);
-  q.k_inv.apply(m_model.reduced_rhs(mu), q.u_free);
-  warm_start_point(m_model, m_options.init, mu, q.u_free, q.start_columns, q.u_start, &q.nearest);
-  // The first search starts from the one made offline at the nearest training snapshot.
-  if (q.nearest >= 0) q.ops.seed(m_model.snapshot_search_memory(q.nearest));
+  if (!q.begin(m_model, mu, m_options.init, res)) return;
+  q.seed(m_model, q.ops);
 
   if (m_options.schedule == GreedySchedule::FixedPoint)
     solve_fixed_point(q, res);
@@ -265,19 +214,13 @@ OnlineResult GreedyActiveSet::solve_reduced(const fom::Param& mu) const {
   res.selected = std::move(q.selected);
   res.coefficients = std::move(q.lambda_i);
   res.lambda = m_model.reconstruct_dual(res.selected, res.coefficients);
+  res.operator_time_s = q.operators.total();
   if (res.status == Status::Success && !res.converged) {
-    res.status = Status::NoConvergence;
     const bool nested = m_options.schedule != GreedySchedule::Interleaved;
     res.message = "greedy active set did not converge in " + std::to_string(m_options.max_iterations) +
                   (nested ? " operator rebuilds (or " + std::to_string(m_options.max_solves) + " solves)" : " iterations") +
                   (q.best_iterate_returned ? "; best iterate with non-negative multipliers returned" : "");
   }
-  const auto t1 = clock::now();
-  res.time_s = std::chrono::duration<double>(t1 - t0).count();
-  res.operator_time_s = q.operators.total();
-  res.u = m_model.reconstruct_primal(res.u_hat, mu);
-  res.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
-  return res;
 }
 
 void schur_multipliers(const Eigen::Ref<const Eigen::MatrixXd>& schur, const Eigen::Ref<const Eigen::VectorXd>& rhs,

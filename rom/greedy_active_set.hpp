@@ -61,6 +61,7 @@
 #include <iosfwd>
 
 #include "core/anderson.hpp"
+#include "rom/active_set_start.hpp"
 #include "rom/online_solver.hpp"
 #include "rom/reduced_model.hpp"
 #include "rom/support_rows.hpp"
@@ -94,30 +95,6 @@ enum class OperatorRebuild {
   /// Every support row searched along the whole master chain at every rebuild.
   Full
 };
-
-/// \brief Where an online active-set iteration starts (see docs/rom.md, "Warm start").
-/// The stencil is ReducedModel::interpolation_stencil(μ): the training parameters
-/// bracketing μ (1D) or the corners of its enclosing grid cell, with multilinear weights.
-enum class WarmStart {
-  /// Paper Alg. 1: no column selected, û = K̂⁻¹ f̂ (the unconstrained solution).
-  Empty,
-  /// The stencil's columns selected, û = Σ w_j û_j (interpolated reduced
-  /// coordinates of their snapshots), operators first built there.
-  Cell,
-  /// The heaviest stencil point alone: its column selected, û = its û_j.
-  Nearest,
-  /// No column selected, û = Σ w_j û_j: a primal guess only (what a primal–dual
-  /// active set such as CPG can use, its first set being the violated columns there).
-  Primal
-};
-
-/// \brief The starting point of `init` at μ: the selected dictionary columns (empty
-/// for Empty and Primal) and the reduced displacement (u_free for Empty).
-/// \param nearest if given, set to the heaviest stencil point's column (whose
-///   ReducedModel::snapshot_search_memory seeds the first contact search), −1 for Empty
-void warm_start_point(const ReducedModel& model, WarmStart init, const fom::Param& mu,
-                      const Eigen::VectorXd& u_free, std::vector<int>& columns, Eigen::VectorXd& u_hat,
-                      int* nearest = nullptr);
 
 /// \brief Settings of GreedyActiveSet (documented defaults); τ, its scaling, the
 /// iteration cap k_max, the step tolerance and the operator clock are the
@@ -183,7 +160,7 @@ class GreedyActiveSet final : public OnlineSolver {
   double m_threshold = 0.0;
   SupportRows m_support;  // contact rows R where D_d is not zero, D_d restricted to R
 
-  OnlineResult solve_reduced(const fom::Param& mu) const override;
+  void solve_reduced(const fom::Param& mu, OnlineResult& res) const override;
 
   struct Query;        // the per-query quantities both schedules share
   struct Interleaved;  // the interleaved schedule's state between its steps

@@ -55,11 +55,29 @@ fom::ContactTolerances OnlineSolver::contact_tolerances() const {
   return m_tolerances_set ? m_tolerances : fom::default_contact_tolerances(model().problem());
 }
 
-OnlineResult OnlineSolver::solve(const fom::Param& mu) const {
-  OnlineResult res = solve_reduced(mu);
+OnlineResult OnlineSolver::start_query(const fom::Param& mu) const {
+  model().problem().check_param(mu);
+  OnlineResult res;
+  res.mu = mu;
+  return res;
+}
+
+void OnlineSolver::finish_query(std::chrono::steady_clock::time_point t0, OnlineResult& res) const {
+  using clock = std::chrono::steady_clock;
+  if (res.status == Status::Success && !res.converged) {
+    res.status = Status::NoConvergence;
+    if (res.message.empty()) res.message = name() + " did not converge";
+  }
+  const auto t1 = clock::now();
+  res.time_s = std::chrono::duration<double>(t1 - t0).count();
+  res.u = reconstruct_primal(res);
+  res.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
   const fom::Pairing* pairing = check_contact(model(), contact_tolerances(), res);
   if (m_indicator && pairing) estimate_errors(*m_indicator, *pairing, res, m_estimate_pairings);
-  return res;
+}
+
+Eigen::VectorXd OnlineSolver::reconstruct_primal(const OnlineResult& res) const {
+  return model().reconstruct_primal(res.u_hat, res.mu);
 }
 
 void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairing, OnlineResult& res, int pairings) {

@@ -87,11 +87,14 @@ struct OnlineResult {
 
 /// \brief An online ROM method. solve() is const and must be thread-safe.
 ///
-/// solve() runs the method (solve_reduced()) and then judges its answer at the full
-/// order on the contact surface: a query the method reports converged whose
-/// row-by-row contact residuals (penetration, separation under pressure, negative
-/// pressure, at the answer's own pairing) exceed contact_tolerances() gets
-/// Status::Inaccurate, with the worst residual and its row in the message.
+/// solve() is one query, the same for every method: it checks μ against the
+/// problem's range, runs the method's step (solve_reduced()) on the clock, marks an
+/// answer that did not converge, reconstructs the full displacement (timed apart),
+/// and then judges the answer at the full order on the contact surface: a query the
+/// method reports converged whose row-by-row contact residuals (penetration,
+/// separation under pressure, negative pressure, at the answer's own pairing) exceed
+/// contact_tolerances() gets Status::Inaccurate, with the worst residual and its row
+/// in the message; with an error indicator set, the errors are estimated.
 class OnlineSolver {
  public:
   virtual ~OnlineSolver() = default;
@@ -99,9 +102,11 @@ class OnlineSolver {
   virtual std::string name() const = 0;
   /// The reduced model the solver works on.
   virtual const ReducedModel& model() const = 0;
-  /// \brief Solves the reduced problem at μ (range-checked by the caller) and checks
-  /// the answer's contact residuals; see the class comment.
-  OnlineResult solve(const fom::Param& mu) const;
+  /// \brief One query at μ; see the class comment.
+  /// \throws InputError for μ of the wrong size or outside the problem's range.
+  OnlineResult solve(const fom::Param& mu) const {
+    return run_query(mu, [&](OnlineResult& res) { solve_reduced(mu, res); });
+  }
   /// Number of dual columns the method draws from (the whole dictionary unless the
   /// method builds its own dual basis, e.g. CPG).
   virtual int dual_basis_size() const { return model().dictionary_size(); }
@@ -117,10 +122,32 @@ class OnlineSolver {
   void set_contact_tolerances(const fom::ContactTolerances& tolerances) { m_tolerances = tolerances, m_tolerances_set = true; }
 
  protected:
-  /// \brief The method itself: solves the reduced problem at μ.
-  virtual OnlineResult solve_reduced(const fom::Param& mu) const = 0;
+  /// \brief The method's step, from μ (already checked; `res.mu` set) to its answer:
+  /// û (`u_hat`), the selection and its multipliers, the pressure `lambda`,
+  /// `iterations`, `converged`, `operator_time_s` when measured; on a failure
+  /// `status` and `message`, and when it did not converge the reason in `message`.
+  virtual void solve_reduced(const fom::Param& mu, OnlineResult& res) const = 0;
+  /// \brief The full displacement of an answer (timed as reconstruction); default
+  /// Φû + u_off(μ) (ReducedModel::reconstruct_primal).
+  virtual Eigen::VectorXd reconstruct_primal(const OnlineResult& res) const;
+  /// \brief solve() with another step than solve_reduced(), for a method that
+  /// reports more than OnlineResult (`step(res)` fills `res` as solve_reduced()).
+  template <class Step>
+  OnlineResult run_query(const fom::Param& mu, Step&& step) const {
+    OnlineResult res = start_query(mu);
+    const auto t0 = std::chrono::steady_clock::now();
+    step(res);
+    finish_query(t0, res);
+    return res;
+  }
 
  private:
+  /// Checks μ; the result with `mu` set.
+  OnlineResult start_query(const fom::Param& mu) const;
+  /// Marks a non-converged answer, times the step (from t0), reconstructs u, checks
+  /// the contact residuals and estimates the errors.
+  void finish_query(std::chrono::steady_clock::time_point t0, OnlineResult& res) const;
+
   fom::ContactTolerances m_tolerances;
   bool m_tolerances_set = false;
   std::shared_ptr<const ErrorIndicator> m_indicator;

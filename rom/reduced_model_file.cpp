@@ -122,10 +122,7 @@ OnlineModel::OnlineModel(std::shared_ptr<const fom::Problem> problem, const Snap
   m_solver = make_online_solver(m_method, *m_model, m_options);
 }
 
-OnlineResult OnlineModel::solve(const fom::Param& mu) const {
-  m_problem->check_param(mu);
-  return m_solver->solve(mu);
-}
+OnlineResult OnlineModel::solve(const fom::Param& mu) const { return m_solver->solve(mu); }
 
 void OnlineModel::save(const std::string& path) const {
   try {

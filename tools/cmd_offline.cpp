@@ -239,59 +239,129 @@ void run_adaptive(const OfflineArgs& a) {
             << (appending ? "appended to " : "database written to ") << out << "\n";
 }
 
+/// What a run computes: the training set (or its part), less the parameters the
+/// appended database holds.
+struct OfflinePlan {
+  bool appending = false;
+  std::string out;                 // the database written
+  int n = 0;                       // training size or level
+  std::vector<fom::Param> training, params;
+  rom::SnapshotDatabase existing;  // the appended database (empty otherwise)
+  rom::SnapshotDatabase sorted;    // `existing` in training order
+};
+
+/// The plan of a run. The database appended to is read on every rank (all refuse
+/// alike) and checked against the run before any snapshot is computed.
+OfflinePlan plan_offline(const OfflineArgs& a, const fom::Problem& problem) {
+  OfflinePlan plan;
+  plan.appending = !a.append.empty();
+  plan.out = plan.appending ? a.append : a.out;
+  const fom::SamplingPlan& sampling = problem.definition().training;
+  if (plan.appending) plan.existing = rom::read_database(a.append, false);
+  if (plan.appending && plan.existing.training_kind == "adaptive")
+    throw InputError("database " + quoted(a.append, 200) +
+                     " was built by offline --adaptive; expected --adaptive to continue it");
+  // --append without --train/--level: the database's training set.
+  const bool size_from_db = plan.appending && !a.train && !a.level && sampling.selector() != "list";
+  plan.n = size_from_db ? plan.existing.training_size
+                        : fom::resolve_training_size(sampling, problem.name(), a.train, a.level, false);
+  if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
+  plan.training = fom::training_set(problem, plan.n);
+  plan.params = a.part.empty() ? plan.training : training_part(plan.training, a.part);
+  if (plan.appending) {
+    rom::check_appendable(plan.existing, a.append, problem, sampling.selector(), plan.n);
+    plan.params = rom::parameters_not_in(plan.existing, plan.params);
+    plan.sorted = rom::sorted_by_training(plan.existing, a.append, plan.training);
+  }
+  return plan;
+}
+
+/// An append with nothing to compute: the database is left as it is, or rewritten
+/// in training order when its snapshots are out of it (parts merged in the wrong
+/// order by an older contactrom), as a whole run would have them.
+void finish_without_snapshots(const OfflineArgs& a, const fom::Problem& problem, const OfflinePlan& plan,
+                              const Ranks& ranks) {
+  const bool reorder = plan.sorted.parameters != plan.existing.parameters;
+  if (reorder) write_on_root(plan.out, [&]() -> const rom::SnapshotDatabase& { return plan.sorted; }, ranks);
+  if (!ranks.root()) return;
+  nlohmann::json j{{"problem", problem.name()}, {"snapshots", 0},
+                   {"total_snapshots", plan.existing.num_snapshots()}, {"out", plan.out}};
+  if (reorder) j["reordered"] = true;
+  std::cout << (a.json ? j.dump()
+                       : a.append + (reorder ? " holds these snapshots; rewritten in training order"
+                                             : " already holds these snapshots; nothing to compute"))
+            << std::endl;
+}
+
+/// The snapshots of the plan, distributed over the MPI ranks under mpirun
+/// (rom/offline_mpi.hpp), else on this process's threads.
+rom::SnapshotDatabase compute_snapshots(const fom::Problem& problem, const OfflinePlan& plan,
+                                        const rom::OfflineOptions& options) {
+  const std::string kind = problem.definition().training.selector();
+#ifdef CONTACTROM_HAVE_MPI
+  if (rom::mpi::active()) return rom::mpi::generate_snapshots_distributed(problem, plan.params, kind, plan.n, options);
+#endif
+  return rom::generate_snapshots(problem, plan.params, kind, plan.n, options);
+}
+
+/// Warns of every snapshot that failed; returns how many did.
+int warn_failed_snapshots(const fom::Problem& problem, const rom::SnapshotDatabase& db) {
+  int failed = 0;
+  for (int j = 0; j < db.num_snapshots(); ++j) {
+    if (db.status[j] == Status::Success) continue;
+    ++failed;
+    std::cerr << "contactrom: warning: snapshot " << j << " (" << param_text(problem, db.parameter(j))
+              << ") status " << to_string(db.status[j]) << "; stored with its status and left out of the ROM\n";
+  }
+  return failed;
+}
+
+/// The summary of a run (one JSON object with --json).
+void print_offline_summary(const OfflineArgs& a, const fom::Problem& problem, const OfflinePlan& plan,
+                           const rom::SnapshotDatabase& db, int failed, const Ranks& ranks) {
+  const int stored = plan.appending ? plan.existing.num_snapshots() : 0;
+  double fom_sum = 0.0;
+  for (double t : db.time_s) fom_sum += t;
+  const double mean_fom = db.num_snapshots() ? fom_sum / db.num_snapshots() : 0.0;
+  if (a.json) {
+    nlohmann::json j;
+    j["problem"] = problem.name();
+    j[db.training_kind] = plan.n;
+    j["snapshots"] = db.num_snapshots();
+    if (plan.appending) j["total_snapshots"] = stored + db.num_snapshots();
+    j["failed"] = failed;
+    j["threads"] = db.threads;
+    j["ranks"] = ranks.size;
+    j["wall_time_s"] = db.wall_time_s;
+    j["setup_time_s"] = db.setup_time_s;
+    j["mean_fom_time_s"] = mean_fom;
+    j["out"] = plan.out;
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::cout << "offline " << problem.name() << ": " << db.num_snapshots() << " snapshots (" << db.training_kind << " "
+            << plan.n << "), " << failed << " failed, " << db.threads << " threads"
+            << (ranks.size > 1 ? " on " + std::to_string(ranks.size) + " MPI ranks" : std::string()) << "\n"
+            << std::setprecision(3) << "wall time " << db.wall_time_s << " s (factorisation " << db.setup_time_s
+            << " s, mean FOM query " << 1e3 * mean_fom << " ms)\n";
+  if (plan.appending)
+    std::cout << "appended to " << plan.out << " (" << stored << " snapshots before, " << stored + db.num_snapshots()
+              << " now)\n";
+  else
+    std::cout << "database written to " << plan.out << "\n";
+}
+
 void run_offline(const OfflineArgs& a) {
   if (a.adaptive) return run_adaptive(a);
 #ifdef CONTACTROM_HAVE_MPI
-  // Under mpirun (main() started MPI), the snapshots are distributed over the ranks
-  // (rom/offline_mpi.hpp).
-  const bool distributed = rom::mpi::active();
   const Ranks ranks{rom::mpi::world_rank(), rom::mpi::world_size()};
 #else
   const Ranks ranks;
 #endif
   const auto problem = open_run(a, ranks);
-  const bool appending = !a.append.empty();
-  const std::string& out = appending ? a.append : a.out;
-  const fom::SamplingPlan& plan = problem->definition().training;
   const std::unique_ptr<FileLock> lock = lock_for_append(a.append, ranks);
-  // The database appended to is read on every rank (all refuse alike) and checked
-  // against the run before any snapshot is computed.
-  rom::SnapshotDatabase existing;
-  if (appending) existing = rom::read_database(a.append, false);
-  if (appending && existing.training_kind == "adaptive")
-    throw InputError("database " + quoted(a.append, 200) +
-                     " was built by offline --adaptive; expected --adaptive to continue it");
-  // --append without --train/--level: the database's training set.
-  const bool size_from_db = appending && !a.train && !a.level && plan.selector() != "list";
-  const int n = size_from_db ? existing.training_size
-                             : fom::resolve_training_size(plan, problem->name(), a.train, a.level, false);
-  if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
-  const std::vector<fom::Param> training = fom::training_set(*problem, n);
-  std::vector<fom::Param> params = a.part.empty() ? training : training_part(training, a.part);
-  if (appending) {
-    rom::check_appendable(existing, a.append, *problem, plan.selector(), n);
-    params = rom::parameters_not_in(existing, params);
-    // Snapshots out of training order (parts merged in the wrong order by an older
-    // contactrom) are put in order, as a whole run would have them.
-    const rom::SnapshotDatabase sorted = rom::sorted_by_training(existing, a.append, training);
-    if (params.empty() && sorted.parameters != existing.parameters) {
-      write_on_root(out, [&]() -> const rom::SnapshotDatabase& { return sorted; }, ranks);
-      if (ranks.root()) std::cout << (a.json ? nlohmann::json{{"problem", problem->name()}, {"snapshots", 0},
-                                                              {"total_snapshots", existing.num_snapshots()},
-                                                              {"out", out}, {"reordered", true}}.dump()
-                                             : a.append + " holds these snapshots; rewritten in training order")
-                                  << std::endl;
-      return;
-    }
-    if (params.empty()) {  // every rank knows it: none computes, the file is left as it is
-      if (ranks.root()) std::cout << (a.json ? nlohmann::json{{"problem", problem->name()}, {"snapshots", 0},
-                                                              {"total_snapshots", existing.num_snapshots()},
-                                                              {"out", out}}.dump()
-                                             : a.append + " already holds these snapshots; nothing to compute")
-                                  << std::endl;
-      return;
-    }
-  }
+  const OfflinePlan plan = plan_offline(a, *problem);
+  if (plan.appending && plan.params.empty()) return finish_without_snapshots(a, *problem, plan, ranks);
 
   const std::string label =
       "offline " + problem->name() + (ranks.size > 1 ? " (rank 0 of " + std::to_string(ranks.size) + ")" : "");
@@ -301,70 +371,23 @@ void run_offline(const OfflineArgs& a) {
   // Snapshots are streamed to a file of this process as they are computed; it
   // becomes the database (serial), or is copied into it (append, MPI ranks), and is
   // removed when this function ends.
-  options.stream_to = temporary_path_for(out);
-  options.stream_label = out;
+  options.stream_to = temporary_path_for(plan.out);
+  options.stream_label = plan.out;
   const TemporaryPart part{options.stream_to};
   options.progress = [&bar](int done, int total) { bar.update(done, total); };
-  const std::string kind = plan.selector();
-#ifdef CONTACTROM_HAVE_MPI
-  const rom::SnapshotDatabase db = distributed
-                                       ? rom::mpi::generate_snapshots_distributed(*problem, params, kind, n, options)
-                                       : rom::generate_snapshots(*problem, params, kind, n, options);
-#else
-  const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, params, kind, n, options);
-#endif
+  const rom::SnapshotDatabase db = compute_snapshots(*problem, plan, options);
   bar.finish();
+
   rom::SnapshotDatabase appended;
   const auto result = [&]() -> const rom::SnapshotDatabase& {
-    if (appending) appended = rom::append_snapshots(existing, a.append, db, training);
-    return appending ? appended : db;
+    if (plan.appending) appended = rom::append_snapshots(plan.existing, a.append, db, plan.training);
+    return plan.appending ? appended : db;
   };
-  if (!appending && ranks.size == 1) {  // the streamed file is the database: publish it as it is
-    commit_temporary(options.stream_to, out);
-  }
-  if (!ranks.root()) {
-    write_on_root(out, result, ranks);
-    return;
-  }
-
-  int failed = 0;
-  for (int j = 0; j < db.num_snapshots(); ++j) {
-    if (db.status[j] == Status::Success) continue;
-    ++failed;
-    std::cerr << "contactrom: warning: snapshot " << j << " (" << param_text(*problem, db.parameter(j))
-              << ") status " << to_string(db.status[j]) << "; stored with its status and left out of the ROM\n";
-  }
-  const int stored = appending ? existing.num_snapshots() : 0;
-  if (appending || ranks.size > 1) write_on_root(out, result, ranks);
-
-  double fom_sum = 0.0;
-  for (double t : db.time_s) fom_sum += t;
-  if (a.json) {
-    nlohmann::json j;
-    j["problem"] = problem->name();
-    j[db.training_kind] = n;
-    j["snapshots"] = db.num_snapshots();
-    if (appending) j["total_snapshots"] = stored + db.num_snapshots();
-    j["failed"] = failed;
-    j["threads"] = db.threads;
-    j["ranks"] = ranks.size;
-    j["wall_time_s"] = db.wall_time_s;
-    j["setup_time_s"] = db.setup_time_s;
-    j["mean_fom_time_s"] = db.num_snapshots() ? fom_sum / db.num_snapshots() : 0.0;
-    j["out"] = out;
-    std::cout << j.dump() << std::endl;
-    return;
-  }
-  std::cout << "offline " << problem->name() << ": " << db.num_snapshots() << " snapshots (" << db.training_kind << " "
-            << n << "), " << failed << " failed, " << db.threads << " threads"
-            << (ranks.size > 1 ? " on " + std::to_string(ranks.size) + " MPI ranks" : std::string()) << "\n"
-            << std::setprecision(3) << "wall time " << db.wall_time_s << " s (factorisation " << db.setup_time_s
-            << " s, mean FOM query " << (db.num_snapshots() ? 1e3 * fom_sum / db.num_snapshots() : 0.0) << " ms)\n";
-  if (appending)
-    std::cout << "appended to " << out << " (" << stored << " snapshots before, " << stored + db.num_snapshots()
-              << " now)\n";
-  else
-    std::cout << "database written to " << out << "\n";
+  if (!plan.appending && ranks.size == 1) commit_temporary(options.stream_to, plan.out);  // the streamed file is the database
+  if (!ranks.root()) return write_on_root(plan.out, result, ranks);
+  const int failed = warn_failed_snapshots(*problem, db);
+  if (plan.appending || ranks.size > 1) write_on_root(plan.out, result, ranks);
+  print_offline_summary(a, *problem, plan, db, failed, ranks);
 }
 
 CommandRegistrar reg("offline", [](CLI::App& app) {

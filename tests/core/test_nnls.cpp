@@ -241,6 +241,38 @@ BOOST_AUTO_TEST_CASE(iteration_cap_gives_no_convergence_and_a_feasible_iterate) 
   BOOST_TEST(x.allFinite());
 }
 
+BOOST_AUTO_TEST_CASE(a_cap_stops_the_run_only_where_it_is_reached) {
+  // Warm-started from a dense positive start, so both frees and binds happen. A cap
+  // at or above the changes the run needs leaves it untouched; a lower cap stops it
+  // at a feasible iterate before the change that would exceed the cap.
+  std::mt19937_64 gen(17);
+  const MatrixXd a = gaussian(30, 20, gen);
+  const VectorXd b = gaussian(30, 1, gen);
+  const VectorXd start = VectorXd::Constant(20, 0.3);
+  Nnls uncapped;
+  const VectorXd x = uncapped.compute(a).solve(b, start);
+  BOOST_REQUIRE((uncapped.info() == Status::Success));
+  const int needed = uncapped.iterations();
+  BOOST_REQUIRE(needed > 3);
+  for (int cap = 1; cap <= needed + 2; ++cap) {
+    NnlsOptions options;
+    options.max_iterations = cap;
+    Nnls capped(options);
+    const VectorXd y = capped.compute(a).solve(b, start);
+    BOOST_TEST_CONTEXT("cap " << cap) {
+      BOOST_TEST(y.minCoeff() >= 0.0);
+      if (cap >= needed) {
+        BOOST_TEST((capped.info() == Status::Success));
+        BOOST_TEST(capped.iterations() == needed);
+        BOOST_TEST((y - x).norm() == 0.0);
+      } else {
+        BOOST_TEST((capped.info() == Status::NoConvergence));
+        BOOST_TEST(capped.iterations() <= cap + 1);  // a step may bind two variables at once
+      }
+    }
+  }
+}
+
 BOOST_AUTO_TEST_CASE(edge_case_empty_dictionary) {
   Nnls nnls;
   const VectorXd x = nnls.compute(MatrixXd(5, 0)).solve(VectorXd::Ones(5));

@@ -5,6 +5,7 @@
 #include <boost/test/unit_test.hpp>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "common/input_error.hpp"
 #include "core/errors.hpp"
@@ -64,4 +65,48 @@ BOOST_AUTO_TEST_CASE(problem_parameters_are_checked_per_component) {
   BOOST_TEST(input_error_of([&] { contactrom::parse_problem_param(*rope, "12,13"); }).find("takes 1 parameter") !=
              std::string::npos);
   BOOST_TEST(input_error_of([&] { contactrom::parse_problem_param(*rope, "nan"); }).find("'nan'") != std::string::npos);
+}
+
+BOOST_AUTO_TEST_CASE(both_parameter_entry_points_are_one_parser) {
+  // fom::parse_param (the library's) and parse_problem_param (the CLI's and
+  // Python's) accept the same texts with the same values and refuse the same texts
+  // with the same message, with the stricter rules: blanks only around a value,
+  // no empty item, no underflow to 0, the value out of range quoted as written.
+  namespace fom = contactrom::fom;
+  const std::string source = CONTACTROM_SOURCE_DIR;
+  for (const std::string problem_name : {"punch_beam", "ironing2"}) {
+    const auto problem = fom::make_problem(source + "/problems/" + problem_name + ".toml");
+    const bool two = problem->num_params() == 2;
+    const std::vector<std::string> accepted =
+        two ? std::vector<std::string>{"0,0.1", " 4 , 0.3 ", "1e-300,0.2", "+2,2e-1"}
+            : std::vector<std::string>{"0.2", " 0.1 ", "1e-300", "+2e-1", "5e-324"};
+    const std::vector<std::string> refused = {"", " ", "0.1,", ",0.1", "0.1,,0.2", "abc", "nan", "inf", "0.1x",
+                                              "1e-400", "1e400", "0.1\v", "-0.1", "0.30000000001", "0x",
+                                              "0.1,0.2,0.3"};
+    for (const std::string& text : accepted) {
+      BOOST_TEST_CONTEXT(problem_name << " '" << text << "'") {
+        const fom::Param a = fom::parse_param(*problem, text);
+        const fom::Param b = contactrom::parse_problem_param(*problem, text);
+        BOOST_TEST(a.size() == problem->num_params());
+        BOOST_TEST((a.array() == b.array()).all());
+        BOOST_TEST(problem->parameters().contains(a));
+      }
+    }
+    for (const std::string& text : refused) {
+      BOOST_TEST_CONTEXT(problem_name << " '" << text << "'") {
+        const std::string a = input_error_of([&] { fom::parse_param(*problem, text); });
+        const std::string b = input_error_of([&] { contactrom::parse_problem_param(*problem, text); });
+        BOOST_TEST(!a.empty());
+        BOOST_TEST(a == b);
+      }
+    }
+  }
+  // The messages of the stricter rules.
+  const auto punch = fom::make_problem(source + "/problems/punch_beam.toml");
+  BOOST_TEST(input_error_of([&] { fom::parse_param(*punch, "1e-400"); }).find("underflows to 0") != std::string::npos);
+  BOOST_TEST(input_error_of([&] { fom::parse_param(*punch, "0.1,"); }).find("after its last comma") != std::string::npos);
+  BOOST_TEST(input_error_of([&] { fom::parse_param(*punch, "0.20000000001"); }).find("'0.20000000001'") !=
+             std::string::npos);
+  BOOST_TEST(input_error_of([&] { fom::parse_param(*punch, "0.1,0.2"); }).find("takes 1 parameter value(s), but") !=
+             std::string::npos);
 }

@@ -120,6 +120,36 @@ BOOST_AUTO_TEST_CASE(random_problems_satisfy_the_kkt_conditions) {
   }
 }
 
+BOOST_AUTO_TEST_CASE(a_cap_stops_the_run_only_where_it_is_reached) {
+  // Same loop as NNLS (core/lawson_hanson.hpp): a cap at or above the changes the
+  // run needs leaves it untouched; a lower one stops at a point of the simplex.
+  std::mt19937_64 gen(23);
+  const MatrixXd a = gaussian(12, 30, gen);
+  const VectorXd b = gaussian(12, 1, gen);
+  SimplexLeastSquares uncapped;
+  const VectorXd alpha = uncapped.compute(a).solve(b);
+  BOOST_REQUIRE((uncapped.info() == Status::Success));
+  const int needed = uncapped.iterations();
+  BOOST_REQUIRE(needed > 3);
+  for (int cap = 1; cap <= needed + 2; ++cap) {
+    contactrom::rom::SimplexLeastSquaresOptions options;
+    options.max_iterations = cap;
+    SimplexLeastSquares capped(options);
+    const VectorXd beta = capped.compute(a).solve(b);
+    BOOST_TEST_CONTEXT("cap " << cap) {
+      BOOST_TEST(beta.minCoeff() >= 0.0);
+      BOOST_TEST(beta.sum() == 1.0, boost::test_tools::tolerance(1e-14));
+      if (cap >= needed) {
+        BOOST_TEST((capped.info() == Status::Success));
+        BOOST_TEST((beta - alpha).norm() == 0.0);
+      } else {
+        BOOST_TEST((capped.info() == Status::NoConvergence));
+        BOOST_TEST(capped.residual_norm() >= uncapped.residual_norm());
+      }
+    }
+  }
+}
+
 BOOST_AUTO_TEST_CASE(edge_cases) {
   SimplexLeastSquares ls;
   // One column: α = 1.

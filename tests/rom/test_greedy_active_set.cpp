@@ -651,13 +651,12 @@ BOOST_AUTO_TEST_CASE(snapshot_search_memory_gives_the_searched_pairing) {
   int settled = 0;
   rom::SupportOperators seeded;
   for (const fom::Param& mu : params) {
-    std::vector<int> columns;
-    Eigen::VectorXd u_hat;
-    int nearest = -1;
-    const Eigen::VectorXd u_free = Eigen::VectorXd::Zero(model.primal_rank());
-    rom::warm_start_point(model, rom::WarmStart::Cell, mu, u_free, columns, u_hat, &nearest);
+    rom::ActiveSetStart start(model, mu);
+    rom::OnlineResult unused;
+    BOOST_REQUIRE(start.begin(model, mu, rom::WarmStart::Cell, unused));
+    const int nearest = start.nearest;
     BOOST_REQUIRE(nearest >= 0);
-    const Eigen::VectorXd u_s = model.surface_basis() * u_hat + model.surface_lifting(mu);
+    const Eigen::VectorXd u_s = model.surface_basis() * start.u_start + model.surface_lifting(mu);
     rom::SupportOperators fresh(false);
     fresh.rebuild(contact, support, u_s);
     seeded.reset(true);

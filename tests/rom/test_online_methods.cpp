@@ -65,6 +65,54 @@ BOOST_AUTO_TEST_CASE(every_builtin_method_is_registered_without_a_call) {
   }
 }
 
+BOOST_AUTO_TEST_CASE(every_method_checks_mu_and_wraps_its_answer_the_same_way) {
+  // OnlineSolver::solve: μ of the wrong size or outside the range is refused with
+  // the problem's message before the method runs; every answer carries μ, the full
+  // displacement Φû + u_off(μ) (the convex hull: u_off + D_p α), its times and,
+  // when not converged, a status that says so.
+  const fom::Problem& problem = *rope().problem;
+  const fom::Param outside = fom::Param::Constant(1, 1e9), wrong_size = fom::Param::Zero(2);
+  std::string expected_outside, expected_size;
+  try {
+    problem.check_param(outside);
+  } catch (const InputError& e) {
+    expected_outside = e.what();
+  }
+  try {
+    problem.check_param(wrong_size);
+  } catch (const InputError& e) {
+    expected_size = e.what();
+  }
+  BOOST_REQUIRE(!expected_outside.empty());
+  BOOST_REQUIRE(!expected_size.empty());
+  for (const char* name : {"greedy", "greedy-nested", "convex-hull", "cpg", "full-dictionary"}) {
+    BOOST_TEST_CONTEXT(name) {
+      const auto solver = rom::make_online_solver(name, rope().model);
+      BOOST_TEST(error_of([&] { solver->solve(outside); }) == expected_outside);
+      BOOST_TEST(error_of([&] { solver->solve(wrong_size); }) == expected_size);
+      const fom::Param mu = fom::Param::Constant(1, 31.0);
+      const rom::OnlineResult r = solver->solve(mu);
+      BOOST_TEST(r.mu(0) == 31.0);
+      BOOST_TEST(r.time_s > 0.0);
+      BOOST_TEST(r.time_s >= r.check_time_s);
+      BOOST_TEST(r.reconstruction_time_s >= 0.0);
+      BOOST_TEST(r.lambda.size() == problem.contact().num_constraints());
+      if (std::string(name) != "convex-hull")
+        BOOST_TEST((r.u - rope().model.reconstruct_primal(r.u_hat, mu)).norm() == 0.0);
+      BOOST_TEST(((r.status == Status::NoConvergence) == (!r.converged && r.status != Status::NumericalIssue)));
+      // A capped query that does not converge says so, with the method's reason.
+      rom::OnlineSolverOptions capped;
+      capped.max_iterations = 1;
+      if (std::string(name) == "convex-hull") capped.extra["max_pairing_iterations"] = "1";
+      const rom::OnlineResult c = rom::make_online_solver(name, rope().model, capped)->solve(mu);
+      if (!c.converged) {
+        BOOST_TEST((c.status == Status::NoConvergence));
+        BOOST_TEST(!c.message.empty());
+      }
+    }
+  }
+}
+
 BOOST_AUTO_TEST_CASE(every_declared_choice_and_bound_is_accepted_by_the_factory) {
   for (const rom::OnlineMethod& m : rom::online_methods()) {
     for (const rom::OptionSpec& s : m.options) {
