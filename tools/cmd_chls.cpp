@@ -24,6 +24,7 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.hpp"
@@ -108,7 +109,7 @@ struct HullArgs {
   double delta = 1e-8, basis_delta = kDefaults.basis_delta, sum_weight = kDefaults.sum_weight;
   int rank_l = kDefaults.rank_l, threads = 0, repeats = 3, max_pairing_iterations = kDefaults.max_pairing_iterations;
   long long seed = static_cast<long long>(kDefaults.seed);
-  bool no_polish = false, json = false, time = false;
+  bool polish = kDefaults.polish, json = false, time = false;
   std::vector<std::string> options;
 };
 
@@ -120,23 +121,21 @@ void run_hull_report(const HullArgs& a) {
   rom::ReducedModelOptions model_options;
   model_options.delta = a.delta;
   const rom::ReducedModel model(*problem, db, model_options);
-  // One parsing path for the settings: the flags and every --option KEY=VALUE go
-  // through OnlineSolverOptions::extra, as for `contactrom online`.
-  rom::OnlineSolverOptions generic;
-  generic.extra["basis"] = a.basis;
-  generic.extra["basis_delta"] = format_number(a.basis_delta);
-  generic.extra["rank_l"] = std::to_string(a.rank_l);
-  generic.extra["seed"] = std::to_string(a.seed);
-  generic.extra["sum_weight"] = format_number(a.sum_weight);
-  generic.extra["polish"] = a.no_polish ? "0" : "1";
-  generic.extra["max_pairing_iterations"] = std::to_string(a.max_pairing_iterations);
+  // One parsing path for the settings: the flags and every --option KEY=VALUE are
+  // read as the method's key/value settings, as for `contactrom online`.
+  std::map<std::string, std::string> values{{"basis", a.basis},
+                                            {"basis_delta", format_number(a.basis_delta)},
+                                            {"rank_l", std::to_string(a.rank_l)},
+                                            {"seed", std::to_string(a.seed)},
+                                            {"sum_weight", format_number(a.sum_weight)},
+                                            {"polish", a.polish ? "true" : "false"},
+                                            {"max_pairing_iterations", std::to_string(a.max_pairing_iterations)}};
   for (const std::string& kv : a.options) {
     auto [key, value] = rom::split_option(kv);
-    generic.extra[key] = value;
+    values[key] = value;
   }
-  rom::validate_online_options("convex-hull", generic);
-  const rom::ConvexHullOptions options = rom::convex_hull_options(generic);
-  const rom::ConvexHullSolver solver(model, options);
+  const auto online_solver = rom::make_online_solver("convex-hull", model, rom::options_from_map("convex-hull", values));
+  const auto& solver = dynamic_cast<const rom::ConvexHullSolver&>(*online_solver);
 
   const std::vector<fom::Param> params =
       a.set == "training" ? rom::database_training_set(db, *problem) : rom::database_validation_set(db, *problem);
@@ -201,7 +200,7 @@ CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
   add_setting(sub, "--rank-l", args->rank_l, hull, "rank_l");
   add_setting(sub, "--seed", args->seed, hull, "seed");
   add_setting(sub, "--sum-weight", args->sum_weight, hull, "sum_weight");
-  sub->add_flag("--no-polish", args->no_polish, "keep the plain nnFOCUSS coefficients (no exact simplex re-solve)");
+  add_setting_negation(sub, "--no-polish", args->polish, hull, "polish");
   add_setting(sub, "--max-pairing-iterations", args->max_pairing_iterations, hull, "max_pairing_iterations");
   std::string keys;
   for (const rom::OptionSpec& spec : rom::online_method("convex-hull").options)

@@ -250,9 +250,8 @@ CommandRegistrar reg("verify", [](CLI::App& app) {
   add_setting(sub, "--max-iterations", args->max_iterations, rom::active_set_settings_table(), "max_iterations");
   add_setting(sub, "--cpg-tolerance", args->cpg_tolerance, baselines::cpg_option_table(), "cpg_tolerance");
   add_setting(sub, "--inner-solve", args->inner_solve, baselines::reduced_active_set_option_table(), "inner_solve");
-  sub->add_option("--init", args->init,
-                  "starting point of greedy/greedy-nested (empty|cell|nearest|primal; default cell) and of "
-                  "cpg/full-dictionary (empty|primal|cell; default empty)");
+  sub->add_option("--init", args->init, "starting point of the methods that take one (as --option init): " +
+                                             shared_setting_help("init"));
   sub->add_option("--reference", args->reference, "reference solver: ipopt (default) | fom (custom active set)");
   add_integer(sub, "--threads", args->threads, "threads for the reference solves (default: hardware concurrency)", 1, 1024);
   add_integer(sub, "--limit", args->limit, "use N evenly spaced validation parameters (default: all)", 1, 1000000);
