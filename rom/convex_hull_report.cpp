@@ -82,7 +82,7 @@ DatabaseChls chls_of_database(const SnapshotDatabase& db, const ChlsOptions& opt
 
 void write_chls_csv(const std::string& path, const SnapshotDatabase& db, const DatabaseChls& c) {
   write_file_atomically(path, [&](std::ostream& out) {
-    for (const std::string& name : db.param_names) out << name << ',';
+    for (const std::string& name : db.problem.param_names) out << name << ',';
     out << "chls_error,status,iterations,support\n";
     for (std::size_t k = 0; k < c.snapshots.size(); ++k) {
       const fom::Param mu = db.parameter(c.snapshots[k]);

@@ -17,7 +17,7 @@
 #include "rom/dense_csv.hpp"
 #include "rom/hdf5_io.hpp"
 #include "rom/online_methods.hpp"
-#include "rom/problem_record.hpp"
+#include "rom/problem_record_io.hpp"
 
 namespace contactrom::rom {
 namespace {

@@ -67,7 +67,7 @@ void run_chls(const ChlsArgs& a) {
   };
   if (!a.out.empty()) rom::write_chls_csv(a.out, db, chls);
   nlohmann::json j;
-  j["problem"] = db.problem;
+  j["problem"] = db.problem.name;
   j["chls_error"] = std::vector<double>(r.errors.data(), r.errors.data() + r.errors.size());
   nlohmann::json params = nlohmann::json::array();
   for (int s : used) params.push_back(param_json(db.parameter(s)));
@@ -77,7 +77,7 @@ void run_chls(const ChlsArgs& a) {
     std::cout << j.dump() << std::endl;
     return;
   }
-  std::cout << "CHLS (leave-one-out convex hull least squares) of " << used.size() << " " << db.problem
+  std::cout << "CHLS (leave-one-out convex hull least squares) of " << used.size() << " " << db.problem.name
             << " primal snapshots\n"
             << std::setprecision(3);
   for (std::size_t k = 0; k < used.size(); ++k)

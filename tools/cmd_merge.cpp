@@ -29,14 +29,14 @@ void run_merge(const MergeArgs& a) {
   rom::write_database(a.out, merged);
   if (a.json) {
     nlohmann::json j;
-    j["problem"] = merged.problem;
+    j["problem"] = merged.problem.name;
     j["inputs"] = a.inputs.size();
     j["snapshots"] = merged.num_snapshots();
     j["out"] = a.out;
     std::cout << j.dump() << std::endl;
     return;
   }
-  std::cout << "merged " << a.inputs.size() << " databases of " << merged.problem << ": "
+  std::cout << "merged " << a.inputs.size() << " databases of " << merged.problem.name << ": "
             << merged.num_snapshots() << " snapshots written to " << a.out << "\n";
 }
 
