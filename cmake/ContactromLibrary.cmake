@@ -1,6 +1,7 @@
 # contactrom_add_library(<folder> SOURCES <a.cpp>... PUBLIC_HEADERS <a.hpp>... [PRIVATE_HEADERS <b.hpp>...]):
 # the library of one source folder, target contactrom_<folder> with alias
-# contactrom::<folder> (exported under that name), C++17. Files are named relative
+# contactrom::<folder> (exported under that name), C++17, whose headers are included
+# as <contactrom/<folder>/x.hpp> from the build tree and from <prefix>/include. Files are named relative
 # to the folder, each listed explicitly. PUBLIC_HEADERS are installed to
 # <prefix>/include/contactrom/<folder>/ (ContactromInstall.cmake) and must include
 # only public headers and public dependencies; PRIVATE_HEADERS (those that include
@@ -14,7 +15,12 @@ function(contactrom_add_library folder)
   list(TRANSFORM arg_PRIVATE_HEADERS PREPEND ${dir}/ OUTPUT_VARIABLE private)
   add_library(contactrom_${folder} ${arg_SOURCES} ${public} ${private})
   add_library(contactrom::${folder} ALIAS contactrom_${folder})
-  target_include_directories(contactrom_${folder} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+  # Headers are included as <contactrom/<folder>/x.hpp>, in the tree as once installed:
+  # the build tree's include/contactrom/<folder> is a link to the folder.
+  file(MAKE_DIRECTORY ${PROJECT_BINARY_DIR}/include/contactrom)
+  file(CREATE_LINK ${dir} ${PROJECT_BINARY_DIR}/include/contactrom/${folder} SYMBOLIC)
+  target_include_directories(contactrom_${folder} PUBLIC $<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/include>
+    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/contactrom>)
   set_target_properties(contactrom_${folder} PROPERTIES EXPORT_NAME ${folder}
                         CONTACTROM_PUBLIC_HEADERS "${public}")
