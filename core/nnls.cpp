@@ -1,4 +1,4 @@
-#include "core/nnls.hpp"
+#include <contactrom/core/nnls.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "fom/child_process.hpp"
+#include <contactrom/fom/child_process.hpp>
 
 #include <fcntl.h>
 #include <poll.h>

@@ -1,4 +1,4 @@
-#include "fom/gmsh_reader.hpp"
+#include <contactrom/fom/gmsh_reader.hpp>
 
 #include <gmsh.h>
 
@@ -12,8 +12,8 @@
 #include <unordered_map>
 #include <utility>
 
-#include "core/format.hpp"
-#include "core/errors.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::fom {
 namespace {

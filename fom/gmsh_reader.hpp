@@ -7,7 +7,7 @@
 /// contactrom::fom.
 #include <string>
 
-#include "fom/mesh.hpp"
+#include <contactrom/fom/mesh.hpp>
 
 namespace contactrom::fom {
 

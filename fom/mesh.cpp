@@ -1,4 +1,4 @@
-#include "fom/mesh.hpp"
+#include <contactrom/fom/mesh.hpp>
 
 #include <cmath>
 #include <cstdint>
@@ -7,13 +7,13 @@
 #include <sstream>
 #include <type_traits>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
-#include "core/input_file.hpp"
-#include "fom/child_process.hpp"
-#include "fom/data_directory.hpp"
-#include "fom/gmsh_reader.hpp"
-#include "fom/mesh_serialization.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/input_file.hpp>
+#include <contactrom/fom/child_process.hpp>
+#include <contactrom/fom/data_directory.hpp>
+#include <contactrom/fom/gmsh_reader.hpp>
+#include <contactrom/fom/mesh_serialization.hpp>
 
 namespace contactrom::fom {
 namespace {

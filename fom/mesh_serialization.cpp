@@ -1,11 +1,11 @@
-#include "fom/mesh_serialization.hpp"
+#include <contactrom/fom/mesh_serialization.hpp>
 
 #include <cstdint>
 #include <cstring>
 #include <type_traits>
 #include <utility>
 
-#include "core/errors.hpp"
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::fom {
 namespace {

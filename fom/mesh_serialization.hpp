@@ -5,7 +5,7 @@
 /// A private header of contactrom::fom.
 #include <string>
 
-#include "fom/mesh.hpp"
+#include <contactrom/fom/mesh.hpp>
 
 namespace contactrom::fom {
 

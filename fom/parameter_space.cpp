@@ -1,12 +1,12 @@
-#include "fom/parameter_space.hpp"
+#include <contactrom/fom/parameter_space.hpp>
 
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
-#include "core/format.hpp"
-#include "core/errors.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::fom {
 

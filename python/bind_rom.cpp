@@ -4,13 +4,13 @@
 #include <Python.h>
 #include <variant>
 
-#include "core/format.hpp"
-#include "core/errors.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
 #include "python/bindings.hpp"
-#include "rom/adaptive_training.hpp"
-#include "rom/fallback.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
+#include <contactrom/rom/adaptive_training.hpp>
+#include <contactrom/rom/fallback.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
 
 namespace contactrom::python {
 namespace {

@@ -1,4 +1,4 @@
-#include "rom/chls.hpp"
+#include <contactrom/rom/chls.hpp>
 
 #include <algorithm>
 #include <chrono>

@@ -1,13 +1,13 @@
-#include "rom/convex_hull_report.hpp"
+#include <contactrom/rom/convex_hull_report.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <ostream>
 
-#include "core/atomic_file.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/parameter_space.hpp"
-#include "rom/offline.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/parameter_space.hpp>
+#include <contactrom/rom/offline.hpp>
 
 namespace contactrom::rom {
 namespace {

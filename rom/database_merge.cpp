@@ -1,9 +1,9 @@
-#include "rom/database_merge.hpp"
+#include <contactrom/rom/database_merge.hpp>
 
 #include <algorithm>
 #include <stdexcept>
 
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 namespace contactrom::rom {
 namespace {

@@ -1,4 +1,4 @@
-#include "rom/offline.hpp"
+#include <contactrom/rom/offline.hpp>
 
 #include <algorithm>
 #include <memory>

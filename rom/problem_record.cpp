@@ -1,7 +1,7 @@
-#include "rom/problem_record.hpp"
+#include <contactrom/rom/problem_record.hpp>
 
-#include "core/errors.hpp"
-#include "fom/problem_file.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/problem_file.hpp>
 
 namespace contactrom::rom {
 

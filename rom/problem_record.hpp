@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "fom/mesh.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/fom/mesh.hpp>
+#include <contactrom/fom/problem.hpp>
 
 namespace contactrom::rom {
 

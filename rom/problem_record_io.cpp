@@ -1,11 +1,11 @@
-#include "rom/problem_record_io.hpp"
+#include <contactrom/rom/problem_record_io.hpp>
 
 #include <array>
 #include <cmath>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
-#include "rom/hdf5_io.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/rom/hdf5_io.hpp>
 
 namespace contactrom::rom {
 namespace {

@@ -5,7 +5,7 @@
 /// contactrom::rom: it includes <hdf5.h>, which the installed package does not provide.
 #include <hdf5.h>
 
-#include "rom/problem_record.hpp"
+#include <contactrom/rom/problem_record.hpp>
 
 namespace contactrom::rom {
 

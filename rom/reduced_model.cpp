@@ -1,8 +1,8 @@
-#include "rom/reduced_model.hpp"
+#include <contactrom/rom/reduced_model.hpp>
 
-#include "rom/error_indicator.hpp"
+#include <contactrom/rom/error_indicator.hpp>
 
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 #include <Eigen/SparseCholesky>
 #include <algorithm>
@@ -10,9 +10,9 @@
 #include <cmath>
 #include <limits>
 
-#include "fom/active_set_solver.hpp"
-#include "rom/error_indicator.hpp"
-#include "rom/pod.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/rom/error_indicator.hpp>
+#include <contactrom/rom/pod.hpp>
 
 namespace contactrom::rom {
 namespace {

@@ -1,4 +1,4 @@
-#include "rom/snapshot_database.hpp"
+#include <contactrom/rom/snapshot_database.hpp>
 
 #include <fcntl.h>
 #include <hdf5.h>
@@ -17,10 +17,10 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "core/atomic_file.hpp"
-#include "core/format.hpp"
-#include "rom/hdf5_io.hpp"
-#include "rom/problem_record_io.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/rom/hdf5_io.hpp>
+#include <contactrom/rom/problem_record_io.hpp>
 
 namespace contactrom::rom {
 namespace {

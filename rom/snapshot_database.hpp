@@ -27,10 +27,10 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "fom/problem.hpp"
-#include "rom/problem_record.hpp"
-#include "rom/snapshot_blocks.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/problem_record.hpp>
+#include <contactrom/rom/snapshot_blocks.hpp>
 
 namespace contactrom::rom {
 

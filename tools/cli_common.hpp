@@ -8,13 +8,13 @@
 #include <nlohmann/json.hpp>
 #include <variant>
 
-#include "fom/input_values.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/fom/input_values.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::cli {
 

@@ -5,9 +5,9 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "core/atomic_file.hpp"
-#include "rom/database_merge.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/rom/database_merge.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 #include "tools/cli.hpp"
 
 namespace contactrom::cli {

@@ -8,8 +8,8 @@
 #include <string>
 
 #include "common/run_command.hpp"
-#include "fom/problem.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace contactrom::test {
 

@@ -18,12 +18,12 @@
 #include <sstream>
 
 #include "common/run_command.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/pairing_fixed_point.hpp"
-#include "rom/convex_hull.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/pairing_fixed_point.hpp>
+#include <contactrom/rom/convex_hull.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
 
 namespace rom = contactrom::rom;
 namespace fom = contactrom::fom;

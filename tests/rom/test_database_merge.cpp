@@ -8,9 +8,9 @@
 #include <filesystem>
 
 #include "common/database_checks.hpp"
-#include "fom/problem.hpp"
-#include "rom/database_merge.hpp"
-#include "rom/offline.hpp"
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/database_merge.hpp>
+#include <contactrom/rom/offline.hpp>
 
 namespace fs = std::filesystem;
 using contactrom::InputError;

@@ -12,10 +12,10 @@
 
 #include "common/cli_blas_threads.hpp"
 #include "common/database_checks.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/problem.hpp"
-#include "rom/offline.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace fs = std::filesystem;
 using contactrom::Status;

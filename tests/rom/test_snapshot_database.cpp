@@ -5,7 +5,7 @@
 #define BOOST_TEST_MODULE rom_snapshot_database
 #include <boost/test/unit_test.hpp>
 
-#include "rom/hdf5_io.hpp"
+#include <contactrom/rom/hdf5_io.hpp>
 
 #include <cstdio>
 #include <cstdlib>
@@ -18,9 +18,9 @@
 #include <unistd.h>
 
 #include "common/input_error.hpp"
-#include "core/errors.hpp"
-#include "fom/problem.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace fs = std::filesystem;
 using contactrom::InputError;
