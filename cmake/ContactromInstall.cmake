@@ -1,5 +1,5 @@
 # cmake --install build --prefix P installs:
-#   P/include/contactrom/{core,fom,rom,baselines}/*.hpp   (#include "rom/reduced_model.hpp")
+#   P/include/contactrom/{core,fom,rom,baselines}/*.hpp   (#include <contactrom/rom/reduced_model.hpp>)
 #   P/lib/libcontactrom_{core,fom,rom,baselines}.{a,so}
 #   P/bin/contactrom
 #   P/share/contactrom/{problems,meshes}

@@ -20,8 +20,7 @@ function(contactrom_add_library folder)
   file(MAKE_DIRECTORY ${PROJECT_BINARY_DIR}/include/contactrom)
   file(CREATE_LINK ${dir} ${PROJECT_BINARY_DIR}/include/contactrom/${folder} SYMBOLIC)
   target_include_directories(contactrom_${folder} PUBLIC $<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/include>
-    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
-    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/contactrom>)
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   set_target_properties(contactrom_${folder} PROPERTIES EXPORT_NAME ${folder}
                         CONTACTROM_PUBLIC_HEADERS "${public}")
   target_compile_features(contactrom_${folder} PUBLIC cxx_std_17)
