@@ -1,12 +1,12 @@
-#include "baselines/benchmark.hpp"
+#include <contactrom/baselines/benchmark.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <memory>
 
-#include "baselines/ipopt_qp.hpp"
-#include "baselines/online_methods.hpp"
-#include "fom/active_set_solver.hpp"
+#include <contactrom/baselines/ipopt_qp.hpp>
+#include <contactrom/baselines/online_methods.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
 
 namespace contactrom::baselines {
 namespace {

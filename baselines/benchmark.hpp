@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "rom/online_timing.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/rom/online_timing.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::baselines {
 

@@ -1,4 +1,4 @@
-#include "baselines/cpg.hpp"
+#include <contactrom/baselines/cpg.hpp>
 
 #include <chrono>
 #include <cmath>

@@ -34,11 +34,11 @@
 #include <string>
 #include <vector>
 
-#include "baselines/reduced_active_set.hpp"
-#include "core/errors.hpp"
-#include "core/nnls.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/baselines/reduced_active_set.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/nnls.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::baselines {
 

@@ -1,4 +1,4 @@
-#include "baselines/full_dictionary.hpp"
+#include <contactrom/baselines/full_dictionary.hpp>
 
 #include <numeric>
 

@@ -14,9 +14,9 @@
 /// \endcode
 #include <memory>
 
-#include "baselines/reduced_active_set.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/baselines/reduced_active_set.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::baselines {
 

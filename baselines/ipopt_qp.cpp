@@ -1,4 +1,4 @@
-#include "baselines/ipopt_qp.hpp"
+#include <contactrom/baselines/ipopt_qp.hpp>
 
 #include <IpIpoptApplication.hpp>
 #include <IpIpoptData.hpp>
@@ -16,12 +16,12 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
-#include "core/stopwatch.hpp"
-#include "fom/kkt.hpp"
-#include "fom/rigid_bodies.hpp"
-#include "fom/pairing_fixed_point.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/stopwatch.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/rigid_bodies.hpp>
+#include <contactrom/fom/pairing_fixed_point.hpp>
 
 namespace contactrom::baselines {
 

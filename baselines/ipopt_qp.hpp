@@ -6,8 +6,8 @@
 /// pairing fixed-point loop. Used to cross-validate the custom active-set solver.
 #include <memory>
 
-#include "fom/active_set_solver.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/problem.hpp>
 
 namespace contactrom::baselines {
 

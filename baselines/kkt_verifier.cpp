@@ -1,4 +1,4 @@
-#include "baselines/kkt_verifier.hpp"
+#include <contactrom/baselines/kkt_verifier.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -22,10 +22,10 @@
 #include <utility>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
 
 namespace contactrom::baselines {
 

@@ -1,10 +1,10 @@
-#include "baselines/online_methods.hpp"
+#include <contactrom/baselines/online_methods.hpp>
 
 #include <algorithm>
 
-#include "baselines/cpg.hpp"
-#include "baselines/full_dictionary.hpp"
-#include "baselines/reduced_active_set.hpp"
+#include <contactrom/baselines/cpg.hpp>
+#include <contactrom/baselines/full_dictionary.hpp>
+#include <contactrom/baselines/reduced_active_set.hpp>
 
 namespace contactrom::baselines {
 namespace {

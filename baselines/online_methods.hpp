@@ -12,7 +12,7 @@
 /// baseline_online_methods() once to the same effect.
 #include <vector>
 
-#include "rom/online_methods.hpp"
+#include <contactrom/rom/online_methods.hpp>
 
 namespace contactrom::baselines {
 

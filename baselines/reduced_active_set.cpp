@@ -1,6 +1,6 @@
-#include "baselines/reduced_active_set.hpp"
+#include <contactrom/baselines/reduced_active_set.hpp>
 
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 #include <Eigen/Cholesky>
 #include <algorithm>
@@ -8,10 +8,10 @@
 #include <cmath>
 #include <limits>
 
-#include "baselines/cpg.hpp"
-#include "baselines/full_dictionary.hpp"
-#include "baselines/online_methods.hpp"
-#include "rom/selection_history.hpp"
+#include <contactrom/baselines/cpg.hpp>
+#include <contactrom/baselines/full_dictionary.hpp>
+#include <contactrom/baselines/online_methods.hpp>
+#include <contactrom/rom/selection_history.hpp>
 
 namespace contactrom::baselines {
 

@@ -61,11 +61,11 @@
 #include <string>
 #include <vector>
 
-#include "core/nnls.hpp"
-#include "rom/greedy_active_set.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/support_rows.hpp"
+#include <contactrom/core/nnls.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/support_rows.hpp>
 
 namespace contactrom::baselines {
 

@@ -1,4 +1,4 @@
-#include "baselines/verification.hpp"
+#include <contactrom/baselines/verification.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -7,15 +7,15 @@
 #include <memory>
 #include <ostream>
 
-#include "baselines/cpg.hpp"
-#include "baselines/ipopt_qp.hpp"
-#include "baselines/reduced_active_set.hpp"
-#include "core/format.hpp"
-#include "core/atomic_file.hpp"
-#include "fom/parameter_space.hpp"
-#include "rom/greedy_active_set.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
+#include <contactrom/baselines/cpg.hpp>
+#include <contactrom/baselines/ipopt_qp.hpp>
+#include <contactrom/baselines/reduced_active_set.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/fom/parameter_space.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
 
 namespace contactrom::baselines {
 namespace {

@@ -28,11 +28,11 @@
 #include <string>
 #include <vector>
 
-#include "baselines/kkt_verifier.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/online_timing.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/baselines/kkt_verifier.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/online_timing.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::baselines {
 

@@ -1,5 +1,5 @@
 # cmake --install build --prefix P installs:
-#   P/include/contactrom/{core,fom,rom,baselines}/*.hpp   (#include "rom/reduced_model.hpp")
+#   P/include/contactrom/{core,fom,rom,baselines}/*.hpp   (#include <contactrom/rom/reduced_model.hpp>)
 #   P/lib/libcontactrom_{core,fom,rom,baselines}.{a,so}
 #   P/bin/contactrom
 #   P/share/contactrom/{problems,meshes}
@@ -7,9 +7,11 @@
 include(CMakePackageConfigHelpers)
 set(CONTACTROM_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/contactrom)
 
+# Only the public headers (contactrom_add_library's PUBLIC_HEADERS): the private ones
+# include dependencies the package does not provide (HDF5) or are internals.
 foreach(folder core fom rom baselines)
-  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/contactrom/${folder}
-          FILES_MATCHING PATTERN "*.hpp")
+  get_target_property(headers contactrom_${folder} CONTACTROM_PUBLIC_HEADERS)
+  install(FILES ${headers} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/contactrom/${folder})
 endforeach()
 install(TARGETS contactrom_core contactrom_fom contactrom_rom contactrom_baselines EXPORT contactromTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

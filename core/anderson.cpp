@@ -1,4 +1,4 @@
-#include "core/anderson.hpp"
+#include <contactrom/core/anderson.hpp>
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "core/atomic_file.hpp"
+#include <contactrom/core/atomic_file.hpp>
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -12,8 +12,8 @@
 #include <cstring>
 #include <fstream>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
 
 namespace contactrom {
 namespace {

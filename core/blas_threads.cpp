@@ -1,4 +1,4 @@
-#include "core/blas_threads.hpp"
+#include <contactrom/core/blas_threads.hpp>
 
 #include <dlfcn.h>
 

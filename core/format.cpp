@@ -1,4 +1,4 @@
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 #include <algorithm>
 #include <cstdio>

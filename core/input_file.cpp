@@ -1,4 +1,4 @@
-#include "core/input_file.hpp"
+#include <contactrom/core/input_file.hpp>
 
 #include <sys/stat.h>
 
@@ -7,8 +7,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
 
 namespace contactrom {
 

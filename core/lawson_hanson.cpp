@@ -1,4 +1,4 @@
-#include "core/lawson_hanson.hpp"
+#include <contactrom/core/lawson_hanson.hpp>
 
 #include <algorithm>
 

@@ -1,6 +1,6 @@
-#include "core/nnls.hpp"
+#include <contactrom/core/nnls.hpp>
 
-#include "core/lawson_hanson.hpp"
+#include <contactrom/core/lawson_hanson.hpp>
 
 #include <algorithm>
 #include <cmath>

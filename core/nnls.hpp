@@ -23,7 +23,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "core/errors.hpp"
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom {
 

@@ -1,4 +1,4 @@
-#include "core/parallel_for.hpp"
+#include <contactrom/core/parallel_for.hpp>
 
 #include <algorithm>
 #include <atomic>

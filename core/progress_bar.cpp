@@ -1,4 +1,4 @@
-#include "core/progress_bar.hpp"
+#include <contactrom/core/progress_bar.hpp>
 
 #include <cstdio>
 #include <ostream>

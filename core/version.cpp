@@ -1,4 +1,4 @@
-#include "core/version.hpp"
+#include <contactrom/core/version.hpp>
 
 namespace contactrom {
 

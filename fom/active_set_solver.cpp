@@ -1,13 +1,13 @@
-#include "fom/active_set_solver.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
 
 #include <Eigen/CholmodSupport>
 #include <chrono>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
-#include "core/stopwatch.hpp"
-#include "fom/pairing_fixed_point.hpp"
-#include "fom/rigid_bodies.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/stopwatch.hpp>
+#include <contactrom/fom/pairing_fixed_point.hpp>
+#include <contactrom/fom/rigid_bodies.hpp>
 
 namespace contactrom::fom {
 namespace {

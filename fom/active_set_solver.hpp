@@ -27,13 +27,13 @@
 #include <Eigen/Dense>
 #include <memory>
 
-#include "fom/contact_model.hpp"
-#include "fom/dual_qp.hpp"
-#include "fom/kkt.hpp"
-#include "fom/pairing_fixed_point.hpp"
-#include "fom/pairing_newton.hpp"
-#include "fom/problem.hpp"
-#include "fom/sparse_cholesky.hpp"
+#include <contactrom/fom/contact_model.hpp>
+#include <contactrom/fom/dual_qp.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/pairing_fixed_point.hpp>
+#include <contactrom/fom/pairing_newton.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/fom/sparse_cholesky.hpp>
 
 namespace contactrom::fom {
 

@@ -1,12 +1,12 @@
-#include "fom/contact_checks.hpp"
+#include <contactrom/fom/contact_checks.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
-#include "fom/contact_model.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/fom/contact_model.hpp>
 
 namespace contactrom::fom {
 namespace {

@@ -1,4 +1,4 @@
-#include "fom/contact_model.hpp"
+#include <contactrom/fom/contact_model.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <map>
 #include <string>
 
-#include "core/errors.hpp"
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::fom {
 namespace {

@@ -1,10 +1,10 @@
-#include "fom/contact_residuals.hpp"
+#include <contactrom/fom/contact_residuals.hpp>
 
 #include <cmath>
 #include <sstream>
 
-#include "core/format.hpp"
-#include "fom/contact_model.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/fom/contact_model.hpp>
 
 namespace contactrom::fom {
 

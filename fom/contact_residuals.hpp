@@ -20,8 +20,8 @@
 #include <Eigen/Dense>
 #include <string>
 
-#include "fom/contact_model.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/fom/contact_model.hpp>
+#include <contactrom/fom/problem.hpp>
 
 namespace contactrom::fom {
 

@@ -1,4 +1,4 @@
-#include "fom/data_directory.hpp"
+#include <contactrom/fom/data_directory.hpp>
 
 #include <dlfcn.h>
 

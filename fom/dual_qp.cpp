@@ -1,10 +1,10 @@
-#include "fom/dual_qp.hpp"
+#include <contactrom/fom/dual_qp.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <set>
 
-#include "core/nnls.hpp"
+#include <contactrom/core/nnls.hpp>
 
 namespace contactrom::fom {
 

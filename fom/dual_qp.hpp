@@ -18,7 +18,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "core/errors.hpp"
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::fom {
 

@@ -1,9 +1,9 @@
-#include "fom/elasticity.hpp"
+#include <contactrom/fom/elasticity.hpp>
 
 #include <cmath>
 #include <string>
 
-#include "core/errors.hpp"
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::fom {
 namespace {

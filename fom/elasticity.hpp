@@ -14,7 +14,7 @@
 #include <Eigen/Sparse>
 #include <vector>
 
-#include "fom/mesh.hpp"
+#include <contactrom/fom/mesh.hpp>
 
 namespace contactrom::fom {
 

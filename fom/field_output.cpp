@@ -1,13 +1,13 @@
-#include "fom/field_output.hpp"
+#include <contactrom/fom/field_output.hpp>
 
 #include <filesystem>
 #include <iomanip>
 #include <limits>
 
-#include "core/atomic_file.hpp"
-#include "core/errors.hpp"
-#include "fom/input_values.hpp"
-#include "fom/kkt.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/input_values.hpp>
+#include <contactrom/fom/kkt.hpp>
 
 namespace contactrom::fom {
 namespace {

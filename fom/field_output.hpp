@@ -9,8 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/atomic_file.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/fom/problem.hpp>
 
 namespace contactrom::fom {
 

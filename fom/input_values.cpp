@@ -1,4 +1,4 @@
-#include "fom/input_values.hpp"
+#include <contactrom/fom/input_values.hpp>
 
 #include <algorithm>
 #include <cerrno>
@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "core/format.hpp"
-#include "core/errors.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom {
 namespace {

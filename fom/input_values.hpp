@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "core/format.hpp"  // quoted()
-#include "fom/problem.hpp"
+#include <contactrom/core/format.hpp>  // quoted()
+#include <contactrom/fom/problem.hpp>
 
 namespace contactrom {
 

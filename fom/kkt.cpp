@@ -1,4 +1,4 @@
-#include "fom/kkt.hpp"
+#include <contactrom/fom/kkt.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -16,7 +16,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "fom/problem.hpp"
+#include <contactrom/fom/problem.hpp>
 
 namespace contactrom::fom {
 

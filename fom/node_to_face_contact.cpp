@@ -1,4 +1,4 @@
-#include "fom/node_to_face_contact.hpp"
+#include <contactrom/fom/node_to_face_contact.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <sstream>
 #include <string>
 
-#include "core/errors.hpp"
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::fom {
 namespace {

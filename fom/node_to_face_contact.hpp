@@ -9,7 +9,7 @@
 #include <array>
 #include <vector>
 
-#include "fom/contact_model.hpp"
+#include <contactrom/fom/contact_model.hpp>
 
 namespace contactrom::fom {
 

@@ -1,9 +1,9 @@
-#include "fom/pairing_fixed_point.hpp"
+#include <contactrom/fom/pairing_fixed_point.hpp>
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 namespace contactrom::fom {
 

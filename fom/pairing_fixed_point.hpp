@@ -51,9 +51,9 @@
 #include <type_traits>
 #include <utility>
 
-#include "core/anderson.hpp"
-#include "core/errors.hpp"
-#include "fom/contact_model.hpp"
+#include <contactrom/core/anderson.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/contact_model.hpp>
 
 namespace contactrom::fom {
 

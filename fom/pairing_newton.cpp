@@ -1,4 +1,4 @@
-#include "fom/pairing_newton.hpp"
+#include <contactrom/fom/pairing_newton.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -27,7 +27,7 @@
 /// fixed point as the plain iteration's (to its tolerance).
 #include <Eigen/Dense>
 
-#include "fom/contact_model.hpp"
+#include <contactrom/fom/contact_model.hpp>
 
 namespace contactrom::fom {
 

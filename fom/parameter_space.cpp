@@ -1,13 +1,13 @@
-#include "fom/parameter_space.hpp"
+#include <contactrom/fom/parameter_space.hpp>
 
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
-#include "core/format.hpp"
-#include "core/errors.hpp"
-#include "fom/input_values.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/input_values.hpp>
 
 namespace contactrom::fom {
 

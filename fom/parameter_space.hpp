@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 namespace contactrom::fom {
 

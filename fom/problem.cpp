@@ -1,4 +1,4 @@
-#include "fom/problem.hpp"
+#include <contactrom/fom/problem.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -6,10 +6,10 @@
 #include <set>
 #include <sstream>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
-#include "fom/contact_checks.hpp"
-#include "fom/node_to_face_contact.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/fom/contact_checks.hpp>
+#include <contactrom/fom/node_to_face_contact.hpp>
 
 namespace contactrom::fom {
 namespace {

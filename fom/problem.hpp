@@ -19,11 +19,11 @@
 #include <string>
 #include <vector>
 
-#include "fom/contact_model.hpp"
-#include "fom/elasticity.hpp"
-#include "fom/mesh.hpp"
-#include "fom/parameter_space.hpp"
-#include "fom/problem_file.hpp"
+#include <contactrom/fom/contact_model.hpp>
+#include <contactrom/fom/elasticity.hpp>
+#include <contactrom/fom/mesh.hpp>
+#include <contactrom/fom/parameter_space.hpp>
+#include <contactrom/fom/problem_file.hpp>
 
 namespace contactrom::fom {
 

@@ -1,6 +1,6 @@
-#include "fom/problem_file.hpp"
+#include <contactrom/fom/problem_file.hpp>
 
-#include "fom/data_directory.hpp"
+#include <contactrom/fom/data_directory.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -12,9 +12,9 @@
 #include <sstream>
 #include <toml++/toml.h>
 
-#include "core/format.hpp"
-#include "core/errors.hpp"
-#include "core/input_file.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/input_file.hpp>
 
 #ifndef CONTACTROM_DEFAULT_PROBLEM_DIR
 #define CONTACTROM_DEFAULT_PROBLEM_DIR "problems"

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "fom/mesh.hpp"
-#include "fom/parameter_space.hpp"
-#include "fom/sampling.hpp"
+#include <contactrom/fom/mesh.hpp>
+#include <contactrom/fom/parameter_space.hpp>
+#include <contactrom/fom/sampling.hpp>
 
 namespace contactrom::fom {
 

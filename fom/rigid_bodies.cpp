@@ -1,4 +1,4 @@
-#include "fom/rigid_bodies.hpp"
+#include <contactrom/fom/rigid_bodies.hpp>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <numeric>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
 
 namespace contactrom::fom {
 

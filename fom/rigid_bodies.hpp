@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "fom/problem.hpp"
+#include <contactrom/fom/problem.hpp>
 
 namespace contactrom::fom {
 

@@ -1,12 +1,12 @@
-#include "fom/sampling.hpp"
+#include <contactrom/fom/sampling.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <random>
 
-#include "core/format.hpp"
-#include "core/errors.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::fom {
 namespace {

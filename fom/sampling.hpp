@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "fom/parameter_space.hpp"
+#include <contactrom/fom/parameter_space.hpp>
 
 namespace contactrom::fom {
 

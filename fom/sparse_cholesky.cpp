@@ -1,4 +1,4 @@
-#include "fom/sparse_cholesky.hpp"
+#include <contactrom/fom/sparse_cholesky.hpp>
 
 #include <cholmod.h>
 

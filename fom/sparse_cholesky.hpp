@@ -17,7 +17,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/errors.hpp"
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::fom {
 

@@ -5,8 +5,8 @@
 #include <sstream>
 #include <string>
 
-#include "core/errors.hpp"
-#include "rom/dense_csv.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/rom/dense_csv.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));

@@ -1,4 +1,4 @@
-// libFuzzer target: the .msh reader (fom/mesh.cpp). The input is written to a .msh
+// libFuzzer target: the .msh reader (fom/gmsh_reader.cpp, with load_mesh's file check of fom/mesh.cpp). The input is written to a .msh
 // file and read as load_mesh reads it, but in this process (load_mesh forks a child
 // for gmsh, whose coverage libFuzzer could not see): the header check that keeps a
 // non-mesh from reaching gmsh's .geo parser, gmsh's MSH reader, and contactrom's
@@ -12,9 +12,10 @@
 #include <fstream>
 #include <string>
 
-// The reader's internals live in an anonymous namespace of fom/mesh.cpp: this
-// target is that translation unit plus the entry point (it links contactrom::core
-// and gmsh, not contactrom::fom, so mesh.cpp is compiled once, here).
+// load_mesh's file check lives in an anonymous namespace of fom/mesh.cpp: this
+// target is that translation unit and the reader's plus the entry point (it links
+// contactrom::core and gmsh, not contactrom::fom, so they are compiled once, here).
+#include "../fom/gmsh_reader.cpp"
 #include "../fom/mesh.cpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

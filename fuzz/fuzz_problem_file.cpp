@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "core/errors.hpp"
-#include "fom/problem_file.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/problem_file.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <string>
 
-#include "core/errors.hpp"
+#include <contactrom/core/errors.hpp>
 #include "hdf5_open_objects.hpp"
-#include "rom/reduced_model_file.hpp"
+#include <contactrom/rom/reduced_model_file.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::string path = "/tmp/contactrom_fuzz_reduced_model_" + std::to_string(::getpid()) + ".h5";

@@ -1,10 +1,10 @@
 // Python bindings of the full-order side: Problem (parameters, operators K(μ),
 // C(u), g(u)), FullOrderSolver and its results, KKT residuals and verification.
-#include "baselines/kkt_verifier.hpp"
-#include "core/format.hpp"
-#include "core/errors.hpp"
+#include <contactrom/baselines/kkt_verifier.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
 #include "python/bindings.hpp"
-#include "rom/offline.hpp"
+#include <contactrom/rom/offline.hpp>
 
 namespace contactrom::python {
 

@@ -4,11 +4,11 @@
 // invalid_input.
 #include <functional>
 
-#include "core/errors.hpp"
-#include "core/nnls.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/nnls.hpp>
 #include "python/bindings.hpp"
-#include "rom/focuss.hpp"
-#include "rom/omp.hpp"
+#include <contactrom/rom/focuss.hpp>
+#include <contactrom/rom/omp.hpp>
 
 namespace contactrom::python {
 namespace {

@@ -4,13 +4,13 @@
 #include <Python.h>
 #include <variant>
 
-#include "core/format.hpp"
-#include "core/errors.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
 #include "python/bindings.hpp"
-#include "rom/adaptive_training.hpp"
-#include "rom/fallback.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
+#include <contactrom/rom/adaptive_training.hpp>
+#include <contactrom/rom/fallback.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
 
 namespace contactrom::python {
 namespace {
@@ -129,11 +129,11 @@ void bind_rom(py::module_& m) {
 FOM snapshots at the training parameters with the problem they belong to. Arrays
 are read-only views with one snapshot per row, as in the HDF5 file.)doc")
       .def_property_readonly("problem", [](const Database& d) { return std::const_pointer_cast<fom::Problem>(d.problem); })
-      .def_property_readonly("problem_name", [](const Database& d) { return d.db->problem; })
+      .def_property_readonly("problem_name", [](const Database& d) { return d.db->problem.name; })
       .def_property_readonly("num_snapshots", [](const Database& d) { return d.db->num_snapshots(); })
       .def_property_readonly("num_dofs", [](const Database& d) { return d.db->num_dofs(); })
       .def_property_readonly("num_constraints", [](const Database& d) { return d.db->num_constraints(); })
-      .def_property_readonly("param_names", [](const Database& d) { return d.db->param_names; })
+      .def_property_readonly("param_names", [](const Database& d) { return d.db->problem.param_names; })
       .def_property_readonly("training_kind", [](const Database& d) { return d.db->training_kind; })
       .def_property_readonly("training_size", [](const Database& d) { return d.db->training_size; })
       .def_property_readonly(
@@ -193,7 +193,7 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
           },
           py::arg("path"), "Writes the HDF5 file (atomically), readable by the CLI and load_database.")
       .def("__repr__", [](const Database& d) {
-        return "<contactrom.SnapshotDatabase " + quoted(d.db->problem, 200) + ": " + std::to_string(d.db->num_snapshots()) +
+        return "<contactrom.SnapshotDatabase " + quoted(d.db->problem.name, 200) + ": " + std::to_string(d.db->num_snapshots()) +
                " snapshots>";
       });
 

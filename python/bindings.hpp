@@ -18,14 +18,14 @@
 #include <string>
 #include <vector>
 
-#include "baselines/ipopt_qp.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/reduced_model_file.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/baselines/ipopt_qp.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/reduced_model_file.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace contactrom::python {
 

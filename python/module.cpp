@@ -3,11 +3,11 @@
 // The pure-Python package `contactrom` (python/contactrom/) re-exports it.
 #include <cmath>
 
-#include "core/blas_threads.hpp"
-#include "core/format.hpp"
-#include "core/errors.hpp"
-#include "core/version.hpp"
-#include "fom/input_values.hpp"
+#include <contactrom/core/blas_threads.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/version.hpp>
+#include <contactrom/fom/input_values.hpp>
 #include "python/bindings.hpp"
 
 namespace contactrom::python {

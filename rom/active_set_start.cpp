@@ -1,4 +1,4 @@
-#include "rom/active_set_start.hpp"
+#include <contactrom/rom/active_set_start.hpp>
 
 #include <algorithm>
 

@@ -11,10 +11,10 @@
 #include <utility>
 #include <vector>
 
-#include "fom/problem.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/support_rows.hpp"
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/support_rows.hpp>
 
 namespace contactrom::rom {
 

@@ -1,13 +1,13 @@
-#include "rom/adaptive_training.hpp"
+#include <contactrom/rom/adaptive_training.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
-#include "core/format.hpp"
-#include "fom/sampling.hpp"
-#include "rom/database_merge.hpp"
-#include "rom/online_methods.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/fom/sampling.hpp>
+#include <contactrom/rom/database_merge.hpp>
+#include <contactrom/rom/online_methods.hpp>
 
 namespace contactrom::rom {
 namespace {

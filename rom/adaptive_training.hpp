@@ -40,11 +40,11 @@
 #include <string>
 #include <vector>
 
-#include "fom/problem.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace contactrom::rom {
 

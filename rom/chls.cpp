@@ -1,6 +1,6 @@
-#include "rom/chls.hpp"
+#include <contactrom/rom/chls.hpp>
 
-#include "core/lawson_hanson.hpp"
+#include <contactrom/core/lawson_hanson.hpp>
 
 #include <algorithm>
 #include <chrono>

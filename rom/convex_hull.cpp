@@ -1,6 +1,6 @@
-#include "rom/convex_hull.hpp"
+#include <contactrom/rom/convex_hull.hpp>
 
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -9,10 +9,10 @@
 #include <limits>
 #include <random>
 
-#include "fom/input_values.hpp"
-#include "fom/pairing_fixed_point.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/pod.hpp"
+#include <contactrom/fom/input_values.hpp>
+#include <contactrom/fom/pairing_fixed_point.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/pod.hpp>
 
 namespace contactrom::rom {
 

@@ -66,13 +66,13 @@
 #include <string>
 #include <vector>
 
-#include "fom/contact_model.hpp"
-#include "fom/problem.hpp"
-#include "rom/chls.hpp"
-#include "rom/focuss.hpp"
-#include "core/nnls.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/fom/contact_model.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/chls.hpp>
+#include <contactrom/rom/focuss.hpp>
+#include <contactrom/core/nnls.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::rom {
 

@@ -1,13 +1,13 @@
-#include "rom/convex_hull_report.hpp"
+#include <contactrom/rom/convex_hull_report.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <ostream>
 
-#include "core/atomic_file.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/parameter_space.hpp"
-#include "rom/offline.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/parameter_space.hpp>
+#include <contactrom/rom/offline.hpp>
 
 namespace contactrom::rom {
 namespace {
@@ -82,7 +82,7 @@ DatabaseChls chls_of_database(const SnapshotDatabase& db, const ChlsOptions& opt
 
 void write_chls_csv(const std::string& path, const SnapshotDatabase& db, const DatabaseChls& c) {
   write_file_atomically(path, [&](std::ostream& out) {
-    for (const std::string& name : db.param_names) out << name << ',';
+    for (const std::string& name : db.problem.param_names) out << name << ',';
     out << "chls_error,status,iterations,support\n";
     for (std::size_t k = 0; k < c.snapshots.size(); ++k) {
       const fom::Param mu = db.parameter(c.snapshots[k]);

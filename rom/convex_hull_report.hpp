@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
-#include "fom/kkt.hpp"
-#include "rom/chls.hpp"
-#include "rom/convex_hull.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_timing.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/rom/chls.hpp>
+#include <contactrom/rom/convex_hull.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_timing.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace contactrom::rom {
 

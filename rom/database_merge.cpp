@@ -1,9 +1,9 @@
-#include "rom/database_merge.hpp"
+#include <contactrom/rom/database_merge.hpp>
 
 #include <algorithm>
 #include <stdexcept>
 
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 namespace contactrom::rom {
 namespace {
@@ -15,9 +15,9 @@ void check_compatible(const SnapshotDatabase& a, const std::string& name_a, cons
     throw InputError("cannot merge " + quoted(name_b, 200) + " into " + quoted(name_a, 200) + ": " + what + " " + vb + " differs from " +
                      va + "; expected databases of the same problem and training set");
   };
-  if (a.problem != b.problem) differ("problem", a.problem, b.problem);
-  if (a.mesh_fingerprint != b.mesh_fingerprint) differ("mesh fingerprint", a.mesh_fingerprint, b.mesh_fingerprint);
-  if (a.param_names != b.param_names) differ("parameter names", join(a.param_names, ","), join(b.param_names, ","));
+  if (a.problem.name != b.problem.name) differ("problem", a.problem.name, b.problem.name);
+  if (a.problem.fingerprint != b.problem.fingerprint) differ("mesh fingerprint", a.problem.fingerprint, b.problem.fingerprint);
+  if (a.problem.param_names != b.problem.param_names) differ("parameter names", join(a.problem.param_names, ","), join(b.problem.param_names, ","));
   if (a.training_kind != b.training_kind || a.training_size != b.training_size)
     differ("training set", a.training_kind + " " + std::to_string(a.training_size),
            b.training_kind + " " + std::to_string(b.training_size));

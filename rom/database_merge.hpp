@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "rom/snapshot_database.hpp"
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace contactrom::rom {
 

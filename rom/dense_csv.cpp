@@ -1,4 +1,4 @@
-#include "rom/dense_csv.hpp"
+#include <contactrom/rom/dense_csv.hpp>
 
 #include <cmath>
 #include <cstdlib>
@@ -6,10 +6,10 @@
 #include <istream>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
-#include "core/input_file.hpp"
-#include "fom/input_values.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/input_file.hpp>
+#include <contactrom/fom/input_values.hpp>
 
 namespace contactrom::rom {
 

@@ -1,11 +1,11 @@
-#include "rom/error_indicator.hpp"
+#include <contactrom/rom/error_indicator.hpp>
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/stopwatch.hpp"
-#include "fom/kkt.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/core/stopwatch.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::rom {
 namespace {

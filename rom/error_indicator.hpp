@@ -38,10 +38,10 @@
 #include <memory>
 #include <string>
 
-#include "core/errors.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/contact_model.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/contact_model.hpp>
+#include <contactrom/fom/problem.hpp>
 
 namespace contactrom::rom {
 

@@ -1,8 +1,8 @@
-#include "rom/fallback.hpp"
+#include <contactrom/rom/fallback.hpp>
 
-#include "core/format.hpp"
-#include "fom/contact_residuals.hpp"
-#include "fom/kkt.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/fom/contact_residuals.hpp>
+#include <contactrom/fom/kkt.hpp>
 
 namespace contactrom::rom {
 

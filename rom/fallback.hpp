@@ -14,8 +14,8 @@
 #include <mutex>
 #include <string>
 
-#include "fom/active_set_solver.hpp"
-#include "rom/online_solver.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/rom/online_solver.hpp>
 
 namespace contactrom::rom {
 

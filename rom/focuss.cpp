@@ -1,4 +1,4 @@
-#include "rom/focuss.hpp"
+#include <contactrom/rom/focuss.hpp>
 
 #include <algorithm>
 #include <cmath>

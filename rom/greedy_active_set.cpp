@@ -1,4 +1,4 @@
-#include "rom/greedy_active_set.hpp"
+#include <contactrom/rom/greedy_active_set.hpp>
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
@@ -9,8 +9,8 @@
 #include <string>
 #include <utility>
 
-#include "core/anderson.hpp"
-#include "rom/selection_history.hpp"
+#include <contactrom/core/anderson.hpp>
+#include <contactrom/rom/selection_history.hpp>
 
 namespace contactrom::rom {
 

@@ -60,11 +60,11 @@
 /// k_max counts the rebuilds, GreedyOptions::max_solves the one-change steps.
 #include <iosfwd>
 
-#include "core/anderson.hpp"
-#include "rom/active_set_start.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/support_rows.hpp"
+#include <contactrom/core/anderson.hpp>
+#include <contactrom/rom/active_set_start.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/support_rows.hpp>
 
 namespace contactrom::rom {
 

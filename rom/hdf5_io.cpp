@@ -1,4 +1,4 @@
-#include "rom/hdf5_io.hpp"
+#include <contactrom/rom/hdf5_io.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -6,9 +6,9 @@
 #include <fstream>
 #include <limits>
 
-#include "core/format.hpp"
-#include "core/atomic_file.hpp"
-#include "core/errors.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::rom::hdf5 {
 namespace {

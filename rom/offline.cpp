@@ -1,4 +1,4 @@
-#include "rom/offline.hpp"
+#include <contactrom/rom/offline.hpp>
 
 #include <algorithm>
 #include <memory>
@@ -14,7 +14,7 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
   const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
 
   SnapshotDatabase db;
-  describe_problem(problem, db);
+  db.problem = record_problem(problem);
   db.created_by = options.created_by;
   db.training_kind = training_kind;
   db.training_size = training_size;

@@ -22,12 +22,12 @@
 #include <string>
 #include <vector>
 
-#include "core/parallel_for.hpp"
-#include "core/progress_bar.hpp"
-#include "core/version.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/problem.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/parallel_for.hpp>
+#include <contactrom/core/progress_bar.hpp>
+#include <contactrom/core/version.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace contactrom::rom {
 

@@ -1,4 +1,4 @@
-#include "rom/offline_mpi.hpp"
+#include <contactrom/rom/offline_mpi.hpp>
 
 #include <mpi.h>
 

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "rom/offline.hpp"
+#include <contactrom/rom/offline.hpp>
 
 namespace contactrom::rom::mpi {
 

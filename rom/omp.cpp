@@ -1,4 +1,4 @@
-#include "rom/omp.hpp"
+#include <contactrom/rom/omp.hpp>
 
 #include <algorithm>
 #include <cmath>

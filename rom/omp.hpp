@@ -12,8 +12,8 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/nnls.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/nnls.hpp>
 
 namespace contactrom::rom {
 

@@ -1,4 +1,4 @@
-#include "rom/online_evaluation.hpp"
+#include <contactrom/rom/online_evaluation.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -6,9 +6,9 @@
 #include <limits>
 #include <ostream>
 
-#include "core/atomic_file.hpp"
-#include "core/format.hpp"
-#include "rom/online_timing.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/rom/online_timing.hpp>
 
 namespace contactrom::rom {
 

@@ -15,12 +15,12 @@
 #include <variant>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_solver.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_solver.hpp>
 
 namespace contactrom::rom {
 

@@ -1,13 +1,13 @@
-#include "rom/online_methods.hpp"
+#include <contactrom/rom/online_methods.hpp>
 
 #include <algorithm>
 #include <mutex>
 #include <sstream>
 
-#include "core/format.hpp"
-#include "fom/input_values.hpp"
-#include "rom/convex_hull.hpp"
-#include "rom/greedy_active_set.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/fom/input_values.hpp>
+#include <contactrom/rom/convex_hull.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
 
 namespace contactrom::rom {
 namespace {

@@ -34,9 +34,9 @@
 #include <string>
 #include <vector>
 
-#include "fom/input_values.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/fom/input_values.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::rom {
 

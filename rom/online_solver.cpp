@@ -1,9 +1,9 @@
-#include "rom/online_solver.hpp"
+#include <contactrom/rom/online_solver.hpp>
 
 #include <chrono>
 
-#include "fom/kkt.hpp"
-#include "rom/error_indicator.hpp"
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/rom/error_indicator.hpp>
 
 namespace contactrom::rom {
 

@@ -22,12 +22,12 @@
 #include <type_traits>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
-#include "fom/contact_residuals.hpp"
-#include "fom/problem.hpp"
-#include "rom/option_table.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/fom/contact_residuals.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/option_table.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::rom {
 

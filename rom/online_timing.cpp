@@ -1,4 +1,4 @@
-#include "rom/online_timing.hpp"
+#include <contactrom/rom/online_timing.hpp>
 
 #include <algorithm>
 #include <chrono>

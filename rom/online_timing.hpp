@@ -5,9 +5,9 @@
 /// `contactrom bench`, `verify --bench` and `hull-report --time`.
 #include <vector>
 
-#include "fom/active_set_solver.hpp"
-#include "fom/problem.hpp"
-#include "rom/online_solver.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/online_solver.hpp>
 
 namespace contactrom::rom {
 

@@ -1,8 +1,8 @@
-#include "rom/option_table.hpp"
+#include <contactrom/rom/option_table.hpp>
 
 #include <cmath>
 
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 namespace contactrom::rom {
 

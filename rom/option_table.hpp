@@ -24,8 +24,8 @@
 #include <variant>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "fom/input_values.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/input_values.hpp>
 
 namespace contactrom::rom {
 

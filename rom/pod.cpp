@@ -1,4 +1,4 @@
-#include "rom/pod.hpp"
+#include <contactrom/rom/pod.hpp>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
@@ -7,7 +7,7 @@
 #include <functional>
 #include <limits>
 
-#include "core/parallel_for.hpp"
+#include <contactrom/core/parallel_for.hpp>
 
 namespace contactrom::rom {
 

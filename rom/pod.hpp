@@ -45,8 +45,8 @@
 #include <Eigen/Dense>
 #include <cstdint>
 
-#include "core/errors.hpp"
-#include "rom/snapshot_blocks.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/rom/snapshot_blocks.hpp>
 
 namespace contactrom::rom {
 

@@ -1,4 +1,4 @@
-#include "rom/pod_mpi.hpp"
+#include <contactrom/rom/pod_mpi.hpp>
 
 #include <mpi.h>
 

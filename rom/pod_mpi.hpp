@@ -12,7 +12,7 @@
 /// decomposes the same small matrices; rank 0 gathers the basis and builds the
 /// reduced model. The sums are the serial ones regrouped: the basis agrees with the
 /// serial run to rounding (singular values to about 1e-12 relative).
-#include "rom/pod.hpp"
+#include <contactrom/rom/pod.hpp>
 
 namespace contactrom::rom::mpi {
 

@@ -3,16 +3,15 @@
 /// \brief The problem part of the files contactrom writes (snapshot databases and
 /// reduced models): the problem file's text, the mesh, the contact rows and the
 /// lifting terms — enough to rebuild the fom::Problem without the .toml and .geo
-/// files and without gmsh. Layout in docs/database_format.md ("The problem").
-#include <hdf5.h>
-
+/// files and without gmsh. Layout in docs/database_format.md ("The problem"); read
+/// and written by the library's HDF5 layer (not part of the installed headers).
 #include <Eigen/Dense>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "fom/mesh.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/fom/mesh.hpp>
+#include <contactrom/fom/problem.hpp>
 
 namespace contactrom::rom {
 
@@ -31,16 +30,6 @@ struct ProblemRecord {
 
 /// \brief The record of `problem`.
 ProblemRecord record_problem(const fom::Problem& problem);
-
-/// \brief Writes the attributes `problem`, `mesh_fingerprint`, `param_names` on `file`
-/// and the datasets /problem_file, /contact/points, /contact/weights, /lifting, /mesh/….
-/// \throws hdf5::Failure
-void write_problem_record(hid_t file, hid_t dcpl, const ProblemRecord& record);
-
-/// \brief Reads what write_problem_record wrote, checking the contact datasets
-/// against `num_constraints` rows, the lifting against `num_dofs`, and every mesh
-/// index against the node count. \throws hdf5::Failure or hdf5::Refused
-ProblemRecord read_problem_record(hid_t file, hsize_t num_constraints, hsize_t num_dofs);
 
 /// \brief Rebuilds the problem from a record (problem-file text and mesh, no gmsh;
 /// `rope` by name) and checks that it is the recorded discretisation (fingerprint,

@@ -1,8 +1,8 @@
-#include "rom/reduced_model.hpp"
+#include <contactrom/rom/reduced_model.hpp>
 
-#include "rom/error_indicator.hpp"
+#include <contactrom/rom/error_indicator.hpp>
 
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 #include <Eigen/SparseCholesky>
 #include <algorithm>
@@ -10,9 +10,9 @@
 #include <cmath>
 #include <limits>
 
-#include "fom/active_set_solver.hpp"
-#include "rom/error_indicator.hpp"
-#include "rom/pod.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/rom/error_indicator.hpp>
+#include <contactrom/rom/pod.hpp>
 
 namespace contactrom::rom {
 namespace {
@@ -73,7 +73,7 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
   const auto t0 = std::chrono::steady_clock::now();
   const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
   if (db.num_dofs() != nd || db.num_constraints() != nc)
-    throw InputError("database of problem " + quoted(db.problem, 200) + " has " + std::to_string(db.num_dofs()) + " dofs and " +
+    throw InputError("database of problem " + quoted(db.problem.name, 200) + " has " + std::to_string(db.num_dofs()) + " dofs and " +
                      std::to_string(db.num_constraints()) + " contact rows, but " + problem.name() + " has " +
                      std::to_string(nd) + " and " + std::to_string(nc));
   if (!(options.delta >= 0.0))
@@ -81,7 +81,7 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
 
   m_dict_snapshots = reduced_model_columns(db, options);
   if (m_dict_snapshots.empty())
-    throw InputError("database of problem " + quoted(db.problem, 200) + " holds no successful snapshot");
+    throw InputError("database of problem " + quoted(db.problem.name, 200) + " holds no successful snapshot");
   const int m = static_cast<int>(m_dict_snapshots.size());
   const int nt = problem.num_load_terms();
   m_offset = reduced_model_offsets(problem, options.lifting);
@@ -110,7 +110,7 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
   }
   m_pod_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_pod).count();
   if (pod.info() != Status::Success)
-    throw InputError("POD of the primal snapshots of " + quoted(db.problem, 200) + " failed (" + to_string(pod.info()) + ")");
+    throw InputError("POD of the primal snapshots of " + quoted(db.problem.name, 200) + " failed (" + to_string(pod.info()) + ")");
   m_phi = pod.basis();
   m_sigma = pod.singular_values();
   const std::vector<char>& dirichlet = problem.is_dirichlet();

@@ -22,9 +22,9 @@
 #include <mutex>
 #include <vector>
 
-#include "fom/problem.hpp"
-#include "rom/pod.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/pod.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace contactrom::rom {
 

@@ -1,4 +1,4 @@
-#include "rom/reduced_model_file.hpp"
+#include <contactrom/rom/reduced_model_file.hpp>
 
 #include <hdf5.h>
 
@@ -8,16 +8,16 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/format.hpp"
-#include "core/atomic_file.hpp"
-#include "core/errors.hpp"
-#include "core/input_file.hpp"
-#include "core/version.hpp"
-#include "fom/kkt.hpp"
-#include "rom/dense_csv.hpp"
-#include "rom/hdf5_io.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/problem_record.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/input_file.hpp>
+#include <contactrom/core/version.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/rom/dense_csv.hpp>
+#include <contactrom/rom/hdf5_io.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/problem_record_io.hpp>
 
 namespace contactrom::rom {
 namespace {

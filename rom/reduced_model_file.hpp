@@ -21,12 +21,12 @@
 #include <memory>
 #include <string>
 
-#include "core/atomic_file.hpp"
-#include "fom/problem.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace contactrom::rom {
 

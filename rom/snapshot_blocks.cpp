@@ -1,12 +1,12 @@
-#include "rom/snapshot_blocks.hpp"
+#include <contactrom/rom/snapshot_blocks.hpp>
 
 #include <hdf5.h>
 
 #include <cmath>
 
-#include "core/errors.hpp"
-#include "core/format.hpp"
-#include "rom/hdf5_io.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/rom/hdf5_io.hpp>
 
 namespace contactrom::rom {
 

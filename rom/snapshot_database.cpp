@@ -1,4 +1,4 @@
-#include "rom/snapshot_database.hpp"
+#include <contactrom/rom/snapshot_database.hpp>
 
 #include <fcntl.h>
 #include <hdf5.h>
@@ -17,10 +17,10 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "core/atomic_file.hpp"
-#include "core/format.hpp"
-#include "rom/hdf5_io.hpp"
-#include "rom/problem_record.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/rom/hdf5_io.hpp>
+#include <contactrom/rom/problem_record_io.hpp>
 
 namespace contactrom::rom {
 namespace {
@@ -70,31 +70,6 @@ std::vector<T> read_vector(hid_t file, const char* name, hsize_t expected) {
   if constexpr (std::is_same_v<T, int>) hdf5::read_int_dataset(file, name, out, rows, cols);
   else hdf5::read_double_dataset(file, name, out, rows, cols);
   return out;
-}
-
-/// The problem part of `db` as a record (and back).
-ProblemRecord problem_record(const SnapshotDatabase& db) {
-  ProblemRecord r;
-  r.name = db.problem;
-  r.fingerprint = db.mesh_fingerprint;
-  r.param_names = db.param_names;
-  r.text = db.problem_text;
-  r.mesh = db.mesh;
-  r.contact_points = db.contact_points;
-  r.contact_weights = db.contact_weights;
-  r.lifting_terms = db.lifting_terms;
-  return r;
-}
-
-void set_problem_record(SnapshotDatabase& db, ProblemRecord r) {
-  db.problem = std::move(r.name);
-  db.mesh_fingerprint = std::move(r.fingerprint);
-  db.param_names = std::move(r.param_names);
-  db.problem_text = std::move(r.text);
-  db.mesh = std::move(r.mesh);
-  db.contact_points = std::move(r.contact_points);
-  db.contact_weights = std::move(r.contact_weights);
-  db.lifting_terms = std::move(r.lifting_terms);
 }
 
 /// Refuses values that no offline run writes: non-finite numbers, negative
@@ -220,7 +195,7 @@ void write_fields(hid_t f, hid_t dcpl, const SnapshotDatabase& db, const std::fu
   write_dataset(f, dcpl, "iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, db.iterations.data());
   write_dataset(f, dcpl, "pairing_iterations", H5T_STD_I32LE, H5T_NATIVE_INT, 1, n, 0, db.pairing_iterations.data());
   write_dataset(f, dcpl, "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, n, 0, db.time_s.data());
-  write_problem_record(f, dcpl, problem_record(db));
+  write_problem_record(f, dcpl, db.problem);
   if (db.training_kind == "adaptive") write_adaptive(f, dcpl, db.adaptive);
 }
 
@@ -389,7 +364,7 @@ void write_database(const std::string& path, const SnapshotDatabase& db) {
   if (db.dual.cols() != db.parameters.cols() || stored != n || db.status.size() != n || db.iterations.size() != n ||
       db.pairing_iterations.size() != n || db.time_s.size() != n)
     throw std::invalid_argument("write_database: inconsistent snapshot counts");
-  if (db.lifting_terms.rows() != db.primal.rows())
+  if (db.problem.lifting_terms.rows() != db.primal.rows())
     throw std::invalid_argument("write_database: lifting terms and snapshots differ in size");
   if (!db.primal_in_memory()) {  // snapshot by snapshot through a temporary file
     check_output_path(path);
@@ -536,11 +511,11 @@ SnapshotDatabase read_database(const std::string& path, bool load_primal) {
         throw hdf5::Refused("dataset /status holds the unknown status code " + std::to_string(s));
       db.status.push_back(static_cast<Status>(s));
     }
-    set_problem_record(db, read_problem_record(f, static_cast<hsize_t>(db.dual.rows()),
+    db.problem = (read_problem_record(f, static_cast<hsize_t>(db.dual.rows()),
                                                static_cast<hsize_t>(db.primal.rows())));
-    if (db.parameters.rows() != static_cast<Eigen::Index>(db.param_names.size()))
+    if (db.parameters.rows() != static_cast<Eigen::Index>(db.problem.param_names.size()))
       throw hdf5::Refused("dataset /parameters has " + std::to_string(db.parameters.rows()) +
-                        " columns but param_names lists " + std::to_string(db.param_names.size()));
+                        " columns but param_names lists " + std::to_string(db.problem.param_names.size()));
     if (db.training_kind != "train" && db.training_kind != "level" && db.training_kind != "list" &&
         db.training_kind != "adaptive")
       throw hdf5::Refused("attribute training_kind is " + quoted(db.training_kind, 200) +
@@ -566,10 +541,10 @@ void check_database(const SnapshotDatabase& db, const fom::Problem& problem, con
 }
 
 void check_database_problem(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path) {
-  if (db.problem != problem.name())
-    throw InputError("database " + quoted(path, 200) + " was built for problem " + quoted(db.problem, 200) + ", not " + quoted(problem.name(), 200));
-  if (db.mesh_fingerprint != problem.fingerprint())
-    throw InputError("database " + quoted(path, 200) + " was built for mesh fingerprint " + db.mesh_fingerprint +
+  if (db.problem.name != problem.name())
+    throw InputError("database " + quoted(path, 200) + " was built for problem " + quoted(db.problem.name, 200) + ", not " + quoted(problem.name(), 200));
+  if (db.problem.fingerprint != problem.fingerprint())
+    throw InputError("database " + quoted(path, 200) + " was built for mesh fingerprint " + db.problem.fingerprint +
                      " but the current " + problem.name() + " mesh is " + problem.fingerprint() +
                      "; rebuild it with contactrom offline");
   if (db.num_dofs() != problem.num_dofs() || db.num_constraints() != problem.contact().num_constraints() ||
@@ -627,12 +602,8 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
   }
 }
 
-void describe_problem(const fom::Problem& problem, SnapshotDatabase& db) {
-  set_problem_record(db, record_problem(problem));
-}
-
 std::unique_ptr<fom::Problem> rebuild_database_problem(const SnapshotDatabase& db, const std::string& path) {
-  return rebuild_problem(problem_record(db), "database " + quoted(path, 200));
+  return rebuild_problem(db.problem, "database " + quoted(path, 200));
 }
 
 std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, const std::string& path) {

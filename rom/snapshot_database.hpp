@@ -27,9 +27,10 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "fom/problem.hpp"
-#include "rom/snapshot_blocks.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/problem_record.hpp>
+#include <contactrom/rom/snapshot_blocks.hpp>
 
 namespace contactrom::rom {
 
@@ -62,14 +63,9 @@ struct AdaptiveRecord {
 
 /// \brief FOM snapshots at the training parameters; see the file comment.
 struct SnapshotDatabase {
-  std::string problem;           ///< problem name
-  /// Text of the problem file the snapshots were computed for ("" for `rope`, which is built in).
-  std::string problem_text;
-  std::shared_ptr<const fom::Mesh> mesh;  ///< the (refined) mesh; null for `rope`
-  Eigen::MatrixXd contact_points;         ///< reference coordinates of the constraint rows (dim × n_c)
-  Eigen::VectorXd contact_weights;        ///< tributary lengths of the constraint rows
-  Eigen::MatrixXd lifting_terms;          ///< n_dofs × n_terms: the lifting basis L_k
-  std::string mesh_fingerprint;  ///< Problem::fingerprint() of the discretisation
+  /// The problem the snapshots were computed for: name, fingerprint, parameter
+  /// names, problem-file text, mesh, contact rows and lifting terms.
+  ProblemRecord problem;
   std::string created_by;        ///< program and version that wrote the file
   /// How the training set was selected: "train" (`--train n`), "level" (`--level n`),
   /// "list" (the problem's listed points) or "adaptive" (offline --adaptive: the
@@ -79,7 +75,6 @@ struct SnapshotDatabase {
   int training_size = 0;                  ///< n of `--train n` or `--level n`
   /// With training_kind "adaptive": how the run went; empty otherwise.
   AdaptiveRecord adaptive;
-  std::vector<std::string> param_names;   ///< names of the parameter components
   Eigen::MatrixXd parameters;             ///< n_params × n_snap, column j = μ_j
   /// n_dofs × n_snap, u(μ_j) − u_lift(μ_j) (zero on Dirichlet dofs); n_dofs × 0 when
   /// they are left on disk (primal_files).
@@ -199,10 +194,6 @@ std::unique_ptr<fom::Problem> rebuild_database_problem(const SnapshotDatabase& d
 /// \brief rebuild_database_problem(), then check_database(): the database must be
 /// that problem's complete training set, in order.
 std::unique_ptr<fom::Problem> problem_from_database(const SnapshotDatabase& db, const std::string& path);
-
-/// \brief Fills the problem fields of `db` (name, fingerprint, text, mesh, contact
-/// points, lifting terms) from `problem`.
-void describe_problem(const fom::Problem& problem, SnapshotDatabase& db);
 
 /// \brief Checks that every stored parameter lies in `problem`'s range and that
 /// the snapshots are those of the training set named by the database's

@@ -1,4 +1,4 @@
-#include "rom/support_rows.hpp"
+#include <contactrom/rom/support_rows.hpp>
 
 #include <algorithm>
 #include <utility>

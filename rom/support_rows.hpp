@@ -7,8 +7,8 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "fom/contact_model.hpp"
-#include "fom/contact_residuals.hpp"
+#include <contactrom/fom/contact_model.hpp>
+#include <contactrom/fom/contact_residuals.hpp>
 
 namespace contactrom::rom {
 

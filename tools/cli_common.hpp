@@ -2,18 +2,19 @@
 /// \file cli_common.hpp
 /// \brief Small helpers shared by the subcommands.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <variant>
 
-#include "fom/input_values.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_solver.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/fom/input_values.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::cli {
 
@@ -56,6 +57,36 @@ CLI::Option* add_setting(CLI::App* sub, const std::string& name, T& target, cons
   else
     return add_integer(sub, name, target, help, static_cast<long long>(spec.range.lower),
                        static_cast<long long>(std::min(spec.range.upper, 9e18)));
+}
+
+/// Adds flag `name` that turns off the flag option `key` of an options table (e.g.
+/// --no-polish for polish): `target` starts at the struct's default; help and
+/// default are the declaration's.
+template <class S>
+CLI::Option* add_setting_negation(CLI::App* sub, const std::string& name, bool& target, const rom::OptionTable<S>& table,
+                                  const std::string& key) {
+  const rom::OptionSpec& spec = table.find(key)->spec;
+  return sub->add_flag_callback(name, [&target] { target = false; },
+                                "off: " + spec.help + " (default " + spec.default_value + "; as --option " + key + "=false)");
+}
+
+/// Help of a setting that several online methods declare (e.g. init): the methods
+/// that take it, grouped by what they accept and their default, as declared.
+inline std::string shared_setting_help(const std::string& key) {
+  std::vector<std::pair<std::string, std::string>> groups;  // (methods, accepted values and default)
+  for (const rom::OnlineMethod& m : rom::online_methods())
+    for (const rom::OptionSpec& s : m.options) {
+      if (s.key != key) continue;
+      const std::string values = rom::describe_option_type(s) + "; default " + s.default_value;
+      auto g = std::find_if(groups.begin(), groups.end(), [&](const auto& x) { return x.second == values; });
+      if (g == groups.end())
+        groups.emplace_back(m.name, values);
+      else
+        g->first += "/" + m.name;
+    }
+  std::string out;
+  for (const auto& [methods, values] : groups) out += (out.empty() ? "" : "; ") + methods + ": " + values;
+  return out;
 }
 
 /// The default of the option `key` of the active-set settings, typed as T.

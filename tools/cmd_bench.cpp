@@ -30,13 +30,13 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "baselines/benchmark.hpp"
-#include "fom/active_set_solver.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_timing.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/baselines/benchmark.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_timing.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 

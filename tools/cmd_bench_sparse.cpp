@@ -20,10 +20,10 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/nnls.hpp"
-#include "rom/focuss.hpp"
-#include "rom/omp.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/nnls.hpp>
+#include <contactrom/rom/focuss.hpp>
+#include <contactrom/rom/omp.hpp>
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 

@@ -24,20 +24,21 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 
-#include "core/atomic_file.hpp"
-#include "core/errors.hpp"
-#include "core/format.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "rom/chls.hpp"
-#include "rom/convex_hull.hpp"
-#include "rom/convex_hull_report.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/rom/chls.hpp>
+#include <contactrom/rom/convex_hull.hpp>
+#include <contactrom/rom/convex_hull_report.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 
@@ -66,7 +67,7 @@ void run_chls(const ChlsArgs& a) {
   };
   if (!a.out.empty()) rom::write_chls_csv(a.out, db, chls);
   nlohmann::json j;
-  j["problem"] = db.problem;
+  j["problem"] = db.problem.name;
   j["chls_error"] = std::vector<double>(r.errors.data(), r.errors.data() + r.errors.size());
   nlohmann::json params = nlohmann::json::array();
   for (int s : used) params.push_back(param_json(db.parameter(s)));
@@ -76,7 +77,7 @@ void run_chls(const ChlsArgs& a) {
     std::cout << j.dump() << std::endl;
     return;
   }
-  std::cout << "CHLS (leave-one-out convex hull least squares) of " << used.size() << " " << db.problem
+  std::cout << "CHLS (leave-one-out convex hull least squares) of " << used.size() << " " << db.problem.name
             << " primal snapshots\n"
             << std::setprecision(3);
   for (std::size_t k = 0; k < used.size(); ++k)
@@ -108,7 +109,7 @@ struct HullArgs {
   double delta = 1e-8, basis_delta = kDefaults.basis_delta, sum_weight = kDefaults.sum_weight;
   int rank_l = kDefaults.rank_l, threads = 0, repeats = 3, max_pairing_iterations = kDefaults.max_pairing_iterations;
   long long seed = static_cast<long long>(kDefaults.seed);
-  bool no_polish = false, json = false, time = false;
+  bool polish = kDefaults.polish, json = false, time = false;
   std::vector<std::string> options;
 };
 
@@ -120,23 +121,21 @@ void run_hull_report(const HullArgs& a) {
   rom::ReducedModelOptions model_options;
   model_options.delta = a.delta;
   const rom::ReducedModel model(*problem, db, model_options);
-  // One parsing path for the settings: the flags and every --option KEY=VALUE go
-  // through OnlineSolverOptions::extra, as for `contactrom online`.
-  rom::OnlineSolverOptions generic;
-  generic.extra["basis"] = a.basis;
-  generic.extra["basis_delta"] = format_number(a.basis_delta);
-  generic.extra["rank_l"] = std::to_string(a.rank_l);
-  generic.extra["seed"] = std::to_string(a.seed);
-  generic.extra["sum_weight"] = format_number(a.sum_weight);
-  generic.extra["polish"] = a.no_polish ? "0" : "1";
-  generic.extra["max_pairing_iterations"] = std::to_string(a.max_pairing_iterations);
+  // One parsing path for the settings: the flags and every --option KEY=VALUE are
+  // read as the method's key/value settings, as for `contactrom online`.
+  std::map<std::string, std::string> values{{"basis", a.basis},
+                                            {"basis_delta", format_number(a.basis_delta)},
+                                            {"rank_l", std::to_string(a.rank_l)},
+                                            {"seed", std::to_string(a.seed)},
+                                            {"sum_weight", format_number(a.sum_weight)},
+                                            {"polish", a.polish ? "true" : "false"},
+                                            {"max_pairing_iterations", std::to_string(a.max_pairing_iterations)}};
   for (const std::string& kv : a.options) {
     auto [key, value] = rom::split_option(kv);
-    generic.extra[key] = value;
+    values[key] = value;
   }
-  rom::validate_online_options("convex-hull", generic);
-  const rom::ConvexHullOptions options = rom::convex_hull_options(generic);
-  const rom::ConvexHullSolver solver(model, options);
+  const auto online_solver = rom::make_online_solver("convex-hull", model, rom::options_from_map("convex-hull", values));
+  const auto& solver = dynamic_cast<const rom::ConvexHullSolver&>(*online_solver);
 
   const std::vector<fom::Param> params =
       a.set == "training" ? rom::database_training_set(db, *problem) : rom::database_validation_set(db, *problem);
@@ -201,7 +200,7 @@ CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
   add_setting(sub, "--rank-l", args->rank_l, hull, "rank_l");
   add_setting(sub, "--seed", args->seed, hull, "seed");
   add_setting(sub, "--sum-weight", args->sum_weight, hull, "sum_weight");
-  sub->add_flag("--no-polish", args->no_polish, "keep the plain nnFOCUSS coefficients (no exact simplex re-solve)");
+  add_setting_negation(sub, "--no-polish", args->polish, hull, "polish");
   add_setting(sub, "--max-pairing-iterations", args->max_pairing_iterations, hull, "max_pairing_iterations");
   std::string keys;
   for (const rom::OptionSpec& spec : rom::online_method("convex-hull").options)

@@ -19,17 +19,17 @@
 #include <filesystem>
 #include <iostream>
 
-#include "core/format.hpp"
-#include "core/errors.hpp"
-#include "core/stopwatch.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "rom/greedy_active_set.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_timing.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/stopwatch.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_timing.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 

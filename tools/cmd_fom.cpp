@@ -7,12 +7,12 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "baselines/ipopt_qp.hpp"
+#include <contactrom/baselines/ipopt_qp.hpp>
 
-#include "core/format.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/contact_checks.hpp"
-#include "fom/field_output.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/contact_checks.hpp>
+#include <contactrom/fom/field_output.hpp>
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 

@@ -5,9 +5,9 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "core/atomic_file.hpp"
-#include "rom/database_merge.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/rom/database_merge.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 #include "tools/cli.hpp"
 
 namespace contactrom::cli {
@@ -29,14 +29,14 @@ void run_merge(const MergeArgs& a) {
   rom::write_database(a.out, merged);
   if (a.json) {
     nlohmann::json j;
-    j["problem"] = merged.problem;
+    j["problem"] = merged.problem.name;
     j["inputs"] = a.inputs.size();
     j["snapshots"] = merged.num_snapshots();
     j["out"] = a.out;
     std::cout << j.dump() << std::endl;
     return;
   }
-  std::cout << "merged " << a.inputs.size() << " databases of " << merged.problem << ": "
+  std::cout << "merged " << a.inputs.size() << " databases of " << merged.problem.name << ": "
             << merged.num_snapshots() << " snapshots written to " << a.out << "\n";
 }
 

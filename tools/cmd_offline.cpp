@@ -25,17 +25,17 @@
 #include <sstream>
 #include <nlohmann/json.hpp>
 
-#include "core/format.hpp"
-#include "core/errors.hpp"
-#include "fom/contact_checks.hpp"
-#include "rom/adaptive_training.hpp"
-#include "rom/database_merge.hpp"
-#include "rom/offline.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/contact_checks.hpp>
+#include <contactrom/rom/adaptive_training.hpp>
+#include <contactrom/rom/database_merge.hpp>
+#include <contactrom/rom/offline.hpp>
 #ifdef CONTACTROM_HAVE_MPI
-#include "rom/offline_mpi.hpp"
+#include <contactrom/rom/offline_mpi.hpp>
 #endif
-#include "core/atomic_file.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 

@@ -16,17 +16,17 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "core/format.hpp"
-#include "core/atomic_file.hpp"
-#include "core/errors.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/field_output.hpp"
-#include "fom/kkt.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/reduced_model_file.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/field_output.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/reduced_model_file.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 

@@ -4,7 +4,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "fom/problem.hpp"
+#include <contactrom/fom/problem.hpp>
 #include "tools/cli.hpp"
 
 namespace contactrom::cli {

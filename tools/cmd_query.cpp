@@ -11,12 +11,12 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "core/atomic_file.hpp"
-#include "fom/field_output.hpp"
-#include "fom/kkt.hpp"
-#include "rom/fallback.hpp"
-#include "rom/online_timing.hpp"
-#include "rom/reduced_model_file.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/fom/field_output.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/rom/fallback.hpp>
+#include <contactrom/rom/online_timing.hpp>
+#include <contactrom/rom/reduced_model_file.hpp>
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 

@@ -9,13 +9,13 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "core/atomic_file.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model_file.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model_file.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 #ifdef CONTACTROM_HAVE_MPI
-#include "rom/offline_mpi.hpp"
-#include "rom/pod_mpi.hpp"
+#include <contactrom/rom/offline_mpi.hpp>
+#include <contactrom/rom/pod_mpi.hpp>
 #endif
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"

@@ -18,24 +18,24 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "baselines/cpg.hpp"
-#include "baselines/full_dictionary.hpp"
-#include "baselines/ipopt_qp.hpp"
-#include "baselines/kkt_verifier.hpp"
-#include "baselines/reduced_active_set.hpp"
-#include "baselines/verification.hpp"
-#include "core/format.hpp"
-#include "core/atomic_file.hpp"
-#include "core/errors.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/parameter_space.hpp"
-#include "rom/greedy_active_set.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_timing.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/baselines/cpg.hpp>
+#include <contactrom/baselines/full_dictionary.hpp>
+#include <contactrom/baselines/ipopt_qp.hpp>
+#include <contactrom/baselines/kkt_verifier.hpp>
+#include <contactrom/baselines/reduced_active_set.hpp>
+#include <contactrom/baselines/verification.hpp>
+#include <contactrom/core/format.hpp>
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/parameter_space.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_timing.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
 
@@ -250,9 +250,8 @@ CommandRegistrar reg("verify", [](CLI::App& app) {
   add_setting(sub, "--max-iterations", args->max_iterations, rom::active_set_settings_table(), "max_iterations");
   add_setting(sub, "--cpg-tolerance", args->cpg_tolerance, baselines::cpg_option_table(), "cpg_tolerance");
   add_setting(sub, "--inner-solve", args->inner_solve, baselines::reduced_active_set_option_table(), "inner_solve");
-  sub->add_option("--init", args->init,
-                  "starting point of greedy/greedy-nested (empty|cell|nearest|primal; default cell) and of "
-                  "cpg/full-dictionary (empty|primal|cell; default empty)");
+  sub->add_option("--init", args->init, "starting point of the methods that take one (as --option init): " +
+                                             shared_setting_help("init"));
   sub->add_option("--reference", args->reference, "reference solver: ipopt (default) | fom (custom active set)");
   add_integer(sub, "--threads", args->threads, "threads for the reference solves (default: hardware concurrency)", 1, 1024);
   add_integer(sub, "--limit", args->limit, "use N evenly spaced validation parameters (default: all)", 1, 1000000);

@@ -13,14 +13,14 @@
 #include <new>
 #include <stdexcept>
 
-#include "core/atomic_file.hpp"
-#include "core/blas_threads.hpp"
-#include "core/errors.hpp"
-#include "core/version.hpp"
-#include "fom/input_values.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/blas_threads.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/version.hpp>
+#include <contactrom/fom/input_values.hpp>
 #include "tools/cli.hpp"
 #ifdef CONTACTROM_HAVE_MPI
-#include "rom/offline_mpi.hpp"
+#include <contactrom/rom/offline_mpi.hpp>
 #endif
 
 namespace contactrom::cli {

@@ -10,13 +10,13 @@
 #include <exception>
 #include <iostream>
 
-#include "core/errors.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace {
 

@@ -12,13 +12,13 @@
 #include <random>
 #include <set>
 
-#include "baselines/cpg.hpp"
-#include "baselines/reduced_active_set.hpp"
-#include "core/nnls.hpp"
-#include "fom/problem.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/baselines/cpg.hpp>
+#include <contactrom/baselines/reduced_active_set.hpp>
+#include <contactrom/core/nnls.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 using namespace contactrom;
 using baselines::cone_projected_greedy;

@@ -12,15 +12,15 @@
 #include <memory>
 #include <thread>
 
-#include "baselines/cpg.hpp"
-#include "baselines/full_dictionary.hpp"
-#include "baselines/reduced_active_set.hpp"
-#include "core/nnls.hpp"
-#include "fom/problem.hpp"
-#include "rom/greedy_active_set.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/baselines/cpg.hpp>
+#include <contactrom/baselines/full_dictionary.hpp>
+#include <contactrom/baselines/reduced_active_set.hpp>
+#include <contactrom/core/nnls.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 using namespace contactrom;
 using Eigen::MatrixXd;

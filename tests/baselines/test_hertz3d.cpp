@@ -11,10 +11,10 @@
 #include <filesystem>
 #include <fstream>
 
-#include "baselines/ipopt_qp.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/baselines/ipopt_qp.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
 
 using namespace contactrom;
 using namespace contactrom::fom;

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "baselines/ipopt_qp.hpp"
+#include <contactrom/baselines/ipopt_qp.hpp>
 #include "common/run_command.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
 
 using namespace contactrom;
 using baselines::IpoptOptions;

@@ -8,9 +8,9 @@
 #include <memory>
 #include <string>
 
-#include "baselines/ipopt_qp.hpp"
-#include "baselines/kkt_verifier.hpp"
-#include "fom/active_set_solver.hpp"
+#include <contactrom/baselines/ipopt_qp.hpp>
+#include <contactrom/baselines/kkt_verifier.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
 
 using namespace contactrom;
 using baselines::verify_solution;

@@ -13,11 +13,11 @@
 #include <memory>
 #include <set>
 
-#include "baselines/reduced_active_set.hpp"
+#include <contactrom/baselines/reduced_active_set.hpp>
 #include "common/tiny_rope.hpp"
-#include "core/errors.hpp"
-#include "rom/greedy_active_set.hpp"
-#include "rom/offline.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
+#include <contactrom/rom/offline.hpp>
 
 using namespace contactrom;
 using baselines::ReducedActiveSet;

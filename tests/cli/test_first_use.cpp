@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "common/run_command.hpp"
-#include "core/version.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/version.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 using contactrom::test::run_command;
 using contactrom::test::slurp;

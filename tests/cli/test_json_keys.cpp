@@ -9,7 +9,7 @@
 #include <string>
 
 #include "common/run_command.hpp"
-#include "rom/online_evaluation.hpp"
+#include <contactrom/rom/online_evaluation.hpp>
 
 using contactrom::test::run_command;
 

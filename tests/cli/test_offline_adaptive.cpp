@@ -8,7 +8,7 @@
 #include <string>
 
 #include "common/run_command.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/rom/snapshot_database.hpp>
 
 using contactrom::test::run_command;
 namespace rom = contactrom::rom;

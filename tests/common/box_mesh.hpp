@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "fom/mesh.hpp"
+#include <contactrom/fom/mesh.hpp>
 
 namespace contactrom::test {
 

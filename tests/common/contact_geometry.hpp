@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "fom/contact_model.hpp"
+#include <contactrom/fom/contact_model.hpp>
 
 namespace contactrom::test {
 

@@ -2,7 +2,7 @@
 // The message of the InputError that f() throws, "" if it throws none.
 #include <string>
 
-#include "core/errors.hpp"
+#include <contactrom/core/errors.hpp>
 
 namespace contactrom::test {
 

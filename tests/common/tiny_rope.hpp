@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
-#include "fom/problem.hpp"
-#include "rom/offline.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 namespace contactrom::test {
 

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <vector>
 
-#include "core/anderson.hpp"
+#include <contactrom/core/anderson.hpp>
 
 using contactrom::AndersonMixer;
 

@@ -14,8 +14,8 @@
 #include <string>
 
 #include "common/input_error.hpp"
-#include "core/atomic_file.hpp"
-#include "core/errors.hpp"
+#include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/errors.hpp>
 
 namespace fs = std::filesystem;
 using contactrom::test::input_error_of;

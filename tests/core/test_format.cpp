@@ -9,7 +9,7 @@
 #include <random>
 #include <string>
 
-#include "core/format.hpp"
+#include <contactrom/core/format.hpp>
 
 using contactrom::format_number;
 using contactrom::join;

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "common/random_problems.hpp"
-#include "core/nnls.hpp"
+#include <contactrom/core/nnls.hpp>
 
 using contactrom::Status;
 using contactrom::Nnls;

@@ -9,8 +9,8 @@
 #include <memory>
 #include <tuple>
 
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
 
 using namespace contactrom;
 using namespace contactrom::fom;

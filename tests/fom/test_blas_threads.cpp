@@ -9,8 +9,8 @@
 
 #include <cstdlib>
 
-#include "core/blas_threads.hpp"
-#include "fom/sparse_cholesky.hpp"
+#include <contactrom/core/blas_threads.hpp>
+#include <contactrom/fom/sparse_cholesky.hpp>
 
 namespace {
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "common/contact_geometry.hpp"
-#include "core/errors.hpp"
-#include "fom/contact_model.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/contact_model.hpp>
 
 using namespace contactrom;
 using contactrom::test::circular_master;

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "common/random_problems.hpp"
-#include "fom/dual_qp.hpp"
+#include <contactrom/fom/dual_qp.hpp>
 
 using contactrom::Status;
 using contactrom::fom::DualQpOptions;

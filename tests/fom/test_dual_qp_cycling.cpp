@@ -8,7 +8,7 @@
 #include <random>
 
 #include "common/random_problems.hpp"
-#include "fom/dual_qp.hpp"
+#include <contactrom/fom/dual_qp.hpp>
 
 using contactrom::Status;
 using contactrom::fom::DualQpSolver;

@@ -6,8 +6,8 @@
 #include <boost/test/unit_test.hpp>
 #include <random>
 
-#include "core/errors.hpp"
-#include "fom/elasticity.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/elasticity.hpp>
 
 using namespace contactrom;
 using namespace contactrom::fom;

@@ -10,7 +10,7 @@
 #include <random>
 
 #include "common/box_mesh.hpp"
-#include "fom/elasticity.hpp"
+#include <contactrom/fom/elasticity.hpp>
 
 using namespace contactrom::fom;
 using Eigen::Vector3d;

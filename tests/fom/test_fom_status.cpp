@@ -9,15 +9,15 @@
 #include <fstream>
 #include <regex>
 
-#include "baselines/ipopt_qp.hpp"
+#include <contactrom/baselines/ipopt_qp.hpp>
 #include "common/input_error.hpp"
 #include "common/run_command.hpp"
-#include "core/errors.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/contact_checks.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
-#include "fom/rigid_bodies.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/contact_checks.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/fom/rigid_bodies.hpp>
 
 using namespace contactrom;
 namespace fs = std::filesystem;

@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "common/input_error.hpp"
-#include "core/errors.hpp"
-#include "fom/input_values.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/input_values.hpp>
+#include <contactrom/fom/problem.hpp>
 
 using contactrom::Interval;
 using contactrom::test::input_error_of;

@@ -16,8 +16,8 @@
 #include <string>
 #include <tuple>
 
-#include "core/errors.hpp"
-#include "fom/mesh.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/mesh.hpp>
 
 using contactrom::InputError;
 using contactrom::fom::load_mesh;

@@ -12,7 +12,7 @@
 #include <string>
 
 #include "common/input_error.hpp"
-#include "fom/mesh.hpp"
+#include <contactrom/fom/mesh.hpp>
 
 using contactrom::fom::load_mesh;
 using contactrom::fom::Mesh;

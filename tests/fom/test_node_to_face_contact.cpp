@@ -9,10 +9,10 @@
 #include <random>
 
 #include "common/box_mesh.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/node_to_face_contact.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/node_to_face_contact.hpp>
+#include <contactrom/fom/problem.hpp>
 
 using namespace contactrom;
 using namespace contactrom::fom;

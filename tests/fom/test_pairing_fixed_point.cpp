@@ -12,9 +12,9 @@
 #include <cmath>
 #include <memory>
 
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/pairing_fixed_point.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/pairing_fixed_point.hpp>
 
 using namespace contactrom;
 using namespace contactrom::fom;

@@ -14,9 +14,9 @@
 #include <string>
 #include <random>
 
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/pairing_newton.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/pairing_newton.hpp>
 
 using namespace contactrom;
 using namespace contactrom::fom;

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "fom/elasticity.hpp"
-#include "fom/problem.hpp"
-#include "fom/problem_file.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/elasticity.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/fom/problem_file.hpp>
 
 using namespace contactrom;
 using Eigen::MatrixXd;

@@ -9,12 +9,12 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 
-#include "baselines/ipopt_qp.hpp"
+#include <contactrom/baselines/ipopt_qp.hpp>
 #include "common/run_command.hpp"
-#include "core/errors.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
 
 using namespace contactrom;
 using contactrom::test::run_command;

@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-#include "fom/sparse_cholesky.hpp"
+#include <contactrom/fom/sparse_cholesky.hpp>
 
 using contactrom::Status;
 using contactrom::fom::SparseCholesky;

@@ -1,7 +1,8 @@
 # ctest install.example: installs the build tree into a temporary prefix, checks
 # that nothing installed points into the source or build folder, runs the
 # installed CLI (which must find its data relative to the prefix), then configures,
-# builds and runs examples/cpp against the installed package.
+# builds and runs examples/cpp against the installed package, then builds
+# tests/install/consumer (every installed header as <contactrom/...>, no HDF5).
 # cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DWORK_DIR=... -DGENERATOR=... [-DSANITIZE=ON] -P run_install_test.cmake
 #
 # SANITIZE=ON (a CONTACTROM_SANITIZE build): GCC writes the source paths of
@@ -28,6 +29,7 @@ endfunction()
 unset(ENV{CONTACTROM_PROBLEM_DIR})
 unset(ENV{CONTACTROM_MESH_DIR})
 set(prefix ${WORK_DIR}/prefix)
+
 file(REMOVE_RECURSE ${WORK_DIR})
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
 
@@ -74,4 +76,16 @@ foreach(method greedy cpg)
     message(FATAL_ERROR "ROM ${method}: errors ${CMAKE_MATCH_1} (primal) ${CMAKE_MATCH_2} (dual) too large")
   endif()
 endforeach()
+
+# Every installed header, included as <contactrom/...> by a program that finds only
+# contactrom (not HDF5, a private dependency: no installed header may include it).
+execute_process(COMMAND grep -r -l "include <hdf5" ${prefix}/include RESULT_VARIABLE rc OUTPUT_VARIABLE hits)
+if(NOT rc EQUAL 1)
+  message(FATAL_ERROR "installed headers include <hdf5.h>:\n${hits}")
+endif()
+run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/install/consumer -B ${WORK_DIR}/consumer -G ${GENERATOR}
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} ${example_flags})
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/consumer -j 2)
+run(${WORK_DIR}/consumer/all_headers)
+expect("${out}" "contactrom [0-9]+\\.[0-9]+\\.[0-9]+, [0-9]+ headers" "the program including every installed header")
 file(REMOVE_RECURSE ${WORK_DIR})

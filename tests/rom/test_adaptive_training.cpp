@@ -10,12 +10,12 @@
 #include <stdexcept>
 
 #include "common/run_command.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/problem.hpp"
-#include "rom/adaptive_training.hpp"
-#include "rom/database_merge.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_methods.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/adaptive_training.hpp>
+#include <contactrom/rom/database_merge.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_methods.hpp>
 
 using namespace contactrom;
 

@@ -16,7 +16,7 @@
 
 #include "common/random_problems.hpp"
 #include "common/run_command.hpp"
-#include "rom/chls.hpp"
+#include <contactrom/rom/chls.hpp>
 
 using contactrom::Status;
 using contactrom::rom::chls_leave_one_out;

@@ -15,14 +15,15 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "common/run_command.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/pairing_fixed_point.hpp"
-#include "rom/convex_hull.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/pairing_fixed_point.hpp>
+#include <contactrom/rom/convex_hull.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
 
 namespace rom = contactrom::rom;
 namespace fom = contactrom::fom;
@@ -328,6 +329,24 @@ BOOST_AUTO_TEST_CASE(registry_and_options) {
   }
 }
 
+/// Rows of a hull-report CSV whose status is not success.
+int not_success_rows(const std::string& csv) {
+  std::istringstream in(csv);
+  std::string line, cell;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  for (std::istringstream h(line); std::getline(h, cell, ',');) header.push_back(cell);
+  const auto column = std::find(header.begin(), header.end(), "status") - header.begin();
+  BOOST_REQUIRE(column < static_cast<long>(header.size()));
+  int count = 0;
+  while (std::getline(in, line)) {
+    std::istringstream row(line);
+    for (long c = 0; c <= column; ++c) std::getline(row, cell, ',');
+    count += cell != "success";
+  }
+  return count;
+}
+
 BOOST_AUTO_TEST_CASE(cli_online_hull_report_and_refusal) {
   namespace fs = std::filesystem;
   using contactrom::test::run_command;
@@ -350,6 +369,34 @@ BOOST_AUTO_TEST_CASE(cli_online_hull_report_and_refusal) {
   const std::string text = contactrom::test::slurp(csv);
   BOOST_TEST(text.rfind("gamma,primal_error,dual_error,errors,sparsity,sum_violation,penetration,", 0) == 0u);
   BOOST_TEST(std::count(text.begin(), text.end(), '\n') == 10);
+
+  // Every key hull-report --help lists for --option is accepted, and at its declared
+  // default gives the same answers as no --option at all.
+  const std::string help = run_command(kExe + " hull-report --help").out;
+  std::string every_default;
+  for (const rom::OptionSpec& spec : rom::online_method("convex-hull").options) {
+    BOOST_TEST(help.find(spec.key) != std::string::npos, "hull-report --help does not list " << spec.key);
+    every_default += " --option " + spec.key + "=" + spec.default_value;
+  }
+  r = run_command(kExe + " hull-report --db " + db + " --set training --delta 1e-7 --json" + every_default);
+  BOOST_REQUIRE_EQUAL(r.exit_code, 0);
+  const auto with_defaults = nlohmann::json::parse(r.out);
+  for (const char* key : {"max_primal_error", "max_dual_error", "mean_sparsity", "max_sum_violation"})
+    BOOST_TEST(with_defaults[key].get<double>() == j[key].get<double>(), key);
+  // The contact-check tolerances reach the statuses: with none allowed, the hull's
+  // answers (a combination of two snapshots with different contact sets) are not
+  // all reported success; --no-polish is --option polish=false.
+  const std::string strict_csv = dir + "/strict.csv";
+  r = run_command(kExe + " hull-report --db " + db + " --set training --delta 1e-7 --out " + strict_csv +
+                  " --option penetration_tolerance=1e-300 --option complementarity_tolerance=1e-300");
+  BOOST_REQUIRE_EQUAL(r.exit_code, 0);
+  BOOST_TEST(not_success_rows(contactrom::test::slurp(csv)) == 0);
+  BOOST_TEST(not_success_rows(contactrom::test::slurp(strict_csv)) > 0);
+  const auto no_polish = run_command(kExe + " hull-report --db " + db + " --set training --delta 1e-7 --json --no-polish");
+  const auto polish_false = run_command(kExe + " hull-report --db " + db + " --set training --delta 1e-7 --json --option polish=false");
+  BOOST_REQUIRE_EQUAL(no_polish.exit_code, 0);
+  BOOST_REQUIRE_EQUAL(polish_false.exit_code, 0);
+  BOOST_TEST(nlohmann::json::parse(no_polish.out)["max_sum_violation"] == nlohmann::json::parse(polish_false.out)["max_sum_violation"]);
 
   BOOST_REQUIRE_EQUAL(run_command(kExe + " offline --problem ironing --level 3 --out " + iron).exit_code, 0);
   for (const std::string& cmd : {kExe + " online --db " + iron + " --method convex-hull",

@@ -8,9 +8,9 @@
 #include <filesystem>
 
 #include "common/database_checks.hpp"
-#include "fom/problem.hpp"
-#include "rom/database_merge.hpp"
-#include "rom/offline.hpp"
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/database_merge.hpp>
+#include <contactrom/rom/offline.hpp>
 
 namespace fs = std::filesystem;
 using contactrom::InputError;
@@ -102,13 +102,13 @@ BOOST_AUTO_TEST_CASE(incompatible_databases_and_repeated_parameters_are_refused)
     }
   };
   SnapshotDatabase b = a;
-  b.mesh_fingerprint = "00000000deadbeef";
+  b.problem.fingerprint = "00000000deadbeef";
   refused(b, "fingerprint");
   b = a;
   b.training_size = 3;
   refused(b, "training set");
   b = a;
-  b.problem = "ironing";
+  b.problem.name = "ironing";
   refused(b, "problem");
   BOOST_CHECK_THROW(merge_databases({a, a}, {"a.h5", "a2.h5"}), InputError);  // same parameters twice
 }

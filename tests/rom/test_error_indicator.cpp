@@ -10,14 +10,14 @@
 #include <cmath>
 #include <memory>
 
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
-#include "rom/error_indicator.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/error_indicator.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 using namespace contactrom;
 

@@ -6,13 +6,13 @@
 
 #include <memory>
 
-#include "fom/active_set_solver.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
-#include "rom/fallback.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/fallback.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 using namespace contactrom;
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "common/random_problems.hpp"
-#include "rom/focuss.hpp"
+#include <contactrom/rom/focuss.hpp>
 
 using contactrom::Status;
 using contactrom::rom::Focuss;

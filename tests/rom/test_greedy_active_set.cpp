@@ -12,17 +12,17 @@
 #include <memory>
 #include <thread>
 
-#include "fom/active_set_solver.hpp"
-#include "fom/contact_residuals.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
-#include "rom/greedy_active_set.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/online_timing.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/support_rows.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/contact_residuals.hpp>
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/online_timing.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/support_rows.hpp>
 
 using namespace contactrom;
 

@@ -20,11 +20,11 @@
 #include <set>
 
 #include "common/tiny_rope.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/problem.hpp"
-#include "rom/greedy_active_set.hpp"
-#include "rom/offline.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 using namespace contactrom;
 using Eigen::MatrixXd;

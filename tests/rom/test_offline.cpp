@@ -12,10 +12,10 @@
 
 #include "common/cli_blas_threads.hpp"
 #include "common/database_checks.hpp"
-#include "fom/active_set_solver.hpp"
-#include "fom/problem.hpp"
-#include "rom/offline.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace fs = std::filesystem;
 using contactrom::Status;
@@ -53,7 +53,7 @@ BOOST_AUTO_TEST_CASE(snapshots_are_bit_identical_for_any_thread_count) {
   BOOST_TEST(bitwise_equal(a.dual, back.dual));
   BOOST_TEST(back.training_kind == "train");
   BOOST_TEST(back.training_size == 8);
-  BOOST_TEST(back.mesh_fingerprint == hertz().fingerprint());
+  BOOST_TEST(back.problem.fingerprint == hertz().fingerprint());
 }
 
 BOOST_AUTO_TEST_CASE(streamed_snapshots_are_those_of_the_run_in_memory) {
@@ -226,7 +226,7 @@ BOOST_AUTO_TEST_CASE(cli_database_of_another_mesh_is_refused) {
   // A database whose fingerprint does not match the current hertz mesh.
   const std::string db = work_dir() + "/foreign.h5";
   contactrom::rom::SnapshotDatabase d = contactrom::rom::generate_snapshots(hertz(), 2);
-  d.mesh_fingerprint = "00000000deadbeef";
+  d.problem.fingerprint = "00000000deadbeef";
   contactrom::rom::write_database(db, d);
   const auto r = run_command(exe + " online --db " + db + " --method greedy");
   BOOST_TEST(r.exit_code != 0);

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "common/database_checks.hpp"
-#include "rom/reduced_model_file.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/rom/reduced_model_file.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace fs = std::filesystem;
 using contactrom::rom::read_database;

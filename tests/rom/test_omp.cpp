@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/random_problems.hpp"
-#include "rom/omp.hpp"
+#include <contactrom/rom/omp.hpp>
 
 using contactrom::Status;
 using contactrom::rom::Omp;

@@ -25,10 +25,10 @@
 #include <string>
 #include <vector>
 
-#include "fom/problem.hpp"
-#include "rom/greedy_active_set.hpp"
-#include "rom/offline.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 extern "C" {
 void* __libc_malloc(size_t size);

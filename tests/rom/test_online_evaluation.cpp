@@ -18,11 +18,11 @@
 
 #include "common/run_command.hpp"
 #include "common/tiny_rope.hpp"
-#include "core/errors.hpp"
-#include "fom/active_set_solver.hpp"
-#include "rom/online_evaluation.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/online_timing.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/rom/online_evaluation.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/online_timing.hpp>
 
 using namespace contactrom;
 using Eigen::VectorXd;

@@ -11,14 +11,14 @@
 #include <memory>
 #include <string>
 
-#include "baselines/online_methods.hpp"
+#include <contactrom/baselines/online_methods.hpp>
 #include "common/run_command.hpp"
-#include "fom/problem.hpp"
-#include "rom/greedy_active_set.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
-#include "rom/reduced_model_file.hpp"
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/greedy_active_set.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/reduced_model_file.hpp>
 
 using namespace contactrom;
 

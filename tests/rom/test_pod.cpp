@@ -7,7 +7,7 @@
 #include <Eigen/Dense>
 #include <random>
 
-#include "rom/pod.hpp"
+#include <contactrom/rom/pod.hpp>
 
 using contactrom::Status;
 using contactrom::rom::Pod;

@@ -7,11 +7,11 @@
 
 #include <memory>
 
-#include "fom/problem.hpp"
-#include "core/errors.hpp"
-#include "rom/offline.hpp"
-#include "rom/online_methods.hpp"
-#include "rom/reduced_model.hpp"
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/online_methods.hpp>
+#include <contactrom/rom/reduced_model.hpp>
 
 using namespace contactrom;
 

@@ -15,11 +15,11 @@
 #include "common/cli_blas_threads.hpp"
 #include "common/database_checks.hpp"
 #include "common/run_command.hpp"
-#include "fom/kkt.hpp"
-#include "fom/problem.hpp"
-#include "rom/hdf5_io.hpp"
-#include "rom/offline.hpp"
-#include "rom/reduced_model_file.hpp"
+#include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/hdf5_io.hpp>
+#include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/reduced_model_file.hpp>
 
 namespace fs = std::filesystem;
 using contactrom::InputError;

@@ -5,7 +5,7 @@
 #define BOOST_TEST_MODULE rom_snapshot_database
 #include <boost/test/unit_test.hpp>
 
-#include "rom/hdf5_io.hpp"
+#include <contactrom/rom/hdf5_io.hpp>
 
 #include <cstdio>
 #include <cstdlib>
@@ -18,9 +18,9 @@
 #include <unistd.h>
 
 #include "common/input_error.hpp"
-#include "core/errors.hpp"
-#include "fom/problem.hpp"
-#include "rom/snapshot_database.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 namespace fs = std::filesystem;
 using contactrom::InputError;
@@ -54,12 +54,12 @@ SnapshotDatabase synthetic(int n_snap, int n_dofs, int n_c) {
   std::mt19937 gen(42);
   std::normal_distribution<double> dist;
   SnapshotDatabase db;
-  db.problem = "hertz";
-  db.mesh_fingerprint = "0123456789abcdef";
+  db.problem.name = "hertz";
+  db.problem.fingerprint = "0123456789abcdef";
   db.created_by = "contactrom test";
   db.training_kind = "train";
   db.training_size = n_snap;
-  db.param_names = {"d"};
+  db.problem.param_names = {"d"};
   db.parameters.resize(1, n_snap);
   db.primal.resize(n_dofs, n_snap);
   db.dual.resize(n_c, n_snap);
@@ -75,9 +75,9 @@ SnapshotDatabase synthetic(int n_snap, int n_dofs, int n_c) {
   db.setup_time_s = 0.25;
   db.wall_time_s = 1.5;
   db.threads = 2;
-  db.contact_points = Eigen::Matrix2Xd::Random(2, n_c);
-  db.contact_weights = Eigen::VectorXd::Constant(n_c, 0.1);
-  db.lifting_terms = Eigen::MatrixXd::Random(n_dofs, 1);
+  db.problem.contact_points = Eigen::Matrix2Xd::Random(2, n_c);
+  db.problem.contact_weights = Eigen::VectorXd::Constant(n_c, 0.1);
+  db.problem.lifting_terms = Eigen::MatrixXd::Random(n_dofs, 1);
   return db;
 }
 
@@ -100,12 +100,12 @@ BOOST_AUTO_TEST_CASE(round_trip_is_bitwise) {
   const std::string path = temp().file("round_trip.h5");
   contactrom::rom::write_database(path, db);
   const SnapshotDatabase back = contactrom::rom::read_database(path);
-  BOOST_TEST(back.problem == db.problem);
-  BOOST_TEST(back.mesh_fingerprint == db.mesh_fingerprint);
+  BOOST_TEST(back.problem.name == db.problem.name);
+  BOOST_TEST(back.problem.fingerprint == db.problem.fingerprint);
   BOOST_TEST(back.created_by == db.created_by);
   BOOST_TEST(back.training_kind == db.training_kind);
   BOOST_TEST(back.training_size == db.training_size);
-  BOOST_TEST(back.param_names == db.param_names, boost::test_tools::per_element());
+  BOOST_TEST(back.problem.param_names == db.problem.param_names, boost::test_tools::per_element());
   BOOST_TEST(bitwise_equal(back.parameters, db.parameters));
   BOOST_TEST(bitwise_equal(back.primal, db.primal));
   BOOST_TEST(bitwise_equal(back.dual, db.dual));
@@ -227,9 +227,9 @@ BOOST_AUTO_TEST_CASE(written_files_carry_valid_metadata_checksums) {
 BOOST_AUTO_TEST_CASE(database_of_another_mesh_or_problem_is_refused) {
   auto hertz = contactrom::fom::make_problem("hertz");
   SnapshotDatabase db;
-  db.problem = "hertz";
-  db.mesh_fingerprint = hertz->fingerprint();
-  db.param_names = {"d"};
+  db.problem.name = "hertz";
+  db.problem.fingerprint = hertz->fingerprint();
+  db.problem.param_names = {"d"};
   db.training_size = 1;                               // hertz --train 1: d = 0.3
   db.parameters = Eigen::MatrixXd::Constant(1, 1, 0.3);
   db.primal = Eigen::MatrixXd::Zero(hertz->num_dofs(), 1);
@@ -237,14 +237,14 @@ BOOST_AUTO_TEST_CASE(database_of_another_mesh_or_problem_is_refused) {
   BOOST_CHECK_NO_THROW(contactrom::rom::check_database(db, *hertz, "ok.h5"));
 
   SnapshotDatabase other_mesh = db;
-  other_mesh.mesh_fingerprint = "ffffffffffffffff";
+  other_mesh.problem.fingerprint = "ffffffffffffffff";
   const std::string msg = input_error_of([&] { contactrom::rom::check_database(other_mesh, *hertz, "db.h5"); });
   BOOST_TEST_MESSAGE(msg);
   BOOST_TEST(msg.find("database 'db.h5' was built for mesh fingerprint ffffffffffffffff but the current hertz mesh is " +
                       hertz->fingerprint()) != std::string::npos);
 
   SnapshotDatabase other_problem = db;
-  other_problem.problem = "ironing";
+  other_problem.problem.name = "ironing";
   const std::string msg2 = input_error_of([&] { contactrom::rom::check_database(other_problem, *hertz, "db.h5"); });
   BOOST_TEST(msg2.find("built for problem 'ironing'") != std::string::npos);
 
@@ -284,7 +284,7 @@ BOOST_AUTO_TEST_CASE(flipped_bits_are_refused_never_read_as_other_numbers) {
         BOOST_TEST(bitwise_equal(back.dual, db.dual));
         BOOST_TEST(bitwise_equal(back.parameters, db.parameters));
         BOOST_TEST((back.status == db.status && back.iterations == db.iterations && back.time_s == db.time_s));
-        BOOST_TEST(bitwise_equal(back.lifting_terms, db.lifting_terms));
+        BOOST_TEST(bitwise_equal(back.problem.lifting_terms, db.problem.lifting_terms));
       }
       ++unchanged;
     } catch (const InputError&) {

@@ -24,10 +24,10 @@
 #include <vector>
 
 #include "common/random_problems.hpp"
-#include "core/errors.hpp"
-#include "core/nnls.hpp"
-#include "rom/dense_csv.hpp"
-#include "rom/omp.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/nnls.hpp>
+#include <contactrom/rom/dense_csv.hpp>
+#include <contactrom/rom/omp.hpp>
 
 namespace fs = std::filesystem;
 using contactrom::InputError;

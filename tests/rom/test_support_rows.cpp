@@ -14,8 +14,8 @@
 
 #include "common/contact_geometry.hpp"
 #include "common/random_problems.hpp"
-#include "fom/contact_model.hpp"
-#include "rom/support_rows.hpp"
+#include <contactrom/fom/contact_model.hpp>
+#include <contactrom/rom/support_rows.hpp>
 
 using namespace contactrom;
 using contactrom::test::gaussian;

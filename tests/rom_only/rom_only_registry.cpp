@@ -3,8 +3,8 @@
 #include <iostream>
 #include <string>
 
-#include "core/errors.hpp"
-#include "rom/online_methods.hpp"
+#include <contactrom/core/errors.hpp>
+#include <contactrom/rom/online_methods.hpp>
 
 int main() {
   try {
