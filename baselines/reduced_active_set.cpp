@@ -11,6 +11,7 @@
 #include <contactrom/baselines/cpg.hpp>
 #include <contactrom/baselines/full_dictionary.hpp>
 #include <contactrom/baselines/online_methods.hpp>
+#include <contactrom/rom/rebuild_fixed_point.hpp>
 #include <contactrom/rom/selection_history.hpp>
 
 namespace contactrom::baselines {
@@ -263,43 +264,39 @@ void ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmStart init, rom
   // training snapshot, as the greedy's does (same pairing as a full search).
   q.seed(m_model, q.ops);
 
-  // The fixed point x ↦ û(x) of the greedy's default schedule (rom::GreedySchedule::
-  // FixedPoint), with this method's own solve on the frozen operators: operators
-  // built at x; û(x) by the primal–dual active set on them until its set is stable;
-  // x Anderson-accelerated (one history over the query) until the contact surface
-  // moves by at most surface_step; then the physical test at û's own pairing.
-  const fom::ContactTolerances tolerances = contact_tolerances();
-  rom::SupportRows::ResidualsScratch scratch;
-  AndersonMixer mixer(m_options.anderson_depth);
-  Eigen::VectorXd x = q.u_hat;  // where the operators are built
-  bool pending = false, failed_test = false;
-  for (int rebuild = 0;; ++rebuild) {
-    q.rebuild_operators(x);
-    if (pending) {
-      // Failing twice in a row: a fixed point of the reduced problem (see the greedy).
-      if (q.gaps_within(tolerances, scratch) || failed_test) {
-        res.converged = true;
-        break;
-      }
-      failed_test = true;
-    } else {
-      failed_test = false;
+  // The fixed point x ↦ û(x) of the greedy's default schedule (rom/rebuild_fixed_point.hpp),
+  // with this method's own solve on the frozen operators: û(x) by the primal–dual
+  // active set on them until its set is stable; x extrapolated by Anderson, one
+  // history over the query.
+  struct Loop {
+    Query& q;
+    rom::OnlineResult& res;
+    const fom::ContactTolerances tolerances;
+    AndersonMixer mixer;
+    Eigen::VectorXd x, x_s;  // where the operators are built, and its surface displacement
+    rom::SupportRows::ResidualsScratch scratch;
+    void rebuild(bool) {
+      q.rebuild_operators(x);
+      x_s = q.u_s;
     }
-    pending = false;
-    if (rebuild >= m_options.max_iterations || q.solves >= m_options.max_solves) break;
-    if (!q.solve_on_frozen_operators(res)) {
+    bool physically_converged() { return q.gaps_within(tolerances, scratch); }
+    int solves() const { return q.solves; }
+    bool solve_frozen(int) { return q.solve_on_frozen_operators(res); }
+    double step() {
+      q.surface_displacement(q.u_hat);
+      return rom::surface_step(q.u_s, x_s, q.solver.m_model.problem().displacement_scale());
+    }
+    void accept() { x = q.u_hat; }
+    void extrapolate() { mixer.next(x, q.u_hat, x); }
+  } loop{q, res, contact_tolerances(), AndersonMixer(m_options.anderson_depth), q.u_hat, {}, {}};
+  const rom::RebuildLimits limits{m_options.max_iterations, m_options.max_solves, m_options.surface_step};
+  switch (rom::run_rebuild_fixed_point(loop, limits)) {
+    case rom::RebuildOutcome::Converged: res.converged = true; break;
+    case rom::RebuildOutcome::NonFinite:
       res.status = Status::NumericalIssue;
       res.message = "reduced saddle-point solve produced a non-finite value";
       break;
-    }
-    // Step 3: the next point: û itself once the surface moved by at most
-    // surface_step (then tested at its own pairing), else the Anderson extrapolation.
-    if (rom::surface_step(m_model, q.u_hat, x) <= m_options.surface_step) {
-      pending = true;
-      x = q.u_hat;
-    } else {
-      mixer.next(x, q.u_hat, x);
-    }
+    case rom::RebuildOutcome::AtCap: break;
   }
   q.report(res);
   if (res.status == Status::Success && !res.converged)

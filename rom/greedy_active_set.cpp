@@ -10,6 +10,7 @@
 #include <utility>
 
 #include <contactrom/core/anderson.hpp>
+#include <contactrom/rom/rebuild_fixed_point.hpp>
 #include <contactrom/rom/selection_history.hpp>
 
 namespace contactrom::rom {
@@ -442,7 +443,7 @@ struct GreedyActiveSet::Nested {
     }
     mixer.reset(g->m_options.anderson_depth);
     seen.clear(), solved.clear();
-    n_lambda = 0, pending = false, failed_test = false, finite = true, solves = 0;
+    n_lambda = 0, pending = false, finite = true, solves = 0;
   }
   /// A selected column p with the operators frozen: its row Ĉ_p = d_pᵀ A of Ĉ_I,
   /// w_p = K̂⁻¹ Ĉ_pᵀ and z_p = D_dᵀ C_s Φ_s w_p, the change of every column's
@@ -474,7 +475,6 @@ struct GreedyActiveSet::Nested {
   std::vector<int> blocked;      // settle_exact: columns not offered again on these operators
   AndersonMixer mixer{0};
   bool pending = false;  // settled: to be confirmed at the fresh pairing of û
-  bool failed_test = false;  // fixed-point schedule: the last settled û failed the physical test
   bool finite = true;    // every solve so far gave finite values
   int solves = 0;
 
@@ -721,56 +721,42 @@ void GreedyActiveSet::solve_nested(Query& q, OnlineResult& res, int max_rebuilds
   q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i(), s.solved);
 }
 
-double surface_step(const ReducedModel& model, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x) {
-  thread_local Eigen::VectorXd diff, change;  // storage reused: the iterations allocate nothing
-  diff = u_hat - x;
-  change.noalias() = model.surface_basis() * diff;
-  return (change.size() > 0 ? change.cwiseAbs().maxCoeff() : 0.0) / model.problem().displacement_scale();
-}
-
 void GreedyActiveSet::solve_fixed_point(Query& q, OnlineResult& res) const {
   thread_local Nested s;  // its storage serves the thread's next queries
   s.start(*this, q);
-  const fom::ContactTolerances tolerances = contact_tolerances();
-  for (int rebuild = 0;; ++rebuild) {
-    // 1. Operators at x (surface rows only); where x = û, the physical test at û's own pairing.
-    if (!s.pending) q.surface_displacement(s.x, s.u_s);  // else u_s is û's already
-    q.rebuild(s.u_s);
-    if (s.pending) {
-      // A settled û that fails the physical test at its own pairing twice in a row
-      // is a fixed point of the reduced problem: iterating cannot improve it. It is
-      // returned as converged; the full-order check then reports it inaccurate.
-      const bool physical = s.physically_converged(tolerances);
-      if (physical || s.failed_test) {
-        res.converged = true;
-        break;
-      }
-      s.failed_test = true;
-    } else {
-      s.failed_test = false;
+  // The greedy's side of the loop: û(x) by the exact one-change solve on the frozen
+  // operators (settle_exact), x extrapolated by Anderson with one history.
+  struct Loop {
+    const GreedyActiveSet& g;
+    Query& q;
+    Nested& s;
+    const fom::ContactTolerances tolerances;
+    void rebuild(bool at_u_hat) {
+      if (!at_u_hat) q.surface_displacement(s.x, s.u_s);  // else u_s is û's already
+      q.rebuild(s.u_s);
     }
-    s.pending = false;
-    if (rebuild >= m_options.max_iterations || s.solves >= m_options.max_solves) break;
-    // 2. û(x): the reduced problem solved exactly on the frozen operators.
-    s.freeze_operators();
-    s.settle_exact(rebuild);
-    if (!s.finite) {
-      numerical_issue(res);
-      break;
+    bool physically_converged() { return s.physically_converged(tolerances); }
+    int solves() const { return s.solves; }
+    bool solve_frozen(int rebuild) {
+      s.freeze_operators();
+      s.settle_exact(rebuild);
+      return s.finite;
     }
-    // 3. The next point: û itself once the step is within the basis' resolution
-    //    (then tested at its own pairing), else the Anderson extrapolation of the
-    //    map x ↦ û(x), with one history over the whole query.
-    q.surface_displacement(s.u_hat, s.u_s_hat);
-    const double step = (s.u_s_hat - s.u_s).lpNorm<Eigen::Infinity>() / m_model.problem().displacement_scale();
-    if (m_options.trace) *m_options.trace << "greedy rebuild=" << rebuild << " surface step=" << step << " U\n";
-    if (step <= m_options.surface_step) {
-      s.pending = true;
+    double step() {
+      q.surface_displacement(s.u_hat, s.u_s_hat);
+      return surface_step(s.u_s_hat, s.u_s, g.m_model.problem().displacement_scale());
+    }
+    void accept() {
       s.x = s.u_hat;
       s.u_s.swap(s.u_s_hat);
-    } else {
-      s.mixer.next(s.x, s.u_hat, s.x);
     }
+    void extrapolate() { s.mixer.next(s.x, s.u_hat, s.x); }
+  } loop{*this, q, s, contact_tolerances()};
+  const RebuildLimits limits{m_options.max_iterations, m_options.max_solves, m_options.surface_step};
+  switch (run_rebuild_fixed_point(loop, limits, m_options.trace, "greedy")) {
+    case RebuildOutcome::Converged: res.converged = true; break;
+    case RebuildOutcome::NonFinite: numerical_issue(res); break;
+    case RebuildOutcome::AtCap: break;
   }
   res.iterations = s.solves;
   q.finish(!res.converged && res.status == Status::Success, s.u_hat, s.lambda_i(), s.solved);

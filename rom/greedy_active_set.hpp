@@ -172,10 +172,6 @@ class GreedyActiveSet final : public OnlineSolver {
   void solve_fixed_point(Query& q, OnlineResult& res) const;
 };
 
-/// \brief \f$ \|\Phi_s(\hat u - x)\|_\infty / U \f$: how far the contact surface of û
-/// moved from x (the fixed-point schedules' step, GreedyOptions::surface_step).
-double surface_step(const ReducedModel& model, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& x);
-
 /// \brief The threshold τ that GreedyActiveSet applies with `options` (defaulted to δ
 /// and scaled per TauScaling), in the units of \f$ D_d^T (Cu - g) \f$.
 double greedy_threshold(const ReducedModel& model, const GreedyOptions& options);
