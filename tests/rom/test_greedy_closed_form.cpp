@@ -24,6 +24,7 @@
 #include <contactrom/fom/problem.hpp>
 #include <contactrom/rom/greedy_active_set.hpp>
 #include <contactrom/rom/offline.hpp>
+#include <contactrom/rom/rebuild_fixed_point.hpp>
 #include <contactrom/rom/reduced_model.hpp>
 
 using namespace contactrom;
@@ -256,4 +257,78 @@ BOOST_AUTO_TEST_CASE(converged_result_meets_the_reduced_kkt_conditions) {
       }
     }
   }
+}
+
+// The outer loop shared by the greedy and the baselines (rom/rebuild_fixed_point.hpp)
+// on a scripted map: û(x) = a·x on a one-dof "surface" (scale U = 1), the physical
+// test answering as told. Plain substitution (extrapolate: x = û) from x = 1 gives
+// x_k = a^k and steps (1 − a)a^k, so the rebuild count is known in closed form.
+namespace {
+struct ScriptedLoop {
+  double a = 0.5;
+  bool physical = true;     // the answer of the test at û's own pairing
+  bool finite = true;
+  Eigen::VectorXd x = Eigen::VectorXd::Ones(1), u_hat = Eigen::VectorXd::Ones(1);
+  int rebuilds = 0, tests = 0, n_solves = 0;
+  bool tested_at_u_hat = false;
+  void rebuild(bool at_u_hat) {
+    ++rebuilds;
+    tested_at_u_hat = at_u_hat;
+  }
+  bool physically_converged() {
+    ++tests;
+    BOOST_TEST(tested_at_u_hat);  // the test only ever runs at x = û
+    return physical;
+  }
+  int solves() const { return n_solves; }
+  bool solve_frozen(int) {
+    ++n_solves;
+    u_hat = a * x;
+    return finite;
+  }
+  double step() { return rom::surface_step(u_hat, x, 1.0); }
+  void accept() { x = u_hat; }
+  void extrapolate() { x = u_hat; }
+};
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(rebuild_fixed_point_stops_when_the_step_is_resolved_and_the_test_passes) {
+  ScriptedLoop loop;
+  const rom::RebuildLimits limits{50, 1000, 1e-3};
+  BOOST_TEST(static_cast<int>(rom::run_rebuild_fixed_point(loop, limits)) ==
+             static_cast<int>(rom::RebuildOutcome::Converged));
+  // Steps 2^-(k+1) for k = 0, 1, …: the first ≤ 1e-3 is k = 9 (2^-10), after 10
+  // solves; one more rebuild at û holds the test.
+  BOOST_TEST(loop.n_solves == 10);
+  BOOST_TEST(loop.rebuilds == 11);
+  BOOST_TEST(loop.tests == 1);
+}
+
+BOOST_AUTO_TEST_CASE(rebuild_fixed_point_returns_a_reduced_fixed_point_that_fails_the_test_twice) {
+  ScriptedLoop loop;
+  loop.a = 1.0;  // û(x) = x: a fixed point at once
+  loop.physical = false;
+  const rom::RebuildLimits limits{50, 1000, 1e-3};
+  BOOST_TEST(static_cast<int>(rom::run_rebuild_fixed_point(loop, limits)) ==
+             static_cast<int>(rom::RebuildOutcome::Converged));
+  BOOST_TEST(loop.tests == 2);  // failed, solved once more at û, failed again: no further iteration helps
+  BOOST_TEST(loop.n_solves == 2);
+}
+
+BOOST_AUTO_TEST_CASE(rebuild_fixed_point_reports_its_caps_and_non_finite_solves) {
+  ScriptedLoop slow;
+  slow.a = 0.99;  // steps 0.01·0.99^k stay above 1e-3 for 229 solves
+  BOOST_TEST(static_cast<int>(rom::run_rebuild_fixed_point(slow, rom::RebuildLimits{7, 1000, 1e-3})) ==
+             static_cast<int>(rom::RebuildOutcome::AtCap));
+  BOOST_TEST(slow.n_solves == 7);  // rebuilds 0 … 6 solve, rebuild 7 is the cap
+  ScriptedLoop capped;
+  capped.a = 0.99;
+  BOOST_TEST(static_cast<int>(rom::run_rebuild_fixed_point(capped, rom::RebuildLimits{50, 3, 1e-3})) ==
+             static_cast<int>(rom::RebuildOutcome::AtCap));
+  BOOST_TEST(capped.n_solves == 3);
+  ScriptedLoop broken;
+  broken.finite = false;
+  BOOST_TEST(static_cast<int>(rom::run_rebuild_fixed_point(broken, rom::RebuildLimits{50, 1000, 1e-3})) ==
+             static_cast<int>(rom::RebuildOutcome::NonFinite));
+  BOOST_TEST(broken.n_solves == 1);
 }
