@@ -35,8 +35,8 @@ std::vector<int> reduced_model_columns(const SnapshotDatabase& db, const Reduced
   return out;
 }
 
-std::vector<Eigen::VectorXd> reduced_model_offsets(const fom::Problem& problem, LiftingKind lifting) {
-  return lifting == LiftingKind::Harmonic ? harmonic_offsets(problem) : problem.lifting_terms();
+std::vector<Eigen::VectorXd> reduced_model_offsets(const fom::Problem& problem, OffsetKind kind) {
+  return kind == OffsetKind::Harmonic ? harmonic_offsets(problem) : problem.lifting_terms();
 }
 
 ReducedSnapshots::ReducedSnapshots(const fom::Problem& problem, const SnapshotDatabase& db, std::vector<int> columns,
@@ -62,7 +62,7 @@ void ReducedSnapshots::read_rows(Eigen::Index first, Eigen::Index count, Eigen::
 
 void share_reduced_model_pod(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options) {
   const ReducedSnapshots snapshots(problem, db, reduced_model_columns(db, options),
-                                   reduced_model_offsets(problem, options.lifting));
+                                   reduced_model_offsets(problem, options.offset));
   PodOptions pod_options = options.pod;
   pod_options.delta = options.delta;
   Pod(pod_options).compute(snapshots);
@@ -84,7 +84,7 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
     throw InputError("database of problem " + quoted(db.problem.name, 200) + " holds no successful snapshot");
   const int m = static_cast<int>(m_dict_snapshots.size());
   const int nt = problem.num_load_terms();
-  m_offset = reduced_model_offsets(problem, options.lifting);
+  m_offset = reduced_model_offsets(problem, options.offset);
   m_dict.resize(nc, m);
   for (int c = 0; c < m; ++c) {
     const int j = m_dict_snapshots[c];
@@ -267,15 +267,15 @@ void ReducedModel::derive() {
   m_phi_s.resize(ns, r);
   for (int a = 0; a < ns && r > 0; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
   m_phi_s_rows = m_phi_s;
-  m_lift_s.resize(ns, nt);
+  m_off_s.resize(ns, nt);
   for (int k = 0; k < nt; ++k)
-    for (int a = 0; a < ns; ++a) m_lift_s(a, k) = m_offset[k](surf[a]);
+    for (int a = 0; a < ns; ++a) m_off_s(a, k) = m_offset[k](surf[a]);
   // The contact search at every reduced snapshot, over all rows (a query's support
   // rows are a subset): one full search per column, offline.
   m_snapshot_memory.assign(static_cast<size_t>(dictionary_size()), fom::SearchMemory());
   fom::Pairing pairing;
   for (int p = 0; p < dictionary_size(); ++p) {
-    const Eigen::VectorXd u_s = m_phi_s * m_snapshot_coords.col(p) + surface_lifting(m_dict_params[static_cast<size_t>(p)]);
+    const Eigen::VectorXd u_s = m_phi_s * m_snapshot_coords.col(p) + surface_offset(m_dict_params[static_cast<size_t>(p)]);
     m_problem.contact().search_rows(u_s, nullptr, nullptr, m_snapshot_memory[static_cast<size_t>(p)], pairing);
   }
   if (m_k_hat.size() == 1) {
@@ -398,8 +398,8 @@ ReducedStiffnessInverse::ReducedStiffnessInverse(const ReducedModel& model, cons
   m_ok = m_factor->info() == Eigen::Success && std::isfinite(m_inv_theta);
 }
 
-Eigen::VectorXd ReducedModel::surface_lifting(const fom::Param& mu) const {
-  return m_lift_s * m_problem.load_coefficients(mu);
+Eigen::VectorXd ReducedModel::surface_offset(const fom::Param& mu) const {
+  return m_off_s * m_problem.load_coefficients(mu);
 }
 
 Eigen::VectorXd ReducedModel::offset(const fom::Param& mu) const {

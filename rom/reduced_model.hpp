@@ -3,16 +3,18 @@
 /// \brief The offline product shared by the dictionary ROMs: POD primal basis,
 /// uncompressed dual dictionary and the parameter-affine reduced operators.
 ///
-/// With \f$ u = u_{lift}(\mu) + \Phi\hat u \f$ (Φ zero on Dirichlet dofs), the
-/// reduced problem of paper eq. (5) needs, for every parameter,
+/// With \f$ u = u_{off}(\mu) + \Phi\hat u \f$, the offset
+/// \f$ u_{off}(\mu) = \sum_k \phi_k(\mu) \tilde L_k \f$ carrying the Dirichlet data
+/// (OffsetKind) and Φ zero on Dirichlet dofs, the reduced problem of paper eq. (5)
+/// needs, for every parameter,
 /// \f[ \hat K(\mu) = \Phi^T K(\mu) \Phi = \sum_q \theta_q(\mu)\,\Phi^T K_q \Phi, \qquad
-///     \hat f(\mu) = \Phi^T f(\mu) = \sum_k \phi_k(\mu) \Big( \Phi^T f_{ext,k}
-///        - \sum_q \theta_q(\mu)\, \Phi^T K_q L_k \Big), \f]
+///     \hat f(\mu) = \sum_k \phi_k(\mu) \Big( \Phi^T f_{ext,k}
+///        - \sum_q \theta_q(\mu)\, \Phi^T K_q \tilde L_k \Big), \f]
 /// which are assembled from the offline pieces \f$ \Phi^T K_q \Phi \f$ (r × r),
-/// \f$ \Phi^T f_{ext,k} \f$ and \f$ \Phi^T K_q L_k \f$ (r each) at a cost
+/// \f$ \Phi^T f_{ext,k} \f$ and \f$ \Phi^T K_q \tilde L_k \f$ (r each) at a cost
 /// independent of the mesh. The nonlinear contact operators are rebuilt online
 /// from the contact-surface rows only: \f$ \Phi_s = \Phi[\text{surface dofs}, :] \f$
-/// and the surface lifting \f$ u_{lift,s}(\mu) = \sum_k \phi_k(\mu) L_{k,s} \f$.
+/// and the surface offset \f$ u_{off,s}(\mu) = \sum_k \phi_k(\mu) \tilde L_{k,s} \f$.
 ///
 /// The dual dictionary \f$ D_d \f$ (n_c × m) holds every pressure snapshot of the
 /// database whose FOM status is Success, uncompressed, in database order.
@@ -32,8 +34,8 @@ class ErrorIndicator;
 
 /// \brief Which affine offset u_off(μ) = Σ_k φ_k(μ) L̃_k the reduced displacement is
 /// measured from (u = u_off(μ) + Φû). Both carry the Dirichlet data exactly.
-enum class LiftingKind {
-  /// L̃_k = L_k, the problem's lifting (Dirichlet values, zero elsewhere): the POD is
+enum class OffsetKind {
+  /// L̃_k = L_k, the problem's Dirichlet lifting (Dirichlet values, zero elsewhere): the POD is
   /// taken of the database snapshots u − u_lift as stored.
   Dirichlet,
   /// L̃_k = the unconstrained FOM response to load term k (Dirichlet values L_k and
@@ -59,8 +61,8 @@ struct ReducedModelOptions {
   /// columns of one snapshot share its parameter and primal snapshot
   /// (sibling_columns()). Default true; false: one column per snapshot.
   bool split_pairs = true;
-  /// Offset of the reduced displacement; see LiftingKind. Default Harmonic.
-  LiftingKind lifting = LiftingKind::Harmonic;
+  /// Offset u_off of the reduced displacement; see OffsetKind. Default Harmonic.
+  OffsetKind offset = OffsetKind::Harmonic;
   /// Keep the primal snapshots u − u_off of the dictionary columns (n × m) in the
   /// model. Only methods that combine whole training solutions need them (the convex
   /// hull); the others use their reduced coordinates Φᵀ(u − u_off) (r × m), which are
@@ -97,8 +99,8 @@ struct ReducedModelData {
 /// FOM status is Success (all with ReducedModelOptions::include_failed_snapshots).
 std::vector<int> reduced_model_columns(const SnapshotDatabase& db, const ReducedModelOptions& options);
 
-/// \brief The offset terms L̃_k of `lifting` (see LiftingKind).
-std::vector<Eigen::VectorXd> reduced_model_offsets(const fom::Problem& problem, LiftingKind lifting);
+/// \brief The offset terms L̃_k of `kind` (see OffsetKind).
+std::vector<Eigen::VectorXd> reduced_model_offsets(const fom::Problem& problem, OffsetKind kind);
 
 /// \brief The matrix a reduced model's POD is taken of: u − u_off(μ_c) of the kept
 /// database snapshots (n_dofs × m), by blocks of rows, from the database in memory or
@@ -215,8 +217,8 @@ class ReducedModel {
   /// \f$ \hat f(\mu) = \Phi^T f(\mu) \f$ from the affine pieces.
   Eigen::VectorXd reduced_rhs(const fom::Param& mu) const;
   /// Offset on the surface dofs, \f$ u_{off}(\mu) \f$ restricted to surface_dofs().
-  Eigen::VectorXd surface_lifting(const fom::Param& mu) const;
-  /// Offset terms L̃_k of the reduced displacement (n_dofs each; see LiftingKind).
+  Eigen::VectorXd surface_offset(const fom::Param& mu) const;
+  /// Offset terms L̃_k of the reduced displacement (n_dofs each; see OffsetKind).
   const std::vector<Eigen::VectorXd>& offset_terms() const { return m_offset; }
   /// \f$ u_{off}(\mu) = \sum_k \phi_k(\mu) \tilde L_k \f$ (n_dofs).
   Eigen::VectorXd offset(const fom::Param& mu) const;
@@ -248,7 +250,7 @@ class ReducedModel {
  private:
   const fom::Problem& m_problem;
   ReducedModelOptions m_options;
-  Eigen::MatrixXd m_primal, m_phi, m_phi_s, m_dict, m_lift_s;
+  Eigen::MatrixXd m_primal, m_phi, m_phi_s, m_dict, m_off_s;  // m_off_s: column k, L̃_k on the surface dofs
   Eigen::VectorXd m_sigma;
   std::vector<int> m_dict_snapshots;
   std::vector<fom::Param> m_dict_params;
@@ -265,7 +267,7 @@ class ReducedModel {
   std::vector<Eigen::VectorXd> m_offset;  // L̃_k
   std::vector<Eigen::MatrixXd> m_k_hat;   // Φᵀ K_q Φ
   Eigen::MatrixXd m_f_hat;                // column k: Φᵀ f_ext,k
-  std::vector<Eigen::MatrixXd> m_kl_hat;  // per q, column k: Φᵀ K_q L_k
+  std::vector<Eigen::MatrixXd> m_kl_hat;  // per q, column k: Φᵀ K_q L̃_k
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m_phi_s_rows;
   Eigen::LLT<Eigen::MatrixXd> m_k_llt;
   Eigen::MatrixXd m_k_inv;

@@ -55,7 +55,16 @@ Eigen::MatrixXd read_columns(hid_t f, const char* name, hsize_t rows, hsize_t co
   return Eigen::Map<Eigen::MatrixXd>(buf.data(), static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols));
 }
 
-std::string lifting_name(LiftingKind kind) { return kind == LiftingKind::Dirichlet ? "dirichlet" : "harmonic"; }
+std::string offset_name(OffsetKind kind) { return kind == OffsetKind::Dirichlet ? "dirichlet" : "harmonic"; }
+
+/// The attribute `offset` (named `lifting` before format version 3).
+OffsetKind read_offset_kind(hid_t f) {
+  const char* name = hdf5::has_attribute(f, "offset") ? "offset" : "lifting";
+  const std::string kind = hdf5::read_string_attribute(f, name);
+  if (kind != "harmonic" && kind != "dirichlet")
+    throw hdf5::Refused(std::string("attribute ") + name + " is " + quoted(kind, 200) + ", expected 'harmonic' or 'dirichlet'");
+  return kind == "dirichlet" ? OffsetKind::Dirichlet : OffsetKind::Harmonic;
+}
 
 void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
   const ReducedModelData d = rom.model().data();
@@ -65,7 +74,7 @@ void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
   hdf5::write_string_attribute(f, "created_by", "contactrom " + contactrom::version());
   hdf5::write_string_attribute(f, "method", rom.method());
   hdf5::write_scalar_attribute(f, "delta", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &d.options.delta);
-  hdf5::write_string_attribute(f, "lifting", lifting_name(d.options.lifting));
+  hdf5::write_string_attribute(f, "offset", offset_name(d.options.offset));
   const int include_failed = d.options.include_failed_snapshots ? 1 : 0;
   hdf5::write_scalar_attribute(f, "include_failed_snapshots", H5T_STD_I32LE, H5T_NATIVE_INT, &include_failed);
   std::vector<std::string> keys, values;
@@ -145,17 +154,14 @@ OnlineModel OnlineModel::load(const std::string& path) {
       throw InputError(label + " is not a contactrom reduced model (attribute kind is not '" + kKind +
                        "'; a snapshot database is read with --db, not --rom)");
     const int version = hdf5::read_int_attribute(f, "format_version");
-    if (version != kReducedModelFormatVersion && version != 1)
-      throw InputError(label + " has format_version " + std::to_string(version) + ", but this contactrom reads version " +
+    if (version < 1 || version > kReducedModelFormatVersion)
+      throw InputError(label + " has format_version " + std::to_string(version) + ", but this contactrom reads versions 1 to " +
                        std::to_string(kReducedModelFormatVersion) + "; rebuild it with contactrom reduce");
     method = hdf5::read_string_attribute(f, "method");
     d.options.delta = hdf5::read_double_attribute(f, "delta");
     if (!(d.options.delta >= 0.0) || !std::isfinite(d.options.delta))
       throw hdf5::Refused("attribute delta is " + format_number(d.options.delta) + ", expected a number >= 0");
-    const std::string lifting = hdf5::read_string_attribute(f, "lifting");
-    if (lifting != "harmonic" && lifting != "dirichlet")
-      throw hdf5::Refused("attribute lifting is " + quoted(lifting, 200) + ", expected 'harmonic' or 'dirichlet'");
-    d.options.lifting = lifting == "dirichlet" ? LiftingKind::Dirichlet : LiftingKind::Harmonic;
+    d.options.offset = read_offset_kind(f);
     d.options.include_failed_snapshots = hdf5::read_int_attribute(f, "include_failed_snapshots") != 0;
     const std::vector<std::string> keys = hdf5::read_string_list(f, "options/keys", hdf5::file_size(f));
     const std::vector<std::string> values = hdf5::read_string_list(f, "options/values", hdf5::file_size(f));

@@ -36,7 +36,7 @@ inline const fom::Problem& rope4(double load = 200.0) {
 
 /// The reduced model of rope4(load) with Φ = identity on the free nodes 1, 2, 3, the
 /// stiffness terms of the left (coefficient γ) and right (coefficient 30) elements,
-/// f̂ = −load/4 per node, no lifting, and the given dictionary (5 × m) whose columns
+/// f̂ = −load/4 per node, a zero offset, and the given dictionary (5 × m) whose columns
 /// stand for training parameters γ = 10, 20, … (database snapshots `snapshots`, or
 /// 0 … m−1 if empty).
 inline rom::ReducedModel hand_rope_model(const Eigen::MatrixXd& dictionary, double load = 200.0,
@@ -44,7 +44,7 @@ inline rom::ReducedModel hand_rope_model(const Eigen::MatrixXd& dictionary, doub
   const Eigen::Index m = dictionary.cols();
   rom::ReducedModelData d;
   d.options.delta = 1e-12;
-  d.options.lifting = rom::LiftingKind::Dirichlet;
+  d.options.offset = rom::OffsetKind::Dirichlet;
   d.basis = Eigen::MatrixXd::Zero(5, 3);
   for (int i = 0; i < 3; ++i) d.basis(i + 1, i) = 1.0;
   d.singular_values = Eigen::Vector3d::Ones();
