@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <contactrom/fom/problem.hpp>
+#include <contactrom/fom/rope.hpp>
 #include <contactrom/rom/offline.hpp>
 #include <contactrom/rom/reduced_model.hpp>
 
@@ -26,9 +27,9 @@ inline const fom::Problem& rope4(double load = 200.0) {
   static std::map<double, std::unique_ptr<fom::Problem>> problems;
   auto& p = problems[load];
   if (!p) {
-    fom::ProblemOptions options;
-    options.rope_elements = 4;
-    options.rope_load = load;
+    fom::RopeOptions options;
+    options.elements = 4;
+    options.load = load;
     p = fom::make_rope_problem(options);
   }
   return *p;
@@ -80,8 +81,8 @@ struct RopeSnapshotRom {
   fom::ConstraintMatrix c;
   Eigen::VectorXd g;
   RopeSnapshotRom() {
-    fom::ProblemOptions options;
-    options.rope_elements = 8;
+    fom::RopeOptions options;
+    options.elements = 8;
     problem = fom::make_rope_problem(options);
     rom::OfflineOptions off;
     off.threads = 1;
