@@ -134,7 +134,7 @@ struct ReducedActiveSet::Query : rom::ActiveSetStart {
   /// u_s = Φ_s x + u_off,s.
   void surface_displacement(const Eigen::VectorXd& x) {
     u_s.noalias() = solver.m_model.surface_basis() * x;
-    u_s += lift_s;
+    u_s += off_s;
   }
 
   /// Step 1: the operators at x (surface rows only).
@@ -222,7 +222,7 @@ struct ReducedActiveSet::Query : rom::ActiveSetStart {
     // as in the greedy: from the rows where each active column is non-zero.
     operators.start();
     for (int i = 0; i < na; ++i)
-      rhs(i) = solver.m_support.reduced_row(active[i], ops.c, ops.g, model.surface_basis_rows(), lift_s, c_hat_i.row(i));
+      rhs(i) = solver.m_support.reduced_row(active[i], ops.c, ops.g, model.surface_basis_rows(), off_s, c_hat_i.row(i));
     operators.stop();
     k_inv.apply(c_hat_i.transpose(), z);  // K̂⁻¹ Ĉ_Iᵀ
     schur.noalias() = c_hat_i * z;

@@ -5,11 +5,11 @@
 /// CPG baseline (W = cone-projected greedy basis, baselines/cpg.hpp) and the
 /// full-dictionary baseline (W = D_d, baselines/full_dictionary.hpp).
 ///
-/// Unknowns: reduced displacement û (u = Φû + u_lift(μ)) and reduced multipliers
+/// Unknowns: reduced displacement û (u = Φû + u_off(μ), the offset of rom::ReducedModel) and reduced multipliers
 /// λ̂ ≥ 0 on the columns of W (λ = Wλ̂). The reduced problem is
 /// \f[ \min_{\hat u} \tfrac12 \hat u^T \hat K \hat u - \hat f^T \hat u \quad\text{s.t.}\quad
 ///     \hat C \hat u - \hat g \le \tau, \qquad
-///     \hat C = W^T C(u) \Phi, \ \hat g = W^T (g(u) - C(u)\,u_{lift}), \f]
+///     \hat C = W^T C(u) \Phi, \ \hat g = W^T (g(u) - C(u)\,u_{off}), \f]
 /// whose KKT system, on the active set I (the columns whose constraint holds with
 /// equality), is the saddle-point system
 /// \f[ \begin{bmatrix} \hat K & \hat C_I^T \\ \hat C_I & 0 \end{bmatrix}
@@ -20,7 +20,7 @@
 /// the solve on frozen operators is this method's own. Starting from I = ∅ and the
 /// unconstrained û = K̂⁻¹f̂ (or from a warm start, ReducedActiveSetOptions::init), x = û:
 ///  1. rebuild the contact operators at x from the surface rows only, exactly as
-///     rom::GreedyActiveSet does (pairing = search(Φ_s x + u_lift,s), C_s, g =
+///     rom::GreedyActiveSet does (pairing = search(Φ_s x + u_off,s), C_s, g =
 ///     assemble(pairing)); when x is the û of the last solve (step 3), test û
 ///     physically at this, its own, pairing (rom::SupportRows::residuals: penetration
 ///     and separation under pressure within the contact tolerances): converged if it

@@ -8,6 +8,7 @@
 #include <contactrom/core/errors.hpp>
 #include <contactrom/fom/input_values.hpp>
 #include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/rope.hpp>
 
 namespace contactrom::fom {
 namespace {
@@ -30,14 +31,15 @@ FileWriter vtu_writer(const Problem& problem, const Param& mu, const Eigen::Vect
     const Mesh* mesh = problem.mesh();
     const ContactModel& contact = problem.contact();
     out << std::setprecision(std::numeric_limits<double>::max_digits10);
-    const int np = mesh ? mesh->num_nodes() : static_cast<int>(problem.rope_x().size());
+    const Eigen::VectorXd rope_x = mesh ? Eigen::VectorXd() : rope_nodes(problem);  // no mesh: the 1D rope
+    const int np = mesh ? mesh->num_nodes() : static_cast<int>(rope_x.size());
     const int ncell = mesh ? mesh->num_elements() : np - 1;
     out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
         << "  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"" << np << "\" NumberOfCells=\"" << ncell << "\">\n";
     Eigen::MatrixXd pts = Eigen::MatrixXd::Zero(np, 3);
     for (int i = 0; i < np; ++i) {
       if (mesh) pts.row(i).head(mesh->dim) = mesh->nodes.col(i).transpose();
-      else pts(i, 0) = problem.rope_x()(i);
+      else pts(i, 0) = rope_x(i);
     }
     out << "      <Points>\n";
     data_array(out, "Points", 3, pts);

@@ -5,22 +5,16 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include <contactrom/core/errors.hpp>
 #include <contactrom/core/format.hpp>
 #include <contactrom/fom/contact_checks.hpp>
 #include <contactrom/fom/node_to_face_contact.hpp>
+#include <contactrom/fom/rope.hpp>
 
 namespace contactrom::fom {
 namespace {
-
-std::string hash_text(const std::string& text) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (unsigned char ch : text) h = (h ^ ch) * 1099511628211ULL;
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
 
 std::string point_text(const Mesh& mesh, int node) {
   std::ostringstream s;
@@ -279,12 +273,55 @@ void keep_nonzero_terms(const AffineVectors& lift, const AffineVectors& fext, in
   }
 }
 
+/// U: the file's value, else the largest prescribed displacement over the box (1 if none).
+double displacement_scale(const ProblemDefinition& def) {
+  double scale = def.displacement_scale;
+  if (!(scale > 0)) {
+    for (const DirichletSpec& d : def.dirichlet)
+      for (const auto& v : d.displacement)
+        if (v) scale = std::max({scale, std::abs(v->min_over(def.parameters)), std::abs(v->max_over(def.parameters))});
+    if (!(scale > 0)) scale = 1.0;
+  }
+  return scale;
+}
+
 }  // namespace
 
-void Problem::finalize_dofs() {
-  m_free_dofs.clear();
+std::string text_fingerprint(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char ch : text) h = (h ^ ch) * 1099511628211ULL;
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+Problem::Problem(ProblemParts parts)
+    : m_definition(std::move(parts.definition)),
+      m_dofs_per_node(parts.dofs_per_node),
+      m_is_dirichlet(std::move(parts.is_dirichlet)),
+      m_k_terms(std::move(parts.stiffness_terms)),
+      m_k_coeff(std::move(parts.stiffness_coefficients)),
+      m_load_coeff(std::move(parts.load_coefficients)),
+      m_lift_terms(std::move(parts.lifting_terms)),
+      m_fext_terms(std::move(parts.external_load_terms)),
+      m_contact(std::move(parts.contact)),
+      m_h1(std::move(parts.h1_gram)),
+      m_mesh(std::move(parts.mesh)),
+      m_fingerprint(std::move(parts.fingerprint)),
+      m_u_scale(parts.displacement_scale) {
+  check_sizes();
   for (int i = 0; i < num_dofs(); ++i)
     if (!m_is_dirichlet[i]) m_free_dofs.push_back(i);
+}
+
+void Problem::check_sizes() const {
+  const auto n = static_cast<Eigen::Index>(m_is_dirichlet.size());
+  bool ok = m_contact && !m_k_terms.empty() && m_k_terms.size() == m_k_coeff.size() && !m_lift_terms.empty() &&
+            m_lift_terms.size() == m_fext_terms.size() && m_lift_terms.size() == m_load_coeff.size() &&
+            m_h1.rows() == n && m_h1.cols() == n && m_u_scale > 0.0;
+  for (const SparseMatrix& k : m_k_terms) ok = ok && k.rows() == n && k.cols() == n;
+  for (size_t t = 0; t < m_lift_terms.size() && ok; ++t) ok = m_lift_terms[t].size() == n && m_fext_terms[t].size() == n;
+  if (!ok) throw std::invalid_argument("Problem: the parts of '" + name() + "' disagree in size");
 }
 
 Eigen::VectorXd Problem::stiffness_coefficients(const Param& mu) const {
@@ -357,105 +394,38 @@ SparseMatrix free_block(const SparseMatrix& k, const std::vector<int>& free_inde
 }
 
 std::unique_ptr<Problem> build_problem(ProblemDefinition definition, Mesh mesh) {
-  std::unique_ptr<Problem> p(new Problem());
-  p->m_definition = std::move(definition);
-  p->m_mesh = std::make_unique<Mesh>(std::move(mesh));
-  const ProblemDefinition& def = p->m_definition;
-  const Mesh& m = *p->m_mesh;
+  ProblemParts p;
+  p.definition = std::move(definition);
+  p.mesh = std::make_unique<Mesh>(std::move(mesh));
+  const ProblemDefinition& def = p.definition;
+  const Mesh& m = *p.mesh;
   const int n = m.dim * m.num_nodes(), np = def.parameters.size();
-  p->m_dofs_per_node = m.dim;
+  p.dofs_per_node = m.dim;
   Builder b(def, m);
   b.check_dimension();
   b.check_bodies();
-  b.assemble_stiffness_terms(p->m_k_terms, p->m_k_coeff);
-  p->m_h1 = assemble_h1_gram(m);
-  p->m_is_dirichlet.assign(static_cast<size_t>(n), 0);
+  b.assemble_stiffness_terms(p.stiffness_terms, p.stiffness_coefficients);
+  p.h1_gram = assemble_h1_gram(m);
+  p.is_dirichlet.assign(static_cast<size_t>(n), 0);
   AffineVectors lift(np, n), fext(np, n);
-  b.dirichlet(p->m_is_dirichlet, lift);
+  b.dirichlet(p.is_dirichlet, lift);
   b.tractions(fext);
-  p->finalize_dofs();
-  keep_nonzero_terms(lift, fext, np, p->m_lift_terms, p->m_fext_terms, p->m_load_coeff);
-  if (p->m_lift_terms.empty()) {  // no load at all: keep one zero term so φ has a size
-    p->m_lift_terms.push_back(Eigen::VectorXd::Zero(n));
-    p->m_fext_terms.push_back(Eigen::VectorXd::Zero(n));
-    p->m_load_coeff.push_back(AffineExpression::constant_value(1.0, np));
+  keep_nonzero_terms(lift, fext, np, p.lifting_terms, p.external_load_terms, p.load_coefficients);
+  if (p.lifting_terms.empty()) {  // no load at all: keep one zero term so φ has a size
+    p.lifting_terms.push_back(Eigen::VectorXd::Zero(n));
+    p.external_load_terms.push_back(Eigen::VectorXd::Zero(n));
+    p.load_coefficients.push_back(AffineExpression::constant_value(1.0, np));
   }
-  p->m_contact = b.contact();
-
-  // U: the file's value, else the largest prescribed displacement over the box.
-  double scale = def.displacement_scale;
-  if (!(scale > 0)) {
-    for (const DirichletSpec& d : def.dirichlet)
-      for (const auto& v : d.displacement)
-        if (v) scale = std::max({scale, std::abs(v->min_over(def.parameters)), std::abs(v->max_over(def.parameters))});
-    if (!(scale > 0)) scale = 1.0;
-  }
-  p->m_u_scale = scale;
-  p->m_fingerprint = hash_text(def.text + "|" + m.fingerprint());
-  check_contact_pairs_face(*p);
-  return p;
-}
-
-std::unique_ptr<Problem> make_rope_problem(const ProblemOptions& opt) {
-  // 1D elastic rope on [0,1] above an obstacle (paper appendix B):
-  // energy ½∫ν(u')² + ∫ f u, u(0)=u(1)=0, u ≥ ψ(x) = −0.2(sin πx − sin 3πx) − 0.5,
-  // ν = γ for x < 0.5 and 30 otherwise.
-  const int ne = opt.rope_elements;
-  if (ne < 2 || ne > 1000000) throw InputError("rope elements " + std::to_string(ne) + " invalid; expected 2..1000000");
-  std::unique_ptr<Problem> p(new Problem());
-  ProblemDefinition& def = p->m_definition;
-  def.name = "rope";
-  def.builtin = "rope";
-  def.parameters.add("gamma", 10.0, 50.0);
-  def.training.kind = SamplingPlan::Kind::List;
-  for (int i = 0; i <= 8; ++i) def.training.points.push_back(Eigen::VectorXd::Constant(1, 10.0 + 5.0 * i));
-  def.validation.kind = SamplingPlan::Kind::List;
-  for (int i = 0; i < 8; ++i) def.validation.points.push_back(Eigen::VectorXd::Constant(1, 12.5 + 5.0 * i));
-  def.rom.convex_hull = true;
-  p->m_dofs_per_node = 1;
-  const int n = ne + 1;
-  const double h = 1.0 / ne;
-  p->m_rope_x = Eigen::VectorXd::LinSpaced(n, 0.0, 1.0);
-  std::vector<Eigen::Triplet<double>> left, right, gram;
-  for (int e = 0; e < ne; ++e) {
-    auto& t = (0.5 * (p->m_rope_x(e) + p->m_rope_x(e + 1)) < 0.5) ? left : right;
-    const double k = 1.0 / h;
-    t.insert(t.end(), {{e, e, k}, {e, e + 1, -k}, {e + 1, e, -k}, {e + 1, e + 1, k}});
-    const double m = h / 6.0;  // H¹ Gram: mass + stiffness
-    gram.insert(gram.end(), {{e, e, 2 * m + k}, {e, e + 1, m - k}, {e + 1, e, m - k}, {e + 1, e + 1, 2 * m + k}});
-  }
-  SparseMatrix kl(n, n), kr(n, n);
-  kl.setFromTriplets(left.begin(), left.end());
-  kr.setFromTriplets(right.begin(), right.end());
-  p->m_k_terms = {kl, kr};
-  AffineExpression gamma = AffineExpression::constant_value(0.0, 1);
-  gamma.coefficients(0) = 1.0;
-  p->m_k_coeff = {gamma, AffineExpression::constant_value(30.0, 1)};
-  p->m_h1.resize(n, n);
-  p->m_h1.setFromTriplets(gram.begin(), gram.end());
-  p->m_is_dirichlet.assign(n, 0);
-  p->m_is_dirichlet.front() = p->m_is_dirichlet.back() = 1;
-  p->finalize_dofs();
-  Eigen::VectorXd w = Eigen::VectorXd::Constant(n, h);
-  w(0) = w(n - 1) = 0.5 * h;
-  Eigen::VectorXd psi(n);
-  for (int i = 0; i < n; ++i) {
-    const double x = p->m_rope_x(i);
-    psi(i) = -0.2 * (std::sin(M_PI * x) - std::sin(3 * M_PI * x)) - 0.5;
-  }
-  p->m_contact = std::make_unique<ObstacleContact>(p->m_rope_x, psi, w);
-  Eigen::VectorXd fext = -opt.rope_load * w;
-  fext(0) = fext(n - 1) = 0.0;
-  p->m_fext_terms = {fext};
-  p->m_lift_terms = {Eigen::VectorXd::Zero(n)};
-  p->m_load_coeff = {AffineExpression::constant_value(1.0, 1)};
-  p->m_u_scale = 0.5;
-  p->m_fingerprint = hash_text("rope|" + std::to_string(ne) + "|" + format_number(opt.rope_load));
-  return p;
+  p.contact = b.contact();
+  p.displacement_scale = displacement_scale(def);
+  p.fingerprint = text_fingerprint(def.text + "|" + m.fingerprint());
+  auto problem = std::make_unique<Problem>(std::move(p));
+  check_contact_pairs_face(*problem);
+  return problem;
 }
 
 std::unique_ptr<Problem> make_problem(const std::string& name_or_path, const ProblemOptions& options) {
-  if (name_or_path == "rope") return make_rope_problem(options);
+  if (name_or_path == "rope") return make_rope_problem();
   ProblemDefinition def = read_problem_file(find_problem_file(name_or_path));
   if (options.refine < 0 || options.refine > 6)
     throw InputError("refine " + std::to_string(options.refine) + " is invalid; expected 0..6");

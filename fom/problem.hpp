@@ -1,7 +1,8 @@
 #pragma once
 /// \file problem.hpp
 /// \brief A parametrised linear-elastic contact problem, built from a problem
-/// file (fom/problem_file.hpp) and its mesh, or the 1D `rope` written in C++.
+/// file (fom/problem_file.hpp) and its mesh, or the 1D `rope` written in C++
+/// (fom/rope.hpp).
 ///
 /// Discrete problem (paper eq. 1–2), in full dof numbering with Dirichlet dofs
 /// kept: \f$ u = u_{lift}(\mu) + u_0 \f$ with \f$ u_0 = 0 \f$ on Dirichlet dofs and
@@ -29,10 +30,28 @@ namespace contactrom::fom {
 
 /// \brief Options of make_problem (documented defaults).
 struct ProblemOptions {
-  int rope_elements = 200;  ///< P1 elements of `rope`
-  double rope_load = 400.0; ///< uniform load f of `rope` (pulls the rope onto the obstacle)
   /// Extra uniform refinements on top of the file's `refine` (`--refine k`), default 0.
+  /// Not used by `rope` (fom/rope.hpp has its own options).
   int refine = 0;
+};
+
+/// \brief What a Problem is made of, as a builder fills it: build_problem() from a
+/// problem file and its mesh, make_rope_problem() (fom/rope.hpp) in C++. Sizes: n dofs,
+/// Q stiffness terms, T load terms.
+struct ProblemParts {
+  ProblemDefinition definition;             ///< the problem file read into data (rope: its equivalent)
+  int dofs_per_node = 2;                    ///< 2 or 3 (the mesh's dimension), 1 for a 1D problem
+  std::vector<char> is_dirichlet;           ///< n flags
+  std::vector<SparseMatrix> stiffness_terms;        ///< K_q, Q matrices n × n
+  std::vector<AffineExpression> stiffness_coefficients;  ///< θ_q(μ), Q
+  std::vector<Eigen::VectorXd> lifting_terms;       ///< L_k, T vectors of size n (Dirichlet values)
+  std::vector<Eigen::VectorXd> external_load_terms; ///< f_ext,k, T vectors of size n
+  std::vector<AffineExpression> load_coefficients;  ///< φ_k(μ), T
+  std::unique_ptr<ContactModel> contact;    ///< the contact constraints (required)
+  SparseMatrix h1_gram;                     ///< n × n Gram matrix of the H¹ norm
+  std::unique_ptr<Mesh> mesh;               ///< the mesh; nullptr for a 1D problem
+  std::string fingerprint;                  ///< of the discretisation
+  double displacement_scale = 1.0;          ///< U (> 0)
 };
 
 /// \brief A parametrised linear-elastic contact problem; see the file comment.
@@ -40,6 +59,10 @@ struct ProblemOptions {
 /// definition it was built from (sampling plans and ROM settings live there).
 class Problem {
  public:
+  /// \brief Takes the parts over. \throws std::invalid_argument if their sizes do not
+  /// agree (a builder's error, not the user's).
+  explicit Problem(ProblemParts parts);
+
   const std::string& name() const { return m_definition.name; }
   /// The problem file read into data (for `rope`, the equivalent built in C++).
   const ProblemDefinition& definition() const { return m_definition; }
@@ -89,8 +112,6 @@ class Problem {
   const Mesh* mesh() const { return m_mesh.get(); }
   /// Material of each body at μ (Young's moduli evaluated).
   std::vector<Material> materials(const Param& mu) const;
-  /// Node coordinates of the 1D rope (empty otherwise).
-  const Eigen::VectorXd& rope_x() const { return m_rope_x; }
   /// Fingerprint of the discretisation (problem definition + mesh).
   std::string fingerprint() const { return m_fingerprint; }
   /// Scale of the displacement field (max |Dirichlet value| over the range, or the
@@ -99,10 +120,7 @@ class Problem {
   double displacement_scale() const { return m_u_scale; }
 
  private:
-  friend std::unique_ptr<Problem> build_problem(ProblemDefinition definition, Mesh mesh);
-  friend std::unique_ptr<Problem> make_rope_problem(const ProblemOptions& options);
-  Problem() = default;
-  void finalize_dofs();  // builds m_free_dofs from m_is_dirichlet
+  void check_sizes() const;  // of the parts taken over
 
   ProblemDefinition m_definition;
   int m_dofs_per_node = 2;
@@ -114,10 +132,14 @@ class Problem {
   std::unique_ptr<ContactModel> m_contact;
   SparseMatrix m_h1;
   std::unique_ptr<Mesh> m_mesh;
-  Eigen::VectorXd m_rope_x;
   std::string m_fingerprint;
   double m_u_scale = 1.0;
 };
+
+/// \brief The fingerprint of a text, 16 lower-case hex digits (a 64-bit FNV-1a-style
+/// hash): what Problem::fingerprint() is made of, stored by databases and reduced-model
+/// files to refuse a problem they were not built for.
+std::string text_fingerprint(const std::string& text);
 
 /// \brief The free-dof block K_ff of a matrix on all dofs (Dirichlet rows and columns
 /// dropped). \param free_index position of each dof among the free dofs (−1: Dirichlet)
@@ -131,10 +153,7 @@ SparseMatrix free_block(const SparseMatrix& k, const std::vector<int>& free_inde
 /// \throws InputError naming the problem file, line and key.
 std::unique_ptr<Problem> build_problem(ProblemDefinition definition, Mesh mesh);
 
-/// \brief The 1D `rope` (paper appendix B), the one problem written in C++.
-std::unique_ptr<Problem> make_rope_problem(const ProblemOptions& options = {});
-
-/// \brief `--problem`: "rope", a shipped name ("hertz" → problems/hertz.toml) or a
+/// \brief `--problem`: "rope" (make_rope_problem() with its defaults), a shipped name ("hertz" → problems/hertz.toml) or a
 /// problem file path; reads the file, meshes it with gmsh (refined as asked) and
 /// builds the problem. \throws InputError for an unknown name or a bad file or mesh.
 std::unique_ptr<Problem> make_problem(const std::string& name_or_path, const ProblemOptions& options = {});

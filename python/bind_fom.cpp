@@ -4,6 +4,7 @@
 #include <contactrom/core/format.hpp>
 #include <contactrom/core/errors.hpp>
 #include "python/bindings.hpp"
+#include <contactrom/fom/rope.hpp>
 #include <contactrom/rom/offline.hpp>
 
 namespace contactrom::python {
@@ -124,7 +125,7 @@ with u = u_lift(mu) + u0 on all dofs (Dirichlet dofs kept).)doc");
       .def_property_readonly(
           "node_coordinates",
           [](const fom::Problem& p) -> py::object {
-            if (!p.mesh()) return py::cast(p.rope_x());
+            if (!p.mesh()) return py::cast(fom::rope_nodes(p));
             return py::cast(Eigen::MatrixXd(p.mesh()->nodes.transpose()));
           },
           "Node coordinates, shape (n_nodes, dim) (dim = 2 or 3; rope: the 1-D abscissae).")

@@ -15,15 +15,22 @@
 namespace contactrom::python {
 namespace {
 
-rom::LiftingKind lifting_kind(const std::string& text) {
-  if (text == "harmonic") return rom::LiftingKind::Harmonic;
-  if (text == "dirichlet") return rom::LiftingKind::Dirichlet;
-  throw InputError("lifting " + quoted(text, 200) + " unknown; expected harmonic or dirichlet");
+/// The offset kind named by `offset`, or by its older spelling `lifting` when given.
+rom::OffsetKind offset_kind(const std::string& offset, const py::object& lifting) {
+  const bool alias = !lifting.is_none();
+  const std::string text = alias ? py::str(lifting).cast<std::string>() : offset;
+  if (alias && offset != "harmonic" && offset != text)
+    throw InputError("offset " + quoted(offset, 200) + " and lifting " + quoted(text, 200) +
+                     " disagree; expected only offset (lifting is its older name)");
+  if (text == "harmonic") return rom::OffsetKind::Harmonic;
+  if (text == "dirichlet") return rom::OffsetKind::Dirichlet;
+  throw InputError(std::string(alias ? "lifting " : "offset ") + quoted(text, 200) +
+                   " unknown; expected harmonic or dirichlet");
 }
 
 std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, double delta, const std::string& method,
-                                                  const py::dict& options, const std::string& lifting,
-                                                  bool include_failed) {
+                                                  const py::dict& options, const std::string& offset,
+                                                  bool include_failed, const py::object& lifting) {
   if (!(delta >= 0.0 && delta <= 1.0))
     throw InputError("delta = " + format_number(delta) + " is outside [0, 1]; expected a POD tolerance such as 1e-8");
   rom::check_online_method(method);
@@ -32,7 +39,7 @@ std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, doub
   const rom::OnlineSolverOptions solver_options = rom::options_from_map(method, values);
   rom::ReducedModelOptions model_options;
   model_options.delta = delta;
-  model_options.lifting = lifting_kind(lifting);
+  model_options.offset = offset_kind(offset, lifting);
   model_options.include_failed_snapshots = include_failed;
   auto r = std::make_unique<ReducedModel>();
   r->db = database.db;
@@ -335,13 +342,15 @@ POD basis, dual dictionary, reduced operators and an online method, built from a
 snapshot database or loaded from a reduced-model file (`contactrom reduce`). The
 object owns the problem (and the database) it needs.)doc")
       .def(py::init(&build_reduced_model), py::arg("db"), py::arg("delta") = 1e-8, py::arg("method") = "greedy",
-           py::arg("options") = py::dict(), py::arg("lifting") = "harmonic",
-           py::arg("include_failed_snapshots") = false, R"doc(
+           py::arg("options") = py::dict(), py::arg("offset") = "harmonic",
+           py::arg("include_failed_snapshots") = false, py::arg("lifting") = py::none(), R"doc(
 Builds the reduced model of a SnapshotDatabase: the POD of its primal snapshots
 truncated at `delta` (energy share dropped), the dual dictionary of its pressures,
 the reduced operators, and the online `method` (contactrom.online_methods()) with its
-`options` (a dict of the method's keys, numbers as numbers). `lifting`: harmonic
-(default) or zero. `include_failed_snapshots`: also use snapshots whose FOM solve did
+`options` (a dict of the method's keys, numbers as numbers). `offset`: what the
+reduced displacement is measured from, "harmonic" (default; the unconstrained FOM
+response) or "dirichlet" (the problem's Dirichlet lifting); `lifting` is accepted as
+its older name. `include_failed_snapshots`: also use snapshots whose FOM solve did
 not succeed. ValueError names the argument for a bad value.)doc")
       .def_static("load", &load_reduced_model, py::arg("path"),
                   "Reads a reduced-model file (`contactrom reduce` or ReducedModel.save): no FOM, no meshing.")

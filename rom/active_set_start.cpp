@@ -21,7 +21,7 @@ bool ActiveSetStart::begin(const ReducedModel& model, const fom::Param& mu, Warm
     res.lambda = Eigen::VectorXd::Zero(model.dictionary().rows());
     return false;
   }
-  lift_s = model.surface_lifting(mu);
+  off_s = model.surface_offset(mu);
   k_inv.apply(model.reduced_rhs(mu), u_free);
 
   start_columns.clear();

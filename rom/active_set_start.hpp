@@ -44,13 +44,13 @@ struct ActiveSetStart {
   ActiveSetStart(const ReducedModel& model, const fom::Param& mu) : k_inv(model, mu) {}
 
   ReducedStiffnessInverse k_inv;   ///< K̂(μ)⁻¹
-  Eigen::VectorXd lift_s;          ///< surface offset u_off,s(μ)
+  Eigen::VectorXd off_s;          ///< surface offset u_off,s(μ)
   Eigen::VectorXd u_free;          ///< unconstrained reduced solution K̂⁻¹ f̂
   Eigen::VectorXd u_start;         ///< starting û
   std::vector<int> start_columns;  ///< starting selection (dictionary columns; empty for Empty and Primal)
   int nearest = -1;                ///< training snapshot nearest to the start (−1: none, init Empty)
 
-  /// \brief Computes lift_s, u_free and the starting point of `init`.
+  /// \brief Computes off_s, u_free and the starting point of `init`.
   /// \returns false, with `res` the answer of a failed query (NumericalIssue, û = 0,
   ///   λ = 0), when K̂(μ) could not be factorised.
   bool begin(const ReducedModel& model, const fom::Param& mu, WarmStart init, OnlineResult& res);

@@ -284,28 +284,6 @@ double checked_basis_delta(const ReducedModel& model, const ConvexHullOptions& o
   return delta;
 }
 
-/// Per load term k: u_off,k − u_lift,k, the reduced model's offset less the Dirichlet lifting.
-std::vector<VectorXd> offset_minus_lifting(const ReducedModel& model) {
-  const fom::Problem& problem = model.problem();
-  std::vector<VectorXd> out;
-  for (int k = 0; k < problem.num_load_terms(); ++k)
-    out.push_back(model.offset_terms()[static_cast<std::size_t>(k)] - problem.lifting_terms()[static_cast<std::size_t>(k)]);
-  return out;
-}
-
-/// The training solutions as the database stores them, d_p = u_j − u_lift(μ_j)
-/// (Dirichlet lifting, so that u = u_lift(μ) + D_p α is a convex combination of the
-/// snapshots up to the Dirichlet data): the reduced model measures its snapshots
-/// from its own offset u_off, which is undone here.
-MatrixXd lifted_snapshots(const ReducedModel& model, const std::vector<VectorXd>& offset_minus_lift) {
-  MatrixXd dp = model.primal_snapshots();
-  for (Index c = 0; c < dp.cols(); ++c) {
-    const VectorXd phi = model.problem().load_coefficients(model.dictionary_parameters()[static_cast<std::size_t>(c)]);
-    for (std::size_t k = 0; k < offset_minus_lift.size(); ++k) dp.col(c) += phi(static_cast<Index>(k)) * offset_minus_lift[k];
-  }
-  return dp;
-}
-
 /// Projection basis B of the residual test space: the SVD basis of D_p at δ, or
 /// orth(D_p R) for a random R of L columns; zero on the Dirichlet rows.
 MatrixXd make_projection_basis(const MatrixXd& dp, const fom::Problem& problem, const ConvexHullOptions& options,
@@ -362,8 +340,10 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
   const auto t0 = std::chrono::steady_clock::now();
   const fom::Problem& problem = model.problem();
   const double delta = checked_basis_delta(model, options);
-  const std::vector<VectorXd> offset_minus_lift = offset_minus_lifting(model);
-  const MatrixXd dp = lifted_snapshots(model, offset_minus_lift);
+  // The training solutions as the database stores them, d_p = u_j − u_lift(μ_j), so
+  // that u = u_lift(μ) + D_p α is a convex combination of the snapshots up to the
+  // Dirichlet data (whatever offset the model's POD is measured from).
+  const MatrixXd& dp = model.primal_snapshots();
   const MatrixXd& dd = model.dictionary();
   const int nt = problem.num_load_terms();
   m_num_dofs = static_cast<int>(dp.rows());
@@ -388,10 +368,8 @@ MonolithicDictionary::MonolithicDictionary(const ReducedModel& model, const Conv
     for (int k = 0; k < nt; ++k) kl.col(k) = kb.transpose() * problem.lifting_terms()[static_cast<std::size_t>(k)];
     m_bkl.push_back(kl);
   }
-  // û = Φᵀ(u − u_off(μ)) = Φᵀ D_p α + Σ_k φ_k(μ) Φᵀ(L_k − L̃_k).
+  // û = Φᵀ(u − u_off(μ)) = Φᵀ D_p α + Φᵀ(u_lift(μ) − u_off(μ)) (ReducedModel::reduced_lifting).
   m_phi_dp = model.basis().transpose() * dp;
-  m_phi_dl.resize(model.basis().cols(), nt);
-  for (int k = 0; k < nt; ++k) m_phi_dl.col(k) = -(model.basis().transpose() * offset_minus_lift[static_cast<std::size_t>(k)]);
 
   const fom::ContactModel& contact = problem.contact();
   if (!contact.has_pairing()) {  // C and g do not depend on u: the contact block is constant
@@ -413,10 +391,6 @@ MatrixXd MonolithicDictionary::projected_stiffness(const fom::Param& mu) const {
 
 VectorXd MonolithicDictionary::surface_lifting(const fom::Param& mu) const {
   return m_lift_s * m_model.problem().load_coefficients(mu);
-}
-
-VectorXd MonolithicDictionary::reduced_offset(const fom::Param& mu) const {
-  return m_phi_dl * m_model.problem().load_coefficients(mu);
 }
 
 VectorXd MonolithicDictionary::projected_rhs(const fom::Param& mu) const {
@@ -447,7 +421,7 @@ void ConvexHullSolver::solve_reduced(const fom::Param& mu, OnlineResult& res) co
 }
 
 Eigen::VectorXd ConvexHullSolver::reconstruct_primal(const OnlineResult& res) const {
-  // u = u_off(μ) + D_p α over the support (mesh-size work, for output only).
+  // u = u_lift(μ) + D_p α over the support (mesh-size work, for output only).
   VectorXd u = model().problem().lifting(res.mu);
   for (std::size_t i = 0; i < res.selected.size(); ++i)
     u.noalias() += res.coefficients(static_cast<Index>(i)) * m_dictionary.primal().col(res.selected[i]);
@@ -476,7 +450,7 @@ void ConvexHullSolver::solve_hull(const fom::Param& mu, ConvexHullResult& res, O
   on.selected.assign(support.begin(), support.end());
   on.coefficients.resize(static_cast<Index>(support.size()));
   on.lambda = VectorXd::Zero(dict.dual().rows());
-  on.u_hat = dict.reduced_offset(mu);
+  on.u_hat = model.reduced_lifting(mu);
   for (std::size_t i = 0; i < support.size(); ++i) {
     const Index j = support[i];
     on.coefficients(static_cast<Index>(i)) = res.alpha(j);

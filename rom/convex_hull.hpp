@@ -6,8 +6,8 @@
 ///
 /// Offline (MonolithicDictionary): the columns of the monolithic dictionary are
 /// the training solutions, each displacement snapshot \f$ d_{p,j} = u_j - u_{lift}(\mu_j) \f$
-/// (as stored in the database, Dirichlet lifting — whatever offset the
-/// ReducedModel uses for its POD) stacked over its pressure snapshot
+/// (as stored in the database and kept by the ReducedModel, ReducedModel::primal_snapshots();
+/// the Dirichlet lifting, whatever offset the model's POD uses) stacked over its pressure snapshot
 /// \f$ d_{d,j} = \lambda_j \f$. A projection
 /// basis B of the residual test space is built in the primal space (free dofs
 /// only: B is zero on Dirichlet dofs), either
@@ -181,13 +181,10 @@ class MonolithicDictionary {
   Eigen::MatrixXd projected_contact(const fom::ConstraintMatrix& c) const;
   /// \brief The constant contact block (contact without pairing), else nullptr.
   const Eigen::MatrixXd* constant_contact() const { return m_has_constant_contact ? &m_bc_const : nullptr; }
-  /// \brief \f$ \Phi^T D_p \f$ (r × m): reduced coordinates of the columns in the
-  /// model's POD basis (for OnlineResult::u_hat).
+  /// \brief \f$ \Phi^T D_p \f$ (r × m): with ReducedModel::reduced_lifting(μ), the reduced
+  /// coordinates \f$ \hat u = \Phi^T D_p\alpha + \Phi^T(u_{lift} - u_{off}) \f$ of an answer
+  /// (OnlineResult::u_hat, in the model's convention u ≈ u_off + Φû).
   const Eigen::MatrixXd& reduced_coordinates() const { return m_phi_dp; }
-  /// \brief \f$ \Phi^T(u_{lift}(\mu) - u_{off}(\mu)) \f$ (r): with it,
-  /// \f$ \hat u = \Phi^T D_p\alpha + \f$ this, so that \f$ u \approx u_{off} + \Phi\hat u \f$
-  /// in the model's convention.
-  Eigen::VectorXd reduced_offset(const fom::Param& mu) const;
   /// \brief Dirichlet lifting \f$ u_{lift}(\mu) \f$ on the surface dofs.
   Eigen::VectorXd surface_lifting(const fom::Param& mu) const;
 
@@ -198,7 +195,7 @@ class MonolithicDictionary {
   const ReducedModel& m_model;
   ConvexHullOptions m_options;
   int m_num_dofs = 0;
-  Eigen::MatrixXd m_mono, m_dd, m_b, m_b_s, m_dp_s, m_lift_s, m_phi_dp, m_phi_dl, m_bc_const;
+  Eigen::MatrixXd m_mono, m_dd, m_b, m_b_s, m_dp_s, m_lift_s, m_phi_dp, m_bc_const;
   std::vector<Eigen::MatrixXd> m_bkd;     // Bᵀ K_q D_p
   Eigen::MatrixXd m_bf;                   // column k: Bᵀ f_ext,k
   std::vector<Eigen::MatrixXd> m_bkl;     // per q, column k: Bᵀ K_q L_k

@@ -133,7 +133,7 @@ struct GreedyActiveSet::Query : ActiveSetStart {
   void surface_displacement(const Eigen::VectorXd& x, Eigen::VectorXd& u_s) {
     operators.start();
     u_s.noalias() = solver.m_model.surface_basis() * x;
-    u_s += lift_s;
+    u_s += off_s;
     operators.stop();
   }
   /// Step 1: the pairing, C_R and g_R of the support rows at u_s.
@@ -307,7 +307,7 @@ struct GreedyActiveSet::Interleaved {
     // Rows of Ĉ_I = D_Iᵀ C_R Φ_s and entries of ĝ_I = D_Iᵀ (g_R − C_R u_off,s), from
     // the rows where each selected column is non-zero.
     q->operators.start();
-    g->m_support.reduced_rows(active, q->ops.c, q->ops.g, g->m_model.surface_basis_rows(), q->lift_s, c_hat_i, rhs, rows);
+    g->m_support.reduced_rows(active, q->ops.c, q->ops.g, g->m_model.surface_basis_rows(), q->off_s, c_hat_i, rhs, rows);
     q->operators.stop();
     n_lambda = na;
     if (na == 0) {
@@ -506,7 +506,7 @@ struct GreedyActiveSet::Nested {
   /// u_free, and the selected columns' vectors.
   void freeze_operators() {
     q->operators.start();
-    g->m_support.gap_operator(q->ops.c, q->ops.g, g->m_model.surface_basis_rows(), q->lift_s, a, b);
+    g->m_support.gap_operator(q->ops.c, q->ops.g, g->m_model.surface_basis_rows(), q->off_s, a, b);
     q->operators.stop();
     gap.noalias() = a * q->u_free;
     gap += b;

@@ -3,15 +3,15 @@
 /// \brief Greedy active-set online solver (Kollepara et al., "Sparse
 /// approximations for contact mechanics", Algorithm 1; docs/theory.md §3.2).
 ///
-/// Unknowns: reduced displacement û (u = Φû + u_lift(μ)) and sparse dictionary
+/// Unknowns: reduced displacement û (u = Φû + u_off(μ), the offset of rom::ReducedModel) and sparse dictionary
 /// coefficients λ̂_I (λ = D_d[:, I] λ̂_I). Starting from I = ∅ and the
 /// unconstrained û = K̂⁻¹ f̂ (GreedyOptions::init = WarmStart::Empty, the paper's
 /// Alg. 1) — or, by default, from the columns of the training parameters around μ
 /// and their interpolated reduced coordinates (WarmStart) — each iteration k:
 ///  1. rebuilds the contact operators at the previous iterate from the surface
-///     rows only: \f$ u_s = \Phi_s \hat u^{k-1} + u_{lift,s} \f$, pairing =
+///     rows only: \f$ u_s = \Phi_s \hat u^{k-1} + u_{off,s} \f$, pairing =
 ///     search(u_s), (C_s, g) = assemble(pairing),
-///     \f$ \hat C = D_d^T C_s \Phi_s \f$, \f$ \hat g = D_d^T (g - C_s u_{lift,s}) \f$;
+///     \f$ \hat C = D_d^T C_s \Phi_s \f$, \f$ \hat g = D_d^T (g - C_s u_{off,s}) \f$;
 ///  2. solves the saddle-point system
 ///     \f[ \begin{bmatrix} \hat K & \hat C_I^T \\ \hat C_I & 0 \end{bmatrix}
 ///         \begin{bmatrix} \hat u \\ \hat\lambda_I \end{bmatrix} =

@@ -37,7 +37,7 @@ class ErrorIndicator;
 struct OnlineResult {
   fom::Param mu;                 ///< parameter of the query
   Eigen::VectorXd u_hat;         ///< reduced primal coordinates û (size r)
-  Eigen::VectorXd u;             ///< full displacement Φû + u_lift(μ) (n_dofs)
+  Eigen::VectorXd u;             ///< full displacement Φû + u_off(μ) (n_dofs; the convex hull: u_lift(μ) + D_p α)
   Eigen::VectorXd lambda;        ///< full contact pressure D_d[:, I] λ̂_I (n_c)
   std::vector<int> selected;     ///< selected dictionary columns I (indices into ReducedModel::dictionary())
   Eigen::VectorXd coefficients;  ///< λ̂_I, in the order of `selected`
@@ -67,14 +67,14 @@ struct OnlineResult {
   double estimate_time_s = 0.0;
   /// Wall time of the online core (seconds): everything from μ to (û, λ̂_I) and the
   /// full pressure, nonlinear contact operators included; the full-field
-  /// reconstruction Φû + u_lift (a mesh-size operation needed only for output) is
+  /// reconstruction of u (a mesh-size operation needed only for output) is
   /// excluded and timed in `reconstruction_time_s`. The full-order contact check
   /// (`check_time_s`) is included: a status is part of the answer.
   double time_s = 0.0;
   /// Wall time of the full-order contact check that sets `contact` (one contact
   /// search and assembly on the surface), included in `time_s`.
   double check_time_s = 0.0;
-  double reconstruction_time_s = 0.0;  ///< wall time of u = Φû + u_lift (seconds)
+  double reconstruction_time_s = 0.0;  ///< wall time of the reconstruction of u (seconds)
   /// Part of `time_s` spent building the contact operators at the iterates (surface
   /// displacement Φ_s û, contact search, assembly of C_R and g_R, the rows Ĉ_I, ĝ_I
   /// of the reduced operators): the "construction of the non-linear operators" that

@@ -2,6 +2,7 @@
 
 #include <contactrom/core/errors.hpp>
 #include <contactrom/fom/problem_file.hpp>
+#include <contactrom/fom/rope.hpp>
 
 namespace contactrom::rom {
 

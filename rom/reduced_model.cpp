@@ -26,6 +26,26 @@ std::vector<Eigen::VectorXd> harmonic_offsets(const fom::Problem& problem) {
   return out;
 }
 
+/// Column k: Φᵀ(L_k − L̃_k), the lifting term's coordinates measured from the offset.
+Eigen::MatrixXd lifting_coordinates(const Eigen::MatrixXd& phi, const fom::Problem& problem,
+                                    const std::vector<Eigen::VectorXd>& offset_terms) {
+  Eigen::MatrixXd out(phi.cols(), static_cast<Eigen::Index>(offset_terms.size()));
+  for (size_t k = 0; k < offset_terms.size(); ++k)
+    out.col(static_cast<Eigen::Index>(k)) = phi.transpose() * (problem.lifting_terms()[k] - offset_terms[k]);
+  return out;
+}
+
+/// Refuses a database whose sizes are not the problem's, or a negative δ.
+void check_model_input(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options) {
+  const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
+  if (db.num_dofs() != nd || db.num_constraints() != nc)
+    throw InputError("database of problem " + quoted(db.problem.name, 200) + " has " + std::to_string(db.num_dofs()) + " dofs and " +
+                     std::to_string(db.num_constraints()) + " contact rows, but " + problem.name() + " has " +
+                     std::to_string(nd) + " and " + std::to_string(nc));
+  if (!(options.delta >= 0.0))
+    throw InputError("POD tolerance delta = " + std::to_string(options.delta) + " invalid; expected >= 0");
+}
+
 }  // namespace
 
 std::vector<int> reduced_model_columns(const SnapshotDatabase& db, const ReducedModelOptions& options) {
@@ -35,8 +55,8 @@ std::vector<int> reduced_model_columns(const SnapshotDatabase& db, const Reduced
   return out;
 }
 
-std::vector<Eigen::VectorXd> reduced_model_offsets(const fom::Problem& problem, LiftingKind lifting) {
-  return lifting == LiftingKind::Harmonic ? harmonic_offsets(problem) : problem.lifting_terms();
+std::vector<Eigen::VectorXd> reduced_model_offsets(const fom::Problem& problem, OffsetKind kind) {
+  return kind == OffsetKind::Harmonic ? harmonic_offsets(problem) : problem.lifting_terms();
 }
 
 ReducedSnapshots::ReducedSnapshots(const fom::Problem& problem, const SnapshotDatabase& db, std::vector<int> columns,
@@ -56,13 +76,17 @@ ReducedSnapshots::ReducedSnapshots(const fom::Problem& problem, const SnapshotDa
 
 void ReducedSnapshots::read_rows(Eigen::Index first, Eigen::Index count, Eigen::MatrixXd& out) const {
   m_stored->read_rows(first, count, out);
-  for (Eigen::Index c = 0; c < out.cols(); ++c)
-    for (const auto& [k, d] : m_shift) out.col(c) -= m_coefficients(k, c) * d.segment(first, count);
+  to_offset(first, out);
+}
+
+void ReducedSnapshots::to_offset(Eigen::Index first, Eigen::MatrixXd& block) const {
+  for (Eigen::Index c = 0; c < block.cols(); ++c)
+    for (const auto& [k, d] : m_shift) block.col(c) -= m_coefficients(k, c) * d.segment(first, block.rows());
 }
 
 void share_reduced_model_pod(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options) {
   const ReducedSnapshots snapshots(problem, db, reduced_model_columns(db, options),
-                                   reduced_model_offsets(problem, options.lifting));
+                                   reduced_model_offsets(problem, options.offset));
   PodOptions pod_options = options.pod;
   pod_options.delta = options.delta;
   Pod(pod_options).compute(snapshots);
@@ -71,62 +95,70 @@ void share_reduced_model_pod(const fom::Problem& problem, const SnapshotDatabase
 ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options)
     : m_problem(problem), m_options(options) {
   const auto t0 = std::chrono::steady_clock::now();
-  const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
-  if (db.num_dofs() != nd || db.num_constraints() != nc)
-    throw InputError("database of problem " + quoted(db.problem.name, 200) + " has " + std::to_string(db.num_dofs()) + " dofs and " +
-                     std::to_string(db.num_constraints()) + " contact rows, but " + problem.name() + " has " +
-                     std::to_string(nd) + " and " + std::to_string(nc));
-  if (!(options.delta >= 0.0))
-    throw InputError("POD tolerance delta = " + std::to_string(options.delta) + " invalid; expected >= 0");
-
+  check_model_input(problem, db, options);
   m_dict_snapshots = reduced_model_columns(db, options);
   if (m_dict_snapshots.empty())
     throw InputError("database of problem " + quoted(db.problem.name, 200) + " holds no successful snapshot");
-  const int m = static_cast<int>(m_dict_snapshots.size());
-  const int nt = problem.num_load_terms();
-  m_offset = reduced_model_offsets(problem, options.lifting);
-  m_dict.resize(nc, m);
-  for (int c = 0; c < m; ++c) {
+  m_offset = reduced_model_offsets(problem, options.offset);
+  take_dictionary(db);
+  compute_basis(ReducedSnapshots(problem, db, m_dict_snapshots, m_offset));
+  reduce_operators();
+  if (options.split_pairs) split_by_pair();
+  derive();
+  m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void ReducedModel::take_dictionary(const SnapshotDatabase& db) {
+  m_dict.resize(db.num_constraints(), static_cast<Eigen::Index>(m_dict_snapshots.size()));
+  for (size_t c = 0; c < m_dict_snapshots.size(); ++c) {
     const int j = m_dict_snapshots[c];
-    m_dict.col(c) = db.dual.col(j);
+    m_dict.col(static_cast<Eigen::Index>(c)) = db.dual.col(j);
     m_dict_params.push_back(db.parameter(j));
   }
-  const ReducedSnapshots snapshots(problem, db, m_dict_snapshots, m_offset);
+}
 
-  // Primal basis: POD with the energy criterion (rom/pod.hpp); Dirichlet rows of
-  // the snapshots are zero, so are those of Φ (set exactly, against rounding).
-  // The snapshots are read whole only when kept or small enough for the SVD;
-  // otherwise the POD reads them by blocks and gives their coordinates.
-  PodOptions pod_options = options.pod;
-  pod_options.delta = options.delta;
+void ReducedModel::compute_basis(const ReducedSnapshots& snapshots) {
+  // Primal basis: POD of u − u_off with the energy criterion (rom/pod.hpp); Dirichlet
+  // rows of the snapshots are zero, so are those of Φ (set exactly, against rounding).
+  // The snapshots are read whole only when kept (as stored, u − u_lift) or small
+  // enough for the SVD; otherwise the POD reads them by blocks and gives their coordinates.
+  const Eigen::Index nd = snapshots.rows(), m = snapshots.cols();
+  PodOptions pod_options = m_options.pod;
+  pod_options.delta = m_options.delta;
   Pod pod(pod_options);
   const auto t_pod = std::chrono::steady_clock::now();
-  const bool whole = options.keep_primal_snapshots || pod.uses_svd(nd, m);
+  const bool whole = m_options.keep_primal_snapshots || pod.uses_svd(nd, m);
+  Eigen::MatrixXd from_offset;  // u − u_off, when read whole
   if (whole) {
-    m_primal = snapshots.read_all();
-    pod.compute(m_primal);
+    Eigen::MatrixXd stored = snapshots.read_stored();
+    from_offset = stored;
+    snapshots.to_offset(0, from_offset);
+    pod.compute(from_offset);
+    m_primal = m_options.keep_primal_snapshots ? std::move(stored) : Eigen::MatrixXd(nd, 0);
   } else {
     pod.compute(snapshots);
+    m_primal.resize(nd, 0);
   }
   m_pod_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_pod).count();
   if (pod.info() != Status::Success)
-    throw InputError("POD of the primal snapshots of " + quoted(db.problem.name, 200) + " failed (" + to_string(pod.info()) + ")");
+    throw InputError("POD of the primal snapshots of " + quoted(m_problem.name(), 200) + " failed (" + to_string(pod.info()) + ")");
   m_phi = pod.basis();
   m_sigma = pod.singular_values();
-  const std::vector<char>& dirichlet = problem.is_dirichlet();
+  const std::vector<char>& dirichlet = m_problem.is_dirichlet();
   // (A basis of rank 0, δ = 1, has no row to clear: row() of an empty matrix is
   // an offset on a null pointer.)
-  for (int i = 0; i < nd && m_phi.cols() > 0; ++i)
-    if (dirichlet[i]) m_phi.row(i).setZero();
-  m_snapshot_coords = whole ? Eigen::MatrixXd(m_phi.transpose() * m_primal) : pod.coordinates();
-  if (!options.keep_primal_snapshots) m_primal.resize(nd, 0);
+  for (Eigen::Index i = 0; i < nd && m_phi.cols() > 0; ++i)
+    if (dirichlet[static_cast<size_t>(i)]) m_phi.row(i).setZero();
+  m_snapshot_coords = whole ? Eigen::MatrixXd(m_phi.transpose() * from_offset) : pod.coordinates();
+}
 
+void ReducedModel::reduce_operators() {
   // Affine reduced operators (file comment).
-  const int r = primal_rank();
+  const int r = primal_rank(), nt = m_problem.num_load_terms();
   m_f_hat.resize(r, nt);
-  for (int k = 0; k < nt; ++k) m_f_hat.col(k) = m_phi.transpose() * problem.external_load_terms()[k];
-  for (int q = 0; q < problem.num_stiffness_terms(); ++q) {
-    const fom::SparseMatrix& kq = problem.stiffness_term(q);
+  for (int k = 0; k < nt; ++k) m_f_hat.col(k) = m_phi.transpose() * m_problem.external_load_terms()[k];
+  for (int q = 0; q < m_problem.num_stiffness_terms(); ++q) {
+    const fom::SparseMatrix& kq = m_problem.stiffness_term(q);
     const Eigen::MatrixXd kphi = kq * m_phi;
     Eigen::MatrixXd khat = m_phi.transpose() * kphi;
     m_k_hat.push_back(0.5 * (khat + khat.transpose()));  // symmetric to rounding
@@ -134,9 +166,13 @@ ReducedModel::ReducedModel(const fom::Problem& problem, const SnapshotDatabase& 
     for (int k = 0; k < nt; ++k) kl.col(k) = kphi.transpose() * m_offset[k];  // Φᵀ K_q L̃_k, K_q symmetric
     m_kl_hat.push_back(kl);
   }
-  if (options.split_pairs) split_by_pair();
-  derive();
-  m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  m_lift_hat = lifting_coordinates(m_phi, m_problem, m_offset);
+}
+
+Eigen::MatrixXd ReducedModel::coordinates_of(const Eigen::MatrixXd& stored) const {
+  Eigen::MatrixXd coords = m_phi.transpose() * stored;
+  for (Eigen::Index c = 0; c < coords.cols(); ++c) coords.col(c) += reduced_lifting(m_dict_params[static_cast<size_t>(c)]);
+  return coords;
 }
 
 void ReducedModel::split_by_pair() {
@@ -214,10 +250,6 @@ ReducedModel::ReducedModel(const fom::Problem& problem, ReducedModelData data)
   if (data.primal_snapshots.cols() > 0)
     require(data.primal_snapshots.rows() == n && data.primal_snapshots.cols() == m, "the primal snapshots",
             data.primal_snapshots.size(), n * m);
-  if (data.snapshot_coordinates.size() == 0 && data.primal_snapshots.cols() > 0)
-    data.snapshot_coordinates = data.basis.transpose() * data.primal_snapshots;
-  require(data.snapshot_coordinates.rows() == r && data.snapshot_coordinates.cols() == m,
-          "the snapshot coordinates", data.snapshot_coordinates.size(), r * m);
   m_phi = std::move(data.basis);
   m_sigma = std::move(data.singular_values);
   m_offset = std::move(data.offset_terms);
@@ -228,7 +260,11 @@ ReducedModel::ReducedModel(const fom::Problem& problem, ReducedModelData data)
   m_dict_snapshots = std::move(data.dictionary_snapshots);
   m_dict_params = std::move(data.dictionary_parameters);
   m_primal = data.primal_snapshots.cols() > 0 ? std::move(data.primal_snapshots) : Eigen::MatrixXd(n, 0);
-  m_snapshot_coords = std::move(data.snapshot_coordinates);
+  m_lift_hat = lifting_coordinates(m_phi, m_problem, m_offset);
+  m_snapshot_coords = data.snapshot_coordinates.size() == 0 && m_primal.cols() > 0 ? coordinates_of(m_primal)
+                                                                                   : std::move(data.snapshot_coordinates);
+  require(m_snapshot_coords.rows() == r && m_snapshot_coords.cols() == m, "the snapshot coordinates",
+          m_snapshot_coords.size(), r * m);
   m_options.keep_primal_snapshots = m_primal.cols() > 0;
   derive();
   m_setup_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -267,15 +303,15 @@ void ReducedModel::derive() {
   m_phi_s.resize(ns, r);
   for (int a = 0; a < ns && r > 0; ++a) m_phi_s.row(a) = m_phi.row(surf[a]);
   m_phi_s_rows = m_phi_s;
-  m_lift_s.resize(ns, nt);
+  m_off_s.resize(ns, nt);
   for (int k = 0; k < nt; ++k)
-    for (int a = 0; a < ns; ++a) m_lift_s(a, k) = m_offset[k](surf[a]);
+    for (int a = 0; a < ns; ++a) m_off_s(a, k) = m_offset[k](surf[a]);
   // The contact search at every reduced snapshot, over all rows (a query's support
   // rows are a subset): one full search per column, offline.
   m_snapshot_memory.assign(static_cast<size_t>(dictionary_size()), fom::SearchMemory());
   fom::Pairing pairing;
   for (int p = 0; p < dictionary_size(); ++p) {
-    const Eigen::VectorXd u_s = m_phi_s * m_snapshot_coords.col(p) + surface_lifting(m_dict_params[static_cast<size_t>(p)]);
+    const Eigen::VectorXd u_s = m_phi_s * m_snapshot_coords.col(p) + surface_offset(m_dict_params[static_cast<size_t>(p)]);
     m_problem.contact().search_rows(u_s, nullptr, nullptr, m_snapshot_memory[static_cast<size_t>(p)], pairing);
   }
   if (m_k_hat.size() == 1) {
@@ -398,8 +434,12 @@ ReducedStiffnessInverse::ReducedStiffnessInverse(const ReducedModel& model, cons
   m_ok = m_factor->info() == Eigen::Success && std::isfinite(m_inv_theta);
 }
 
-Eigen::VectorXd ReducedModel::surface_lifting(const fom::Param& mu) const {
-  return m_lift_s * m_problem.load_coefficients(mu);
+Eigen::VectorXd ReducedModel::surface_offset(const fom::Param& mu) const {
+  return m_off_s * m_problem.load_coefficients(mu);
+}
+
+Eigen::VectorXd ReducedModel::reduced_lifting(const fom::Param& mu) const {
+  return m_lift_hat * m_problem.load_coefficients(mu);
 }
 
 Eigen::VectorXd ReducedModel::offset(const fom::Param& mu) const {

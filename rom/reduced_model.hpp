@@ -3,16 +3,18 @@
 /// \brief The offline product shared by the dictionary ROMs: POD primal basis,
 /// uncompressed dual dictionary and the parameter-affine reduced operators.
 ///
-/// With \f$ u = u_{lift}(\mu) + \Phi\hat u \f$ (Φ zero on Dirichlet dofs), the
-/// reduced problem of paper eq. (5) needs, for every parameter,
+/// With \f$ u = u_{off}(\mu) + \Phi\hat u \f$, the offset
+/// \f$ u_{off}(\mu) = \sum_k \phi_k(\mu) \tilde L_k \f$ carrying the Dirichlet data
+/// (OffsetKind) and Φ zero on Dirichlet dofs, the reduced problem of paper eq. (5)
+/// needs, for every parameter,
 /// \f[ \hat K(\mu) = \Phi^T K(\mu) \Phi = \sum_q \theta_q(\mu)\,\Phi^T K_q \Phi, \qquad
-///     \hat f(\mu) = \Phi^T f(\mu) = \sum_k \phi_k(\mu) \Big( \Phi^T f_{ext,k}
-///        - \sum_q \theta_q(\mu)\, \Phi^T K_q L_k \Big), \f]
+///     \hat f(\mu) = \sum_k \phi_k(\mu) \Big( \Phi^T f_{ext,k}
+///        - \sum_q \theta_q(\mu)\, \Phi^T K_q \tilde L_k \Big), \f]
 /// which are assembled from the offline pieces \f$ \Phi^T K_q \Phi \f$ (r × r),
-/// \f$ \Phi^T f_{ext,k} \f$ and \f$ \Phi^T K_q L_k \f$ (r each) at a cost
+/// \f$ \Phi^T f_{ext,k} \f$ and \f$ \Phi^T K_q \tilde L_k \f$ (r each) at a cost
 /// independent of the mesh. The nonlinear contact operators are rebuilt online
 /// from the contact-surface rows only: \f$ \Phi_s = \Phi[\text{surface dofs}, :] \f$
-/// and the surface lifting \f$ u_{lift,s}(\mu) = \sum_k \phi_k(\mu) L_{k,s} \f$.
+/// and the surface offset \f$ u_{off,s}(\mu) = \sum_k \phi_k(\mu) \tilde L_{k,s} \f$.
 ///
 /// The dual dictionary \f$ D_d \f$ (n_c × m) holds every pressure snapshot of the
 /// database whose FOM status is Success, uncompressed, in database order.
@@ -32,8 +34,8 @@ class ErrorIndicator;
 
 /// \brief Which affine offset u_off(μ) = Σ_k φ_k(μ) L̃_k the reduced displacement is
 /// measured from (u = u_off(μ) + Φû). Both carry the Dirichlet data exactly.
-enum class LiftingKind {
-  /// L̃_k = L_k, the problem's lifting (Dirichlet values, zero elsewhere): the POD is
+enum class OffsetKind {
+  /// L̃_k = L_k, the problem's Dirichlet lifting (Dirichlet values, zero elsewhere): the POD is
   /// taken of the database snapshots u − u_lift as stored.
   Dirichlet,
   /// L̃_k = the unconstrained FOM response to load term k (Dirichlet values L_k and
@@ -59,12 +61,13 @@ struct ReducedModelOptions {
   /// columns of one snapshot share its parameter and primal snapshot
   /// (sibling_columns()). Default true; false: one column per snapshot.
   bool split_pairs = true;
-  /// Offset of the reduced displacement; see LiftingKind. Default Harmonic.
-  LiftingKind lifting = LiftingKind::Harmonic;
-  /// Keep the primal snapshots u − u_off of the dictionary columns (n × m) in the
-  /// model. Only methods that combine whole training solutions need them (the convex
-  /// hull); the others use their reduced coordinates Φᵀ(u − u_off) (r × m), which are
-  /// always kept. Default true; OnlineModel keeps them only for a method that needs them.
+  /// Offset u_off of the reduced displacement; see OffsetKind. Default Harmonic.
+  OffsetKind offset = OffsetKind::Harmonic;
+  /// Keep the primal snapshots of the dictionary columns (n × m), as the database
+  /// stores them (u − u_lift), in the model. Only methods that combine whole training
+  /// solutions need them (the convex hull); the others use their reduced coordinates
+  /// Φᵀ(u − u_off) (r × m), which are always kept. Default true; OnlineModel keeps
+  /// them only for a method that needs them.
   bool keep_primal_snapshots = true;
   /// How the POD is computed: algorithm, threads, block size, MPI ranks (rom/pod.hpp);
   /// its delta is replaced by `delta` above. Default PodOptions().
@@ -85,11 +88,12 @@ struct ReducedModelData {
   Eigen::MatrixXd dictionary;              ///< D_d, n_c × m
   std::vector<int> dictionary_snapshots;   ///< database snapshot index of each column
   std::vector<fom::Param> dictionary_parameters;  ///< parameter of each column
-  /// u − u_off of each column, n × m; or empty (0 columns) when the model does not keep
-  /// them (ReducedModelOptions::keep_primal_snapshots).
+  /// u − u_lift of each column (the training solution less the problem's Dirichlet
+  /// lifting, as the database stores it), n × m; or empty (0 columns) when the model
+  /// does not keep them (ReducedModelOptions::keep_primal_snapshots).
   Eigen::MatrixXd primal_snapshots;
   /// Φᵀ(u − u_off) of each column, r × m. May be left empty when primal_snapshots is
-  /// given (then computed from them).
+  /// given (then computed from them: Φᵀ(u − u_lift) + Φᵀ(u_lift − u_off)).
   Eigen::MatrixXd snapshot_coordinates;
 };
 
@@ -97,12 +101,13 @@ struct ReducedModelData {
 /// FOM status is Success (all with ReducedModelOptions::include_failed_snapshots).
 std::vector<int> reduced_model_columns(const SnapshotDatabase& db, const ReducedModelOptions& options);
 
-/// \brief The offset terms L̃_k of `lifting` (see LiftingKind).
-std::vector<Eigen::VectorXd> reduced_model_offsets(const fom::Problem& problem, LiftingKind lifting);
+/// \brief The offset terms L̃_k of `kind` (see OffsetKind).
+std::vector<Eigen::VectorXd> reduced_model_offsets(const fom::Problem& problem, OffsetKind kind);
 
 /// \brief The matrix a reduced model's POD is taken of: u − u_off(μ_c) of the kept
 /// database snapshots (n_dofs × m), by blocks of rows, from the database in memory or
-/// on disk (SnapshotDatabase::primal_file). `db` and `problem` must outlive it.
+/// on disk (SnapshotDatabase::primal_file): the stored u − u_lift less
+/// \f$ \sum_k \phi_k(\mu_c) (\tilde L_k - L_k) \f$. `db` and `problem` must outlive it.
 class ReducedSnapshots : public SnapshotBlocks {
  public:
   ReducedSnapshots(const fom::Problem& problem, const SnapshotDatabase& db, std::vector<int> columns,
@@ -110,6 +115,11 @@ class ReducedSnapshots : public SnapshotBlocks {
   Eigen::Index rows() const override { return m_stored->rows(); }
   Eigen::Index cols() const override { return m_stored->cols(); }
   void read_rows(Eigen::Index first, Eigen::Index count, Eigen::MatrixXd& out) const override;
+  /// The stored snapshots u − u_lift, whole (n_dofs × m).
+  Eigen::MatrixXd read_stored() const { return m_stored->read_all(); }
+  /// Rows [first, first + block.rows()) of the stored snapshots, measured from the
+  /// offset instead, in place: u − u_lift becomes u − u_off.
+  void to_offset(Eigen::Index first, Eigen::MatrixXd& block) const;
 
  private:
   std::unique_ptr<SnapshotBlocks> m_stored;                 // u − u_lift, as stored
@@ -171,8 +181,9 @@ class ReducedModel {
   const std::vector<int>& sibling_columns(int p) const {
     return m_siblings[static_cast<size_t>(m_dict_snapshots[static_cast<size_t>(p)])];
   }
-  /// Primal snapshots u − u_off of the dictionary columns (n_dofs × m), for methods
-  /// that need them (e.g. monolithic dictionaries); n_dofs × 0 when the model does not
+  /// Primal snapshots of the dictionary columns as the database stores them,
+  /// u − u_lift(μ) (n_dofs × m), for methods that combine whole training solutions
+  /// (the convex hull's monolithic dictionary); n_dofs × 0 when the model does not
   /// keep them (has_primal_snapshots()).
   const Eigen::MatrixXd& primal_snapshots() const { return m_primal; }
   /// Whether primal_snapshots() holds one column per dictionary column.
@@ -215,11 +226,15 @@ class ReducedModel {
   /// \f$ \hat f(\mu) = \Phi^T f(\mu) \f$ from the affine pieces.
   Eigen::VectorXd reduced_rhs(const fom::Param& mu) const;
   /// Offset on the surface dofs, \f$ u_{off}(\mu) \f$ restricted to surface_dofs().
-  Eigen::VectorXd surface_lifting(const fom::Param& mu) const;
-  /// Offset terms L̃_k of the reduced displacement (n_dofs each; see LiftingKind).
+  Eigen::VectorXd surface_offset(const fom::Param& mu) const;
+  /// Offset terms L̃_k of the reduced displacement (n_dofs each; see OffsetKind).
   const std::vector<Eigen::VectorXd>& offset_terms() const { return m_offset; }
   /// \f$ u_{off}(\mu) = \sum_k \phi_k(\mu) \tilde L_k \f$ (n_dofs).
   Eigen::VectorXd offset(const fom::Param& mu) const;
+  /// \brief \f$ \Phi^T(u_{lift}(\mu) - u_{off}(\mu)) \f$ (r): the reduced coordinates of a
+  /// field given as u − u_lift (a primal snapshot, a combination of them) are
+  /// \f$ \Phi^T(u - u_{lift}) \f$ plus this. Zero for OffsetKind::Dirichlet.
+  Eigen::VectorXd reduced_lifting(const fom::Param& mu) const;
 
   /// \brief Cholesky factor of \f$ \Phi^T K_0 \Phi \f$ when the problem has a single
   /// stiffness term (then \f$ \hat K(\mu) = \theta_0(\mu)\,\Phi^T K_0\Phi \f$: factorised
@@ -248,7 +263,7 @@ class ReducedModel {
  private:
   const fom::Problem& m_problem;
   ReducedModelOptions m_options;
-  Eigen::MatrixXd m_primal, m_phi, m_phi_s, m_dict, m_lift_s;
+  Eigen::MatrixXd m_primal, m_phi, m_phi_s, m_dict, m_off_s;  // m_off_s: column k, L̃_k on the surface dofs
   Eigen::VectorXd m_sigma;
   std::vector<int> m_dict_snapshots;
   std::vector<fom::Param> m_dict_params;
@@ -260,12 +275,17 @@ class ReducedModel {
   std::vector<std::vector<double>> m_grid_values;
   std::vector<int> m_grid_columns;
   void build_parameter_grid();
+  void take_dictionary(const SnapshotDatabase& db);  // D_d and the columns' parameters
+  void compute_basis(const ReducedSnapshots& snapshots);  // Φ, σ, coordinates, primal snapshots
+  void reduce_operators();  // Φᵀ K_q Φ, Φᵀ f_ext,k, Φᵀ K_q L̃_k
   void split_by_pair();  // ReducedModelOptions::split_pairs
+  Eigen::MatrixXd coordinates_of(const Eigen::MatrixXd& stored) const;  // Φᵀ(u − u_off) of u − u_lift columns
   void derive();  // surface rows, snapshot coordinates and search memories, grid, factor of Φᵀ K₀ Φ
   std::vector<Eigen::VectorXd> m_offset;  // L̃_k
   std::vector<Eigen::MatrixXd> m_k_hat;   // Φᵀ K_q Φ
   Eigen::MatrixXd m_f_hat;                // column k: Φᵀ f_ext,k
-  std::vector<Eigen::MatrixXd> m_kl_hat;  // per q, column k: Φᵀ K_q L_k
+  std::vector<Eigen::MatrixXd> m_kl_hat;  // per q, column k: Φᵀ K_q L̃_k
+  Eigen::MatrixXd m_lift_hat;             // column k: Φᵀ(L_k − L̃_k) (derived)
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m_phi_s_rows;
   Eigen::LLT<Eigen::MatrixXd> m_k_llt;
   Eigen::MatrixXd m_k_inv;

@@ -55,7 +55,16 @@ Eigen::MatrixXd read_columns(hid_t f, const char* name, hsize_t rows, hsize_t co
   return Eigen::Map<Eigen::MatrixXd>(buf.data(), static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols));
 }
 
-std::string lifting_name(LiftingKind kind) { return kind == LiftingKind::Dirichlet ? "dirichlet" : "harmonic"; }
+std::string offset_name(OffsetKind kind) { return kind == OffsetKind::Dirichlet ? "dirichlet" : "harmonic"; }
+
+/// The attribute `offset` (named `lifting` before format version 3).
+OffsetKind read_offset_kind(hid_t f) {
+  const char* name = hdf5::has_attribute(f, "offset") ? "offset" : "lifting";
+  const std::string kind = hdf5::read_string_attribute(f, name);
+  if (kind != "harmonic" && kind != "dirichlet")
+    throw hdf5::Refused(std::string("attribute ") + name + " is " + quoted(kind, 200) + ", expected 'harmonic' or 'dirichlet'");
+  return kind == "dirichlet" ? OffsetKind::Dirichlet : OffsetKind::Harmonic;
+}
 
 void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
   const ReducedModelData d = rom.model().data();
@@ -65,7 +74,7 @@ void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
   hdf5::write_string_attribute(f, "created_by", "contactrom " + contactrom::version());
   hdf5::write_string_attribute(f, "method", rom.method());
   hdf5::write_scalar_attribute(f, "delta", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &d.options.delta);
-  hdf5::write_string_attribute(f, "lifting", lifting_name(d.options.lifting));
+  hdf5::write_string_attribute(f, "offset", offset_name(d.options.offset));
   const int include_failed = d.options.include_failed_snapshots ? 1 : 0;
   hdf5::write_scalar_attribute(f, "include_failed_snapshots", H5T_STD_I32LE, H5T_NATIVE_INT, &include_failed);
   std::vector<std::string> keys, values;
@@ -102,6 +111,123 @@ void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
   write_problem_record(f, dcpl, record_problem(rom.problem()));
 }
 
+/// What a reduced-model file holds, as read (OnlineModel::load).
+struct StoredModel {
+  int version = 0;
+  ReducedModelData data;
+  ProblemRecord record;
+  std::string method;
+  std::map<std::string, std::string> option_values;
+};
+
+/// The attributes: format version, method, δ, offset kind, failed snapshots, options.
+void read_settings(hid_t f, const std::string& label, StoredModel& s) {
+  if (!hdf5::has_attribute(f, "kind") || hdf5::read_string_attribute(f, "kind") != kKind)
+    throw InputError(label + " is not a contactrom reduced model (attribute kind is not '" + kKind +
+                     "'; a snapshot database is read with --db, not --rom)");
+  s.version = hdf5::read_int_attribute(f, "format_version");
+  if (s.version < 1 || s.version > kReducedModelFormatVersion)
+    throw InputError(label + " has format_version " + std::to_string(s.version) + ", but this contactrom reads versions 1 to " +
+                     std::to_string(kReducedModelFormatVersion) + "; rebuild it with contactrom reduce");
+  s.method = hdf5::read_string_attribute(f, "method");
+  ReducedModelOptions& o = s.data.options;
+  o.delta = hdf5::read_double_attribute(f, "delta");
+  if (!(o.delta >= 0.0) || !std::isfinite(o.delta))
+    throw hdf5::Refused("attribute delta is " + format_number(o.delta) + ", expected a number >= 0");
+  o.offset = read_offset_kind(f);
+  o.include_failed_snapshots = hdf5::read_int_attribute(f, "include_failed_snapshots") != 0;
+  const std::vector<std::string> keys = hdf5::read_string_list(f, "options/keys", hdf5::file_size(f));
+  const std::vector<std::string> values = hdf5::read_string_list(f, "options/values", hdf5::file_size(f));
+  if (keys.size() != values.size()) throw hdf5::Refused("datasets /options/keys and /options/values differ in length");
+  for (size_t i = 0; i < keys.size(); ++i) s.option_values[keys[i]] = values[i];
+}
+
+/// Basis, singular values, offset terms and the reduced operators (n dofs).
+void read_operators(hid_t f, hsize_t n, ReducedModelData& d) {
+  const auto [r, n_basis] = shape2(f, "basis");
+  d.basis = read_columns(f, "basis", n, r);
+  std::vector<double> sigma;
+  hsize_t rows = 0, cols = 0;
+  hdf5::read_double_dataset(f, "singular_values", sigma, rows, cols);
+  if (cols != 1 || rows < r) throw hdf5::Refused("dataset /singular_values holds fewer values than modes");
+  for (double v : sigma)
+    if (!std::isfinite(v) || v < 0.0)
+      throw hdf5::Refused("dataset /singular_values holds " + format_number(v) + ", expected finite values >= 0");
+  d.singular_values = Eigen::Map<Eigen::VectorXd>(sigma.data(), static_cast<Eigen::Index>(rows));
+  const auto [nt, n_offset] = shape2(f, "offset");
+  const Eigen::MatrixXd offset = read_columns(f, "offset", n, nt);
+  for (hsize_t k = 0; k < nt; ++k) d.offset_terms.push_back(offset.col(static_cast<Eigen::Index>(k)));
+  d.load_terms = read_columns(f, "reduced/load", r, nt);
+  for (int q = 0;; ++q) {
+    const std::string name = "reduced/stiffness_" + std::to_string(q);
+    if (H5Lexists(f, name.c_str(), H5P_DEFAULT) <= 0) break;
+    d.stiffness_terms.push_back(read_columns(f, name.c_str(), r, r));
+    d.stiffness_offset_terms.push_back(read_columns(f, ("reduced/stiffness_offset_" + std::to_string(q)).c_str(), r, nt));
+  }
+  (void)n_basis, (void)n_offset;
+}
+
+/// The dictionary, its columns' snapshots and parameters, their coordinates and (for
+/// a method that combines them, or version 1) their primal snapshots; m columns.
+void read_columns_data(hid_t f, const StoredModel& s, hsize_t n, ReducedModelData& d) {
+  const hsize_t m = static_cast<hsize_t>(d.dictionary.cols()), r = static_cast<hsize_t>(d.basis.cols());
+  hsize_t rows = 0, cols = 0;
+  hdf5::read_int_dataset(f, "dictionary_snapshots", d.dictionary_snapshots, rows, cols);
+  if (rows != m || cols != 1) throw hdf5::Refused("dataset /dictionary_snapshots does not hold one index per column");
+  for (int j : d.dictionary_snapshots)
+    if (j < 0) throw hdf5::Refused("dataset /dictionary_snapshots holds the negative index " + std::to_string(j));
+  const auto [mp, np] = shape2(f, "dictionary_parameters");
+  const Eigen::MatrixXd params = read_columns(f, "dictionary_parameters", np, m);
+  for (hsize_t c = 0; c < m; ++c) d.dictionary_parameters.push_back(params.col(static_cast<Eigen::Index>(c)));
+  // Version 1 stored the primal snapshots always and no coordinates; versions 2 and 3
+  // the coordinates always and the snapshots only for a method that needs them.
+  bool needs_primal = false;
+  try {
+    needs_primal = online_method_needs_primal_snapshots(s.method);
+  } catch (const InputError&) {  // an unknown method is reported later, naming the file
+  }
+  if (s.version == 1 || needs_primal) d.primal_snapshots = read_columns(f, "primal_snapshots", n, m);
+  if (s.version == 1) {
+    d.snapshot_coordinates = d.basis.transpose() * d.primal_snapshots;  // stored from the offset, u − u_off
+    if (!needs_primal) d.primal_snapshots.resize(0, 0);
+  } else {
+    d.snapshot_coordinates = read_columns(f, "snapshot_coordinates", r, m);
+  }
+  (void)mp;
+}
+
+/// The whole file but the problem's rebuild (OnlineModel::load).
+StoredModel read_stored_model(hid_t f, const std::string& label) {
+  StoredModel s;
+  read_settings(f, label, s);
+  const auto [r, n] = shape2(f, "basis");
+  const auto [m, nc] = shape2(f, "dictionary");
+  read_operators(f, n, s.data);
+  s.data.dictionary = read_columns(f, "dictionary", nc, m);
+  read_columns_data(f, s, n, s.data);
+  const double scale = std::max(1.0, s.data.dictionary.size() ? s.data.dictionary.cwiseAbs().maxCoeff() : 0.0);
+  if (s.data.dictionary.size() && s.data.dictionary.minCoeff() < -1e-9 * scale)
+    throw hdf5::Refused("dataset /dictionary holds a negative pressure");
+  s.record = read_problem_record(f, nc, n);
+  // The surface rows are stored for readers of the file; the model takes them from the basis.
+  const auto [r_s, n_s] = shape2(f, "surface_basis");
+  if (r_s != r) throw hdf5::Refused("dataset /surface_basis does not hold one row per mode");
+  read_columns(f, "surface_basis", n_s, r);  // its numbers are finite, as every stored number
+  return s;
+}
+
+/// Versions 1 and 2 stored the primal snapshots measured from the offset, u − u_off;
+/// the model holds them as the database does, u − u_lift = (u − u_off) + Σ_k φ_k (L̃_k − L_k).
+void measure_primal_from_lifting(const fom::Problem& problem, ReducedModelData& d) {
+  if (d.primal_snapshots.cols() == 0 || d.offset_terms.size() != static_cast<size_t>(problem.num_load_terms())) return;
+  for (Eigen::Index c = 0; c < d.primal_snapshots.cols(); ++c) {
+    const Eigen::VectorXd phi = problem.load_coefficients(d.dictionary_parameters[static_cast<size_t>(c)]);
+    for (size_t k = 0; k < d.offset_terms.size(); ++k)
+      if (d.offset_terms[k].size() == d.primal_snapshots.rows())
+        d.primal_snapshots.col(c) += phi(static_cast<Eigen::Index>(k)) * (d.offset_terms[k] - problem.lifting_terms()[k]);
+  }
+}
+
 }  // namespace
 
 OnlineModel::OnlineModel(std::shared_ptr<const fom::Problem> problem, std::unique_ptr<ReducedModel> model,
@@ -135,104 +261,27 @@ void OnlineModel::save(const std::string& path) const {
 OnlineModel OnlineModel::load(const std::string& path) {
   const std::string label = "reduced model " + quoted(path, 200);
   Handle file(hdf5::open_file(path, "reduced model", "contactrom reduce"), H5Fclose, "the file structure");
-  const hid_t f = file.id();
-  ReducedModelData d;
-  ProblemRecord record;
-  std::string method;
-  std::map<std::string, std::string> option_values;
+  StoredModel stored;
   try {
-    if (!hdf5::has_attribute(f, "kind") || hdf5::read_string_attribute(f, "kind") != kKind)
-      throw InputError(label + " is not a contactrom reduced model (attribute kind is not '" + kKind +
-                       "'; a snapshot database is read with --db, not --rom)");
-    const int version = hdf5::read_int_attribute(f, "format_version");
-    if (version != kReducedModelFormatVersion && version != 1)
-      throw InputError(label + " has format_version " + std::to_string(version) + ", but this contactrom reads version " +
-                       std::to_string(kReducedModelFormatVersion) + "; rebuild it with contactrom reduce");
-    method = hdf5::read_string_attribute(f, "method");
-    d.options.delta = hdf5::read_double_attribute(f, "delta");
-    if (!(d.options.delta >= 0.0) || !std::isfinite(d.options.delta))
-      throw hdf5::Refused("attribute delta is " + format_number(d.options.delta) + ", expected a number >= 0");
-    const std::string lifting = hdf5::read_string_attribute(f, "lifting");
-    if (lifting != "harmonic" && lifting != "dirichlet")
-      throw hdf5::Refused("attribute lifting is " + quoted(lifting, 200) + ", expected 'harmonic' or 'dirichlet'");
-    d.options.lifting = lifting == "dirichlet" ? LiftingKind::Dirichlet : LiftingKind::Harmonic;
-    d.options.include_failed_snapshots = hdf5::read_int_attribute(f, "include_failed_snapshots") != 0;
-    const std::vector<std::string> keys = hdf5::read_string_list(f, "options/keys", hdf5::file_size(f));
-    const std::vector<std::string> values = hdf5::read_string_list(f, "options/values", hdf5::file_size(f));
-    if (keys.size() != values.size())
-      throw hdf5::Refused("datasets /options/keys and /options/values differ in length");
-    for (size_t i = 0; i < keys.size(); ++i) option_values[keys[i]] = values[i];
-
-    const auto [r, n] = shape2(f, "basis");
-    const auto [m, nc] = shape2(f, "dictionary");
-    d.basis = read_columns(f, "basis", n, r);
-    d.dictionary = read_columns(f, "dictionary", nc, m);
-    std::vector<double> sigma;
-    hsize_t rows = 0, cols = 0;
-    hdf5::read_double_dataset(f, "singular_values", sigma, rows, cols);
-    if (cols != 1 || rows < r) throw hdf5::Refused("dataset /singular_values holds fewer values than modes");
-    for (double v : sigma)
-      if (!std::isfinite(v) || v < 0.0)
-        throw hdf5::Refused("dataset /singular_values holds " + format_number(v) + ", expected finite values >= 0");
-    d.singular_values = Eigen::Map<Eigen::VectorXd>(sigma.data(), static_cast<Eigen::Index>(rows));
-    const auto [nt, n_offset] = shape2(f, "offset");
-    const Eigen::MatrixXd offset = read_columns(f, "offset", n, nt);
-    for (hsize_t k = 0; k < nt; ++k) d.offset_terms.push_back(offset.col(static_cast<Eigen::Index>(k)));
-    d.load_terms = read_columns(f, "reduced/load", r, nt);
-    for (int q = 0;; ++q) {
-      const std::string name = "reduced/stiffness_" + std::to_string(q);
-      if (H5Lexists(f, name.c_str(), H5P_DEFAULT) <= 0) break;
-      d.stiffness_terms.push_back(read_columns(f, name.c_str(), r, r));
-      d.stiffness_offset_terms.push_back(
-          read_columns(f, ("reduced/stiffness_offset_" + std::to_string(q)).c_str(), r, nt));
-    }
-    hdf5::read_int_dataset(f, "dictionary_snapshots", d.dictionary_snapshots, rows, cols);
-    if (rows != m || cols != 1) throw hdf5::Refused("dataset /dictionary_snapshots does not hold one index per column");
-    for (int j : d.dictionary_snapshots)
-      if (j < 0) throw hdf5::Refused("dataset /dictionary_snapshots holds the negative index " + std::to_string(j));
-    const auto [mp, np] = shape2(f, "dictionary_parameters");
-    const Eigen::MatrixXd params = read_columns(f, "dictionary_parameters", np, m);
-    for (hsize_t c = 0; c < m; ++c) d.dictionary_parameters.push_back(params.col(static_cast<Eigen::Index>(c)));
-    // Version 1 stored the primal snapshots always and no coordinates; version 2 the
-    // coordinates always and the snapshots only for a method that needs them.
-    bool needs_primal = false;
-    try {
-      needs_primal = online_method_needs_primal_snapshots(method);
-    } catch (const InputError&) {  // an unknown method is reported below, naming the file
-    }
-    if (version == 1 || needs_primal) d.primal_snapshots = read_columns(f, "primal_snapshots", n, m);
-    if (version == 1) {
-      d.snapshot_coordinates = d.basis.transpose() * d.primal_snapshots;
-      if (!needs_primal) d.primal_snapshots.resize(0, 0);
-    } else {
-      d.snapshot_coordinates = read_columns(f, "snapshot_coordinates", r, m);
-    }
-    const double scale = std::max(1.0, d.dictionary.size() ? d.dictionary.cwiseAbs().maxCoeff() : 0.0);
-    if (d.dictionary.size() && d.dictionary.minCoeff() < -1e-9 * scale)
-      throw hdf5::Refused("dataset /dictionary holds a negative pressure");
-    record = read_problem_record(f, nc, n);
-    // The surface rows are stored for readers of the file; the model takes them from the basis.
-    const auto [r_s, n_s] = shape2(f, "surface_basis");
-    if (r_s != r) throw hdf5::Refused("dataset /surface_basis does not hold one row per mode");
-    read_columns(f, "surface_basis", n_s, r);  // its numbers are finite, as every stored number
-    (void)mp, (void)n_offset;
+    stored = read_stored_model(file.id(), label);
     file.close("file close");
   } catch (const hdf5::Refused& e) {
     throw InputError(label + " is not a valid contactrom reduced model: " + e.what());
   } catch (const hdf5::Failure& e) {
     throw InputError(label + " is truncated or corrupt (HDF5 cannot read " + e.what() + ")");
   }
-  std::shared_ptr<const fom::Problem> problem = rebuild_problem(record, label);
-  for (const fom::Param& p : d.dictionary_parameters) {
+  std::shared_ptr<const fom::Problem> problem = rebuild_problem(stored.record, label);
+  for (const fom::Param& p : stored.data.dictionary_parameters) {
     try {
       problem->check_param(p);
     } catch (const InputError& e) {
       throw InputError(label + " dataset /dictionary_parameters: " + e.what());
     }
   }
+  if (stored.version < 3) measure_primal_from_lifting(*problem, stored.data);
   try {
-    auto model = std::make_unique<ReducedModel>(*problem, std::move(d));
-    return OnlineModel(problem, std::move(model), method, options_from_map(method, option_values));
+    auto model = std::make_unique<ReducedModel>(*problem, std::move(stored.data));
+    return OnlineModel(problem, std::move(model), stored.method, options_from_map(stored.method, stored.option_values));
   } catch (const InputError& e) {
     throw InputError(label + ": " + e.what());
   }

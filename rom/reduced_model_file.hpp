@@ -31,9 +31,11 @@
 namespace contactrom::rom {
 
 /// \brief Version of the reduced-model file layout (attribute `format_version`).
-/// Version 2 stores the snapshots' reduced coordinates and the primal snapshots only
-/// for a method that needs them; version-1 files are still read.
-inline constexpr int kReducedModelFormatVersion = 2;
+/// Version 3 names the offset kind `offset` (versions 1 and 2: `lifting`) and stores
+/// the primal snapshots as the database does, u − u_lift (versions 1 and 2: u − u_off);
+/// version 2 stores the snapshots' reduced coordinates and the primal snapshots only
+/// for a method that needs them. Files of versions 1 and 2 are still read.
+inline constexpr int kReducedModelFormatVersion = 3;
 
 /// \brief A reduced model with its online method, ready to query; see the file comment.
 /// Immutable after construction; solve() is thread-safe.

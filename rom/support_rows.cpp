@@ -88,7 +88,7 @@ fom::ContactResiduals SupportRows::residuals(const fom::ConstraintMatrix& c_r, c
 }
 
 void SupportRows::gap_operator(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
-                               const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s, RowMajorMatrix& a,
+                               const RowMajorMatrix& phi_s, const Eigen::VectorXd& off_s, RowMajorMatrix& a,
                                Eigen::VectorXd& b) const {
   const Eigen::Index r = phi_s.cols(), nr = c_r.rows();
   a.resize(nr, r);
@@ -99,13 +99,13 @@ void SupportRows::gap_operator(const fom::ConstraintMatrix& c_r, const Eigen::Ve
   for (Eigen::Index i = 0; i < nr; ++i) {
     row_times_basis<true>(1.0, value + outer[i], inner + outer[i], outer[i + 1] - outer[i], phi_s, a.data() + i * r);
     double acc = -g_r(i);
-    for (int e = outer[i]; e < outer[i + 1]; ++e) acc += value[e] * lift_s(inner[e]);
+    for (int e = outer[i]; e < outer[i + 1]; ++e) acc += value[e] * off_s(inner[e]);
     b(i) = acc;
   }
 }
 
 double SupportRows::reduced_row(int p, const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
-                                const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s,
+                                const RowMajorMatrix& phi_s, const Eigen::VectorXd& off_s,
                                 Eigen::Ref<Eigen::RowVectorXd> c_hat) const {
   c_hat.setZero();
   const int* outer = c_r.outerIndexPtr();
@@ -116,20 +116,20 @@ double SupportRows::reduced_row(int p, const fom::ConstraintMatrix& c_r, const E
     const double wi = basis(i, p);
     row_times_basis<false>(wi, value + outer[i], inner + outer[i], outer[i + 1] - outer[i], phi_s, c_hat.data());
     double acc = g_r(i);
-    for (int e = outer[i]; e < outer[i + 1]; ++e) acc -= value[e] * lift_s(inner[e]);
+    for (int e = outer[i]; e < outer[i + 1]; ++e) acc -= value[e] * off_s(inner[e]);
     g_hat += wi * acc;
   }
   return g_hat;
 }
 
 void SupportRows::reduced_rows(const std::vector<int>& columns, const fom::ConstraintMatrix& c_r,
-                               const Eigen::VectorXd& g_r, const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s,
+                               const Eigen::VectorXd& g_r, const RowMajorMatrix& phi_s, const Eigen::VectorXd& off_s,
                                RowMajorMatrix& c_hat, Eigen::VectorXd& g_hat, RowsScratch& scratch) const {
   const Eigen::Index r = phi_s.cols(), nr = static_cast<Eigen::Index>(rows.size());
   if (columns.size() < 2) {  // nothing to share
     for (size_t i = 0; i < columns.size(); ++i) {
       const auto at = static_cast<Eigen::Index>(i);
-      g_hat(at) = reduced_row(columns[i], c_r, g_r, phi_s, lift_s, c_hat.row(at));
+      g_hat(at) = reduced_row(columns[i], c_r, g_r, phi_s, off_s, c_hat.row(at));
     }
     return;
   }
@@ -153,7 +153,7 @@ void SupportRows::reduced_rows(const std::vector<int>& columns, const fom::Const
         scratch.stamp[static_cast<size_t>(k)] = scratch.call;
         row_times_basis<true>(1.0, value + outer[k], inner + outer[k], outer[k + 1] - outer[k], phi_s, a_k);
         double acc = g_r(k);
-        for (int e = outer[k]; e < outer[k + 1]; ++e) acc -= value[e] * lift_s(inner[e]);
+        for (int e = outer[k]; e < outer[k + 1]; ++e) acc -= value[e] * off_s(inner[e]);
         scratch.b(k) = acc;
       }
       const double wk = basis(k, p);

@@ -55,13 +55,13 @@ struct SupportRows {
   /// \brief \f$ A = C_R \Phi_s \f$ (|R| × r) and \f$ b = C_R u_{off,s} - g_R \f$, so that
   /// \f$ A\hat u + b \f$ is the gap on R at \f$ \hat u \f$. O(nnz(C_R) · r).
   void gap_operator(const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r, const RowMajorMatrix& phi_s,
-                    const Eigen::VectorXd& lift_s, RowMajorMatrix& a, Eigen::VectorXd& b) const;
+                    const Eigen::VectorXd& off_s, RowMajorMatrix& a, Eigen::VectorXd& b) const;
 
   /// \brief Row p of the reduced operators from C_R and g_R:
   /// \f$ \hat C_p = w_p^T C_R \Phi_s \f$ into `c_hat` (size r) and the return value
   /// \f$ \hat g_p = w_p^T (g_R - C_R u_{off,s}) \f$. O(nnz(w_p) · 6 · r).
   double reduced_row(int p, const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r, const RowMajorMatrix& phi_s,
-                     const Eigen::VectorXd& lift_s, Eigen::Ref<Eigen::RowVectorXd> c_hat) const;
+                     const Eigen::VectorXd& off_s, Eigen::Ref<Eigen::RowVectorXd> c_hat) const;
 
   /// Storage of reduced_rows(), reused from one call to the next.
   struct RowsScratch {
@@ -76,7 +76,7 @@ struct SupportRows {
   /// combined per column, O(|∪ supp| · 6 · r + Σ |supp_p| · r) instead of
   /// O(Σ |supp_p| · 6 · r): the supports of neighbouring training snapshots overlap.
   void reduced_rows(const std::vector<int>& columns, const fom::ConstraintMatrix& c_r, const Eigen::VectorXd& g_r,
-                    const RowMajorMatrix& phi_s, const Eigen::VectorXd& lift_s, RowMajorMatrix& c_hat,
+                    const RowMajorMatrix& phi_s, const Eigen::VectorXd& off_s, RowMajorMatrix& c_hat,
                     Eigen::VectorXd& g_hat, RowsScratch& scratch) const;
 
  private:

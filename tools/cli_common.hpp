@@ -135,23 +135,23 @@ inline void append_summary_json(nlohmann::json& j, const rom::SummaryValues& val
 inline void warn_if_no_primal_modes(const rom::ReducedModel& model) {
   if (model.primal_rank() == 0)
     std::cerr << "contactrom: warning: delta " << model.delta()
-              << " keeps no POD mode (primal rank 0); the reduced solution is the lifting alone"
+              << " keeps no POD mode (primal rank 0); the reduced solution is the offset alone"
                  " and no contact can be enforced; expected a delta well below 1 (paper: 1e-6 to 1e-10)\n";
 }
 
 /// The options that choose a reduced model and its online method (`online`, `reduce`).
 struct MethodArgs {
-  std::string method = "greedy", lifting = "harmonic";
+  std::string method = "greedy", offset = "harmonic";
   std::string tau_scaling = setting_default<std::string>("tau_scaling");
   double delta = 1e-8, tau = setting_default<double>("tau");
   int max_iterations = setting_default<int>("max_iterations");
   std::vector<std::string> options;  // KEY=VALUE method settings
 
-  /// The reduced-model settings (δ, lifting).
+  /// The reduced-model settings (δ, offset).
   rom::ReducedModelOptions model_options() const {
     rom::ReducedModelOptions o;
     o.delta = delta;
-    o.lifting = lifting == "dirichlet" ? rom::LiftingKind::Dirichlet : rom::LiftingKind::Harmonic;
+    o.offset = offset == "dirichlet" ? rom::OffsetKind::Dirichlet : rom::OffsetKind::Harmonic;
     return o;
   }
   /// The online settings; \throws InputError for an --option without '='.
@@ -171,15 +171,16 @@ struct MethodArgs {
   }
 };
 
-/// Adds --method, --delta, --tau, --tau-scaling, --lifting, --max-iterations, --option.
+/// Adds --method, --delta, --tau, --tau-scaling, --offset (alias --lifting), --max-iterations, --option.
 inline void add_method_options(CLI::App* sub, MethodArgs& a) {
   sub->add_option("--method", a.method, "online method (default greedy; listed below)");
   sub->footer(rom::describe_online_methods());
   add_number(sub, "--delta", a.delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
   add_setting(sub, "--tau", a.tau, rom::active_set_settings_table(), "tau");
   add_setting(sub, "--tau-scaling", a.tau_scaling, rom::active_set_settings_table(), "tau_scaling");
-  sub->add_option("--lifting", a.lifting,
-                  "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet")
+  sub->add_option("--offset,--lifting", a.offset,
+                  "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet"
+                  " (--lifting: the same option)")
       ->check(CLI::IsMember({"harmonic", "dirichlet"}));
   add_setting(sub, "--max-iterations", a.max_iterations, rom::active_set_settings_table(), "max_iterations");
   sub->add_option("--option", a.options, "method setting KEY=VALUE, repeatable; each method's keys are listed below");

@@ -1,5 +1,5 @@
 // contactrom online --db DB.h5 --method greedy [--delta D] [--tau T] [--validation [--params FILE.csv]] [--param V]
-//                   [--out FILE.csv|DIR] [--json] [--threads T] [--kkt] [--lifting harmonic|dirichlet]
+//                   [--out FILE.csv|DIR] [--json] [--threads T] [--kkt] [--offset harmonic|dirichlet]
 //                   [--tau-scaling absolute|relative] [--max-iterations K] [--option KEY=VALUE]...
 // Builds the reduced model (POD basis with tolerance δ, dual dictionary) from a
 // snapshot database and evaluates an online method:

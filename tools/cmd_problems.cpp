@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <contactrom/fom/problem.hpp>
+#include <contactrom/fom/rope.hpp>
 #include "tools/cli.hpp"
 
 namespace contactrom::cli {

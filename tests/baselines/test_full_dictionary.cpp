@@ -57,9 +57,9 @@ VectorXd exact_reduced_solution(const rom::ReducedModel& model, const fom::Param
   fom::ConstraintMatrix c;
   VectorXd g;
   contact.assemble(contact.search(us), c, g);
-  const VectorXd lift_s = model.surface_lifting(mu);
+  const VectorXd off_s = model.surface_offset(mu);
   const MatrixXd c_hat = model.dictionary().transpose() * (c * model.surface_basis());
-  const VectorXd g_hat = model.dictionary().transpose() * (g - c * lift_s);
+  const VectorXd g_hat = model.dictionary().transpose() * (g - c * off_s);
   const Eigen::LLT<MatrixXd> k(model.reduced_stiffness(mu));
   const VectorXd f_hat = model.reduced_rhs(mu);
   const MatrixXd z = k.solve(c_hat.transpose());
@@ -100,7 +100,7 @@ BOOST_AUTO_TEST_CASE(converged_solution_solves_the_reduced_qp) {
     BOOST_TEST(baselines::reduced_penetration(*h.model, full.dual_columns(), res.u) <= full.threshold() + 1e-10);
     // Optimality: the same û as an independent exact solve at the final pairing.
     BOOST_TEST(relative(res.u_hat, exact_reduced_solution(*h.model, mu, res.u)) <= 1e-4);
-    // λ = D_d[:, I] λ̂_I and u = Φû + u_lift.
+    // λ = D_d[:, I] λ̂_I and u = Φû + u_off.
     BOOST_TEST(relative(res.lambda, h.model->reconstruct_dual(res.selected, res.coefficients)) <= 1e-14);
     BOOST_TEST(relative(res.u, h.model->reconstruct_primal(res.u_hat, mu)) <= 1e-14);
   }

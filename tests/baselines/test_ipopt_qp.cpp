@@ -14,6 +14,7 @@
 #include "common/run_command.hpp"
 #include <contactrom/fom/active_set_solver.hpp>
 #include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/rope.hpp>
 
 using namespace contactrom;
 using baselines::IpoptOptions;
@@ -139,9 +140,9 @@ BOOST_AUTO_TEST_CASE(warm_start_from_converged_solution_settles_at_once) {
 }
 
 BOOST_AUTO_TEST_CASE(separated_rope_has_no_active_row) {
-  fom::ProblemOptions opt;
-  opt.rope_load = -100.0;  // pulls the rope away from the obstacle
-  const auto p = fom::make_problem("rope", opt);
+  fom::RopeOptions opt;
+  opt.load = -100.0;  // pulls the rope away from the obstacle
+  const auto p = fom::make_rope_problem(opt);
   const FomSolution sol = IpoptQpSolver(*p).solve(p1(30));
   BOOST_TEST_REQUIRE(sol.status == Status::Success, sol.message);
   BOOST_TEST(sol.active == 0);

@@ -1,6 +1,7 @@
 // `online --validation --params FILE.csv`: a database evaluated against the FOM on a
 // user-given parameter list gives, row by row, the errors of single queries at the
-// same parameters; bad lists are refused with the file and line named.
+// same parameters; bad lists are refused with the file and line named. The offset
+// option `--offset` and its other name `--lifting` build the same reduced model.
 #define BOOST_TEST_MODULE cli_online_params
 #include <boost/test/unit_test.hpp>
 #include <fstream>
@@ -54,6 +55,26 @@ BOOST_AUTO_TEST_CASE(parameter_list_rows_equal_single_queries) {
     BOOST_TEST(std::stod(rows[i + 1][1]) == s["primal_error"].get<double>(), boost::test_tools::tolerance(1e-9));
     BOOST_TEST(std::stod(rows[i + 1][2]) == s["dual_error"].get<double>(), boost::test_tools::tolerance(1e-9));
   }
+}
+
+BOOST_AUTO_TEST_CASE(offset_and_its_other_name_lifting_build_the_same_model) {
+  const std::string dir = contactrom::test::temp_dir();
+  const std::string db = dir + "/h8.h5";
+  BOOST_REQUIRE(run_command(kExe + " offline --problem hertz --train 8 --out " + db).exit_code == 0);
+  const auto query = [&](const std::string& flag) {
+    const auto r = run_command(kExe + " online --db " + db + " --param 0.17 --json " + flag);
+    BOOST_REQUIRE_MESSAGE(r.exit_code == 0, flag + ": " + r.err);
+    return nlohmann::json::parse(r.out);
+  };
+  const auto offset = query("--offset dirichlet"), lifting = query("--lifting dirichlet"), harmonic = query("");
+  BOOST_TEST(offset["primal_rank"].get<int>() == lifting["primal_rank"].get<int>());
+  BOOST_TEST(offset["primal_error"].get<double>() == lifting["primal_error"].get<double>());
+  BOOST_TEST(offset["dual_error"].get<double>() == lifting["dual_error"].get<double>());
+  // ... and a model other than the default (harmonic) offset's.
+  BOOST_TEST(offset["primal_error"].get<double>() != harmonic["primal_error"].get<double>());
+  const auto bad = run_command(kExe + " online --db " + db + " --param 0.17 --offset zero");
+  BOOST_TEST(bad.exit_code == 2);
+  BOOST_TEST(bad.err.find("zero") != std::string::npos, bad.err);
 }
 
 BOOST_AUTO_TEST_CASE(bad_parameter_lists_are_refused) {

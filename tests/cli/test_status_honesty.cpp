@@ -148,7 +148,7 @@ void check_refused(const contactrom::test::CommandResult& r, const std::string& 
 
 BOOST_AUTO_TEST_CASE(a_delta_that_keeps_no_mode_gives_an_empty_basis_or_a_clear_refusal_everywhere) {
   // δ = 1 is inside the documented range [0, 1] and keeps no POD mode: every command
-  // that builds a reduced model either answers on the empty basis (the lifting alone,
+  // that builds a reduced model either answers on the empty basis (the offset alone,
   // which enforces no contact: never a success at a load that presses) or refuses in
   // one line naming delta. Under the sanitizers (CONTACTROM_SANITIZE) undefined
   // behaviour on the empty basis fails the command.
@@ -163,7 +163,7 @@ BOOST_AUTO_TEST_CASE(a_delta_that_keeps_no_mode_gives_an_empty_basis_or_a_clear_
       const auto j = nlohmann::json::parse(r.out);
       BOOST_TEST(j["primal_rank"].get<int>() == 0);
       BOOST_TEST(j["status"].get<std::string>() != "success");
-      BOOST_TEST(j["kkt"]["penetration"].get<double>() > 0.05);  // the lifting alone penetrates
+      BOOST_TEST(j["kkt"]["penetration"].get<double>() > 0.05);  // the offset alone penetrates
     }
     BOOST_TEST_CONTEXT("reduce and query " << method) {
       const auto r = run_command(kExe + " reduce --db " + db + " --method " + method + " --delta 1 --out " + rom);

@@ -11,6 +11,7 @@
 
 #include <contactrom/fom/active_set_solver.hpp>
 #include <contactrom/fom/kkt.hpp>
+#include <contactrom/fom/rope.hpp>
 
 using namespace contactrom;
 using namespace contactrom::fom;
@@ -170,9 +171,9 @@ BOOST_AUTO_TEST_CASE(ironing_pressure_centroid_follows_iron) {
 // A rope pulled upwards never touches the obstacle: λ = 0 and u is the
 // unconstrained solution, computed here independently with a sparse Cholesky.
 BOOST_AUTO_TEST_CASE(separated_configuration_is_unconstrained) {
-  ProblemOptions opt;
-  opt.rope_load = -100.0;
-  auto problem = make_problem("rope", opt);
+  RopeOptions opt;
+  opt.load = -100.0;
+  auto problem = make_rope_problem(opt);
   ActiveSetSolver s(*problem);
   const Param mu = p1(20.0);
   const FomSolution sol = s.solve(mu);

@@ -16,6 +16,9 @@
 #include <contactrom/fom/elasticity.hpp>
 #include <contactrom/fom/problem.hpp>
 #include <contactrom/fom/problem_file.hpp>
+#include <contactrom/fom/rope.hpp>
+
+#include <stdexcept>
 
 using namespace contactrom;
 using Eigen::MatrixXd;
@@ -226,8 +229,8 @@ BOOST_AUTO_TEST_CASE(definitions_that_do_not_fit_the_mesh_are_refused) {
 BOOST_AUTO_TEST_CASE(rope_terms_in_closed_form) {
   // 4 elements, h = ¼: left elements (x < ½) scaled by γ, right ones by 30; tributary
   // weights h inside and h/2 at the ends; load −f·w.
-  fom::ProblemOptions options;
-  options.rope_elements = 4;
+  fom::RopeOptions options;
+  options.elements = 4;
   const auto p = fom::make_rope_problem(options);
   BOOST_TEST(p->num_dofs() == 5);
   BOOST_TEST(p->dofs_per_node() == 1);
@@ -244,7 +247,31 @@ BOOST_AUTO_TEST_CASE(rope_terms_in_closed_form) {
   const VectorXd fext = p->external_load_terms()[0];
   BOOST_TEST((fext - (VectorXd(5) << 0, -100, -100, -100, 0).finished()).norm() <= 1e-12);
   BOOST_TEST(p->lifting(gamma).norm() == 0.0);
-  BOOST_CHECK_THROW(fom::make_rope_problem(fom::ProblemOptions{1}), InputError);
+  BOOST_CHECK_THROW(fom::make_rope_problem(fom::RopeOptions{1}), InputError);
+}
+
+BOOST_AUTO_TEST_CASE(rope_nodes_are_the_uniform_grid_and_parts_must_agree) {
+  // The rope has no mesh; its nodes (for output) are x_i = i / elements.
+  fom::RopeOptions options;
+  options.elements = 4;
+  const auto p = fom::make_rope_problem(options);
+  BOOST_TEST(p->mesh() == nullptr);
+  BOOST_TEST((fom::rope_nodes(*p) - (VectorXd(5) << 0.0, 0.25, 0.5, 0.75, 1.0).finished()).norm() == 0.0);
+  // The default rope is `--problem rope`'s, with the fingerprint its databases store
+  // (the value databases of format version 2 hold: they rebuild this problem).
+  BOOST_TEST(fom::make_problem("rope")->fingerprint() == "7ce20918bc2496ed");
+  BOOST_TEST(fom::make_rope_problem()->fingerprint() != p->fingerprint());
+  // A Problem's parts must agree in size: here a stiffness term of the wrong size.
+  fom::ProblemParts parts;
+  parts.is_dirichlet.assign(3, 0);
+  parts.stiffness_terms = {fom::SparseMatrix(2, 2)};
+  parts.stiffness_coefficients = {fom::AffineExpression::constant_value(1.0, 1)};
+  parts.lifting_terms = parts.external_load_terms = {VectorXd::Zero(3)};
+  parts.load_coefficients = {fom::AffineExpression::constant_value(1.0, 1)};
+  parts.contact = std::make_unique<fom::ObstacleContact>(VectorXd::LinSpaced(3, 0.0, 1.0), VectorXd::Zero(3),
+                                                         VectorXd::Ones(3));
+  parts.h1_gram = fom::SparseMatrix(3, 3);
+  BOOST_CHECK_THROW(fom::Problem(std::move(parts)), std::invalid_argument);
 }
 
 BOOST_AUTO_TEST_CASE(parameters_are_parsed_and_range_checked) {

@@ -123,3 +123,12 @@ def test_verify_errors_are_absolute_against_a_near_zero_reference(problems, solv
     # The solution at 2e-9 is about twice the one at 1e-9: a relative error would be
     # about 1; the absolute one is of the size of the displacement, about 1e-9.
     assert 0.0 < report["errors"]["primal_error"] < 1e-6
+
+
+def test_rope_node_coordinates_are_its_uniform_abscissae():
+    # The 1D rope has no mesh: its nodes are x_i = i / 200 on [0, 1], one dof each.
+    rope = contactrom.problem("rope")
+    x = rope.node_coordinates
+    assert x.shape == (rope.num_dofs,) and rope.num_dofs == 201
+    assert np.allclose(x, np.arange(201) / 200.0, rtol=0.0, atol=1e-15)
+    assert x[0] == 0.0 and x[-1] == 1.0

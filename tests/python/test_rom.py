@@ -200,7 +200,7 @@ def test_cli_reduced_model_loads_in_python(tmp_path, hertz_db_path):
 
 
 def test_delta_one_gives_the_empty_basis_and_no_success(db):
-    # delta = 1 keeps no POD mode: the answer is the lifting alone (no contact
+    # delta = 1 keeps no POD mode: the answer is the offset alone (no contact
     # enforced), never a success at a pressing load; the convex hull refuses.
     with pytest.warns(RuntimeWarning, match="keeps no POD mode"):
         empty = contactrom.ReducedModel(db, delta=1.0, method="greedy")
@@ -269,3 +269,21 @@ def test_every_option_reports_its_documented_default_typed(db):
             # typed back in, the documented default is accepted and kept
             again = contactrom.ReducedModel(db, method=method, options={key: value}).options
             assert again[key] == value, (method, key)
+
+
+def test_offset_and_its_other_name_lifting_build_the_same_model(hertz_db_path, db):
+    # As the CLI's --offset dirichlet (whose other name is --lifting), at one query.
+    cli = run_cli_json("online", "--db", str(hertz_db_path), "--param", "0.17", "--offset", "dirichlet")
+    answers = []
+    for kwargs in ({"offset": "dirichlet"}, {"lifting": "dirichlet"}):
+        model = contactrom.ReducedModel(db, **kwargs)
+        r = model.solve(0.17)
+        assert model.primal_rank == cli["primal_rank"], kwargs
+        assert [model.dictionary_snapshots[c] for c in r.selected] == cli["selected"], kwargs
+        answers.append(r.u)
+    assert np.array_equal(answers[0], answers[1])
+    assert not np.array_equal(answers[0], contactrom.ReducedModel(db).solve(0.17).u)  # the default: harmonic
+    with pytest.raises(ValueError, match="offset 'zero' unknown"):
+        contactrom.ReducedModel(db, offset="zero")
+    with pytest.raises(ValueError, match="disagree"):
+        contactrom.ReducedModel(db, offset="dirichlet", lifting="harmonic")

@@ -82,10 +82,10 @@ bool contains(const std::vector<int>& v, int x) { return std::find(v.begin(), v.
 BOOST_AUTO_TEST_CASE(monolithic_dictionary_and_projected_operators) {
   const Setup& s = rope();
   const fom::Problem& p = *s.problem;
-  for (auto lifting : {rom::LiftingKind::Dirichlet, rom::LiftingKind::Harmonic}) {
+  for (auto offset : {rom::OffsetKind::Dirichlet, rom::OffsetKind::Harmonic}) {
     rom::ReducedModelOptions mo;
     mo.delta = 1e-7;
-    mo.lifting = lifting;
+    mo.offset = offset;
     const rom::ReducedModel model(p, s.db, mo);
     const rom::MonolithicDictionary dict(model);
     // Columns: stored snapshots u − u_lift over their pressures, whatever the model's offset.

@@ -114,7 +114,7 @@ double own_pairing_violation(const rom::ReducedModel& model, const Eigen::Vector
 }  // namespace
 
 BOOST_AUTO_TEST_CASE(training_parameter_reproduces_its_snapshot) {
-  // Default model (harmonic lifting) and solver settings (τ = δ, step tolerance 1e-5).
+  // Default model (harmonic offset) and solver settings (τ = δ, step tolerance 1e-5).
   Setup& h = hertz();
   const rom::SnapshotDatabase& db = h.db(12);
   rom::ReducedModelOptions options;
@@ -149,19 +149,19 @@ BOOST_AUTO_TEST_CASE(training_parameter_reproduces_its_snapshot) {
 }
 
 BOOST_AUTO_TEST_CASE(training_parameter_selects_its_own_column) {
-  // Both liftings: the dominant selected column is the snapshot itself, with
+  // Both offsets: the dominant selected column is the snapshot itself, with
   // coefficient 1 up to the pairing fixed-point tolerance.
   Setup& h = hertz();
   const rom::SnapshotDatabase& db = h.db(12);
-  for (rom::LiftingKind lifting : {rom::LiftingKind::Harmonic, rom::LiftingKind::Dirichlet}) {
+  for (rom::OffsetKind offset : {rom::OffsetKind::Harmonic, rom::OffsetKind::Dirichlet}) {
     rom::ReducedModelOptions options;
     options.delta = 1e-10;
-    options.lifting = lifting;
+    options.offset = offset;
     const rom::ReducedModel model(*h.problem, db, options);
     const rom::GreedyActiveSet greedy(model);
     for (int j = 0; j < db.num_snapshots(); ++j) {
       const rom::OnlineResult res = greedy.solve(db.parameter(j));
-      BOOST_TEST_CONTEXT("lifting " << static_cast<int>(lifting) << ", snapshot " << j) {
+      BOOST_TEST_CONTEXT("offset " << static_cast<int>(offset) << ", snapshot " << j) {
         const auto it = std::find(res.selected.begin(), res.selected.end(), j);
         BOOST_REQUIRE(it != res.selected.end());
         BOOST_TEST(std::abs(res.coefficients(it - res.selected.begin()) - 1.0) <= 1e-5);
@@ -267,8 +267,8 @@ BOOST_AUTO_TEST_CASE(converged_solution_satisfies_reduced_kkt_conditions) {
       BOOST_TEST(res.coefficients.minCoeff() >= 0.0);  // λ̂ ≥ 0
       // Operators at the final iterate (they differ from the last iteration's by
       // the step tolerance only; the greedy confirms the reduced constraint at them).
-      const Eigen::VectorXd lift_s = model.surface_lifting(mu);
-      const Eigen::VectorXd u_s = model.surface_basis() * res.u_hat + lift_s;
+      const Eigen::VectorXd off_s = model.surface_offset(mu);
+      const Eigen::VectorXd u_s = model.surface_basis() * res.u_hat + off_s;
       fom::ConstraintMatrix c;
       Eigen::VectorXd g;
       contact.assemble(contact.search(u_s), c, g);
@@ -610,13 +610,13 @@ BOOST_AUTO_TEST_CASE(search_memory_settles_small_moves_and_searches_large_ones) 
   const fom::ContactModel& contact = h.problem->contact();
   const rom::SupportRows support(model.dictionary());
   const fom::Param mu = fom::validation_set(*h.problem, 30)[40];
-  const Eigen::VectorXd lift = model.surface_lifting(mu);
+  const Eigen::VectorXd off_s = model.surface_offset(mu);
   const Eigen::VectorXd u0 = rom::GreedyActiveSet(model).solve(mu).u_hat;
   Eigen::VectorXd direction = Eigen::VectorXd::Ones(u0.size());
   direction *= u0.norm() / direction.norm();
   rom::SupportOperators remembering(true);
   for (double step : {0.0, 1e-8, 1e-6, 1e-4, 1e-3, 1e-2, 0.3, 0.0, 1e-5}) {
-    const Eigen::VectorXd u_s = model.surface_basis() * (u0 + step * direction) + lift;
+    const Eigen::VectorXd u_s = model.surface_basis() * (u0 + step * direction) + off_s;
     rom::SupportOperators fresh(false);
     fresh.rebuild(contact, support, u_s);
     const int certified = remembering.certified_rows(), searched = remembering.searched_rows();
@@ -656,7 +656,7 @@ BOOST_AUTO_TEST_CASE(snapshot_search_memory_gives_the_searched_pairing) {
     BOOST_REQUIRE(start.begin(model, mu, rom::WarmStart::Cell, unused));
     const int nearest = start.nearest;
     BOOST_REQUIRE(nearest >= 0);
-    const Eigen::VectorXd u_s = model.surface_basis() * start.u_start + model.surface_lifting(mu);
+    const Eigen::VectorXd u_s = model.surface_basis() * start.u_start + model.surface_offset(mu);
     rom::SupportOperators fresh(false);
     fresh.rebuild(contact, support, u_s);
     seeded.reset(true);
@@ -738,8 +738,8 @@ BOOST_AUTO_TEST_CASE(support_row_kernels_match_the_dense_operators) {
     const fom::Param mu = fom::validation_set(problem, 12)[5];
     const rom::GreedyActiveSet greedy(model);
     const rom::OnlineResult res = greedy.solve(mu);
-    const Eigen::VectorXd lift_s = model.surface_lifting(mu);
-    const Eigen::VectorXd u_s = model.surface_basis() * res.u_hat + lift_s;
+    const Eigen::VectorXd off_s = model.surface_offset(mu);
+    const Eigen::VectorXd u_s = model.surface_basis() * res.u_hat + off_s;
     const fom::Pairing pairing = contact.search(u_s);
     fom::ConstraintMatrix c, c_r;
     Eigen::VectorXd g, g_r, gap, violation;
@@ -753,11 +753,11 @@ BOOST_AUTO_TEST_CASE(support_row_kernels_match_the_dense_operators) {
     }
     const Eigen::MatrixXd& dict = model.dictionary();
     const Eigen::MatrixXd c_hat = dict.transpose() * (c * model.surface_basis());
-    const Eigen::VectorXd g_hat = dict.transpose() * (g - c * lift_s);
+    const Eigen::VectorXd g_hat = dict.transpose() * (g - c * off_s);
     const double scale = c_hat.cwiseAbs().maxCoeff(), g_scale = std::max(g_hat.cwiseAbs().maxCoeff(), 1e-300);
     Eigen::RowVectorXd row(model.primal_rank());
     for (int p = 0; p < model.dictionary_size(); ++p) {
-      const double gp = support.reduced_row(p, c_r, g_r, model.surface_basis_rows(), lift_s, row);
+      const double gp = support.reduced_row(p, c_r, g_r, model.surface_basis_rows(), off_s, row);
       BOOST_TEST((row - c_hat.row(p)).cwiseAbs().maxCoeff() <= 1e-13 * scale);
       BOOST_TEST(std::abs(gp - g_hat(p)) <= 1e-13 * g_scale);
     }
@@ -769,7 +769,7 @@ BOOST_AUTO_TEST_CASE(support_row_kernels_match_the_dense_operators) {
              {}, {m / 2}, {m / 2, m / 2 + 1}, {m - 1, 0, m / 2}, {m / 2 + 1, m / 2, m / 2 - 1, m - 1}}) {
       rom::RowMajorMatrix rows(static_cast<Eigen::Index>(columns.size()) + 1, model.primal_rank());
       Eigen::VectorXd g_rows(static_cast<Eigen::Index>(columns.size()) + 1);
-      support.reduced_rows(columns, c_r, g_r, model.surface_basis_rows(), lift_s, rows, g_rows, scratch);
+      support.reduced_rows(columns, c_r, g_r, model.surface_basis_rows(), off_s, rows, g_rows, scratch);
       for (size_t i = 0; i < columns.size(); ++i) {
         const auto at = static_cast<Eigen::Index>(i);
         BOOST_TEST((rows.row(at) - c_hat.row(columns[i])).cwiseAbs().maxCoeff() <= 1e-13 * scale, columns.size());

@@ -68,6 +68,33 @@ BOOST_AUTO_TEST_CASE(snapshot_coordinates_are_the_projections_of_the_snapshots) 
   }
 }
 
+BOOST_AUTO_TEST_CASE(primal_snapshots_are_kept_as_the_database_stores_them) {
+  // One convention from the database to the convex hull: the kept primal snapshots
+  // are the stored u − u_lift, bitwise, whatever the offset; the coordinates are
+  // measured from the offset, Φᵀ(u − u_off) = Φᵀ(u − u_lift) + reduced_lifting(μ).
+  Built& b = hertz12();
+  for (const rom::OffsetKind kind : {rom::OffsetKind::Harmonic, rom::OffsetKind::Dirichlet}) {
+    rom::ReducedModelOptions options;
+    options.delta = 1e-10;
+    options.offset = kind;
+    const rom::ReducedModel model(*b.problem, b.db, options);
+    BOOST_REQUIRE(model.has_primal_snapshots());
+    for (int c = 0; c < model.dictionary_size(); ++c) {
+      BOOST_TEST_CONTEXT("offset " << static_cast<int>(kind) << ", column " << c) {
+        const int j = model.dictionary_snapshots()[static_cast<size_t>(c)];
+        const fom::Param mu = b.db.parameter(j);
+        BOOST_TEST((model.primal_snapshots().col(c) - b.db.primal.col(j)).cwiseAbs().maxCoeff() == 0.0);
+        const Eigen::VectorXd u = b.db.primal.col(j) + b.problem->lifting(mu);
+        const Eigen::VectorXd coords = model.basis().transpose() * (u - model.offset(mu));
+        BOOST_TEST((coords - model.snapshot_coordinates().col(c)).norm() <= 1e-12 * coords.norm());
+        const Eigen::VectorXd lift = model.basis().transpose() * (b.problem->lifting(mu) - model.offset(mu));
+        BOOST_TEST((lift - model.reduced_lifting(mu)).norm() <= 1e-13 * (1.0 + lift.norm()));
+        if (kind == rom::OffsetKind::Dirichlet) BOOST_TEST(model.reduced_lifting(mu).cwiseAbs().maxCoeff() == 0.0);
+      }
+    }
+  }
+}
+
 BOOST_AUTO_TEST_CASE(one_parameter_stencil_brackets_the_query) {
   const rom::ReducedModel& model = *hertz12().model;
   const auto& params = model.dictionary_parameters();

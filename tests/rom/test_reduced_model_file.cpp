@@ -55,6 +55,37 @@ std::vector<Param> queries() {
   return out;
 }
 
+/// max |v_i|, 0 for an empty v (a query that selects no column).
+double max_abs(const Eigen::VectorXd& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
+
+/// The model's primal snapshots as format versions 1 and 2 stored them, measured from
+/// the offset: u − u_off = (u − u_lift) − Σ_k φ_k (L̃_k − L_k), summed as the POD's
+/// input is (bitwise the same numbers).
+Eigen::MatrixXd from_offset(const contactrom::rom::ReducedModel& model) {
+  Eigen::MatrixXd out = model.primal_snapshots();
+  const contactrom::fom::Problem& problem = model.problem();
+  for (Eigen::Index c = 0; c < out.cols(); ++c) {
+    const Eigen::VectorXd phi = problem.load_coefficients(model.dictionary_parameters()[static_cast<size_t>(c)]);
+    for (int k = 0; k < problem.num_load_terms(); ++k) {
+      const Eigen::VectorXd d = model.offset_terms()[static_cast<size_t>(k)] - problem.lifting_terms()[static_cast<size_t>(k)];
+      if (d.cwiseAbs().maxCoeff() > 0.0) out.col(c) -= phi(k) * d;
+    }
+  }
+  return out;
+}
+
+/// As check_same_answers, to rounding (a file whose snapshots were converted).
+void check_close_answers(const OnlineModel& a, const OnlineModel& b) {
+  for (const Param& mu : queries()) {
+    const OnlineResult x = a.solve(mu), y = b.solve(mu);
+    BOOST_TEST(x.selected == y.selected);
+    BOOST_TEST(x.status == y.status);
+    BOOST_TEST(max_abs(x.coefficients - y.coefficients) <= 1e-10);
+    BOOST_TEST((x.u - y.u).norm() <= 1e-10 * x.u.norm());
+    BOOST_TEST((x.lambda - y.lambda).norm() <= 1e-10 * x.lambda.norm());
+  }
+}
+
 void check_same_answers(const OnlineModel& a, const OnlineModel& b) {
   BOOST_TEST(a.model().primal_rank() == b.model().primal_rank());
   BOOST_TEST(a.model().dictionary_size() == b.model().dictionary_size());
@@ -63,7 +94,7 @@ void check_same_answers(const OnlineModel& a, const OnlineModel& b) {
     BOOST_TEST(x.selected == y.selected);
     BOOST_TEST(x.iterations == y.iterations);
     BOOST_TEST(x.status == y.status);
-    BOOST_TEST((x.coefficients - y.coefficients).cwiseAbs().maxCoeff() == 0.0);
+    BOOST_TEST(max_abs(x.coefficients - y.coefficients) == 0.0);
     BOOST_TEST((x.u - y.u).cwiseAbs().maxCoeff() == 0.0);
     BOOST_TEST((x.lambda - y.lambda).cwiseAbs().maxCoeff() == 0.0);
   }
@@ -126,6 +157,14 @@ BOOST_AUTO_TEST_CASE(saved_model_answers_like_the_original_for_every_method) {
 
 namespace {
 
+bool has_attribute(const std::string& path, const char* name) {
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  BOOST_REQUIRE(f >= 0);
+  const bool found = H5Aexists(f, name) > 0;
+  H5Fclose(f);
+  return found;
+}
+
 bool has_dataset(const std::string& path, const char* name) {
   const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   BOOST_REQUIRE(f >= 0);
@@ -146,10 +185,11 @@ void make_version_1(const std::string& path) {
   H5Aclose(a), H5Fclose(f);
 }
 
-/// Adds the m × n dataset /primal_snapshots (one column of `primal` per row).
+/// Adds (or replaces) the m × n dataset /primal_snapshots (one column of `primal` per row).
 void add_primal_snapshots(const std::string& path, const Eigen::MatrixXd& primal) {
   const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   BOOST_REQUIRE(f >= 0);
+  if (H5Lexists(f, "primal_snapshots", H5P_DEFAULT) > 0) BOOST_REQUIRE(H5Ldelete(f, "primal_snapshots", H5P_DEFAULT) >= 0);
   const hsize_t dims[2] = {static_cast<hsize_t>(primal.cols()), static_cast<hsize_t>(primal.rows())};
   const hid_t space = H5Screate_simple(2, dims, nullptr);
   const hid_t d = H5Dcreate2(f, "primal_snapshots", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
@@ -172,10 +212,17 @@ BOOST_AUTO_TEST_CASE(files_store_primal_snapshots_only_for_methods_that_combine_
   BOOST_TEST(has_dataset(hull, "primal_snapshots"));
   BOOST_TEST(!g.model().has_primal_snapshots());
   BOOST_TEST(fs::file_size(greedy) < fs::file_size(hull));
-  // The coordinates are the projections of the snapshots (as computed from them).
+  // The coordinates are the projections of the training solutions measured from the
+  // offset, Φᵀ(u − u_off(μ)), u from the database.
   const OnlineModel loaded = OnlineModel::load(greedy);
   const Eigen::MatrixXd& coords = loaded.model().snapshot_coordinates();
-  const Eigen::MatrixXd expected = h.model().basis().transpose() * h.model().primal_snapshots();
+  Eigen::MatrixXd expected(coords.rows(), coords.cols());
+  for (Eigen::Index c = 0; c < coords.cols(); ++c) {
+    const Param mu = loaded.model().dictionary_parameters()[static_cast<size_t>(c)];
+    const int j = loaded.model().dictionary_snapshots()[static_cast<size_t>(c)];
+    const Eigen::VectorXd u = hertz_db().primal.col(j) + hertz()->lifting(mu);
+    expected.col(c) = h.model().basis().transpose() * (u - h.model().offset(mu));
+  }
   BOOST_TEST((coords - expected).cwiseAbs().maxCoeff() <= 1e-12 * expected.cwiseAbs().maxCoeff());
   check_same_answers(g, loaded);
   // A convex hull on a model without primal snapshots is refused, naming what is missing.
@@ -187,22 +234,72 @@ BOOST_AUTO_TEST_CASE(files_store_primal_snapshots_only_for_methods_that_combine_
 }
 
 BOOST_AUTO_TEST_CASE(version_1_files_are_still_read) {
-  // Version 1 stored the primal snapshots for every method and no coordinates.
+  // Version 1 stored the primal snapshots, measured from the offset (u − u_off), for
+  // every method and no coordinates.
   const OnlineModel hull(hertz(), hertz_db(), {}, "convex-hull");
-  const Eigen::MatrixXd& primal = hull.model().primal_snapshots();
+  const Eigen::MatrixXd primal = from_offset(hull.model());
   const Eigen::MatrixXd expected = hull.model().basis().transpose() * primal;
   for (const std::string method : {"greedy", "convex-hull"}) {
     BOOST_TEST_CONTEXT("method " << method) {
       const std::string path = work_dir() + "/hertz10_v1_" + method + ".h5";
       const OnlineModel original(hertz(), hertz_db(), {}, method);
       original.save(path);
-      if (method == "greedy") add_primal_snapshots(path, primal);
+      add_primal_snapshots(path, primal);
       make_version_1(path);
       const OnlineModel loaded = OnlineModel::load(path);
       BOOST_TEST(loaded.method() == method);
       BOOST_TEST(loaded.model().has_primal_snapshots() == (method == "convex-hull"));
       BOOST_TEST((loaded.model().snapshot_coordinates() - expected).cwiseAbs().maxCoeff() == 0.0);
-      check_same_answers(original, loaded);
+      if (method == "greedy") check_same_answers(original, loaded);
+      else check_close_answers(original, loaded);  // the snapshots back to u − u_lift: to rounding
+    }
+  }
+}
+
+namespace {
+
+/// Makes a file as format version 2 wrote it: the offset kind in the attribute
+/// `lifting` (version 3: `offset`).
+void make_version_2(const std::string& path) {
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  BOOST_REQUIRE(f >= 0);
+  const std::string kind = contactrom::rom::hdf5::read_string_attribute(f, "offset");
+  BOOST_REQUIRE(H5Adelete(f, "offset") >= 0);
+  contactrom::rom::hdf5::write_string_attribute(f, "lifting", kind);
+  const hid_t a = H5Aopen(f, "format_version", H5P_DEFAULT);
+  const int two = 2;
+  BOOST_REQUIRE(H5Awrite(a, H5T_NATIVE_INT, &two) >= 0);
+  H5Aclose(a), H5Fclose(f);
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(version_2_files_are_still_read) {
+  // Version 2 named the offset kind `lifting` and stored the convex hull's primal
+  // snapshots measured from the offset (u − u_off); the model gets them back as the
+  // database stores them (u − u_lift).
+  using contactrom::rom::OffsetKind;
+  for (const std::string method : {"greedy", "convex-hull"}) {
+    for (const OffsetKind offset : {OffsetKind::Dirichlet, OffsetKind::Harmonic}) {
+      BOOST_TEST_CONTEXT("method " << method << ", offset " << static_cast<int>(offset)) {
+        contactrom::rom::ReducedModelOptions options;
+        options.offset = offset;
+        const OnlineModel original(hertz(), hertz_db(), options, method);
+        const std::string path = work_dir() + "/hertz10_v2_" + method + std::to_string(static_cast<int>(offset)) + ".h5";
+        original.save(path);
+        if (method == "convex-hull") add_primal_snapshots(path, from_offset(original.model()));
+        make_version_2(path);
+        BOOST_TEST(!has_attribute(path, "offset"));
+        const OnlineModel loaded = OnlineModel::load(path);
+        BOOST_TEST((loaded.model().options().offset == offset));
+        if (method == "greedy") {
+          check_same_answers(original, loaded);
+        } else {
+          const Eigen::MatrixXd& stored = original.model().primal_snapshots();
+          BOOST_TEST((loaded.model().primal_snapshots() - stored).norm() <= 1e-13 * stored.norm());
+          check_close_answers(original, loaded);
+        }
+      }
     }
   }
 }

@@ -95,9 +95,9 @@ BOOST_AUTO_TEST_CASE(compact_operators_match_the_dense_formulas) {
     VectorXd g_r(static_cast<Eigen::Index>(support.rows.size()));
     for (size_t i = 0; i < support.rows.size(); ++i) g_r(static_cast<Eigen::Index>(i)) = g_full(support.rows[i]);
     const rom::RowMajorMatrix phi_s = gaussian(ns, r, gen);
-    const VectorXd lift_s = gaussian(ns, 1, gen), u_s = gaussian(ns, 1, gen);
+    const VectorXd off_s = gaussian(ns, 1, gen), u_s = gaussian(ns, 1, gen);
     const MatrixXd c_dense(c_full);
-    const double scale = 1.0 + c_dense.norm() * (1.0 + phi_s.norm() + lift_s.norm() + u_s.norm()) * w.norm();
+    const double scale = 1.0 + c_dense.norm() * (1.0 + phi_s.norm() + off_s.norm() + u_s.norm()) * w.norm();
 
     BOOST_TEST_CONTEXT("trial " << trial << ", r = " << r) {
       // Violation Wᵀ(C u_s − g) over every column: rows outside R do not contribute.
@@ -108,16 +108,16 @@ BOOST_AUTO_TEST_CASE(compact_operators_match_the_dense_formulas) {
       // A = C_R Φ_s, b = C_R u_off − g_R; A û + b is the gap at û on R.
       rom::RowMajorMatrix a;
       VectorXd b;
-      support.gap_operator(c_r, g_r, phi_s, lift_s, a, b);
+      support.gap_operator(c_r, g_r, phi_s, off_s, a, b);
       BOOST_TEST((a - c_rows * phi_s).norm() <= 1e-13 * scale);
-      BOOST_TEST((b - (c_rows * lift_s - g_r)).norm() <= 1e-13 * scale);
+      BOOST_TEST((b - (c_rows * off_s - g_r)).norm() <= 1e-13 * scale);
 
       // ĉ_p = w_pᵀ C Φ_s, ĝ_p = w_pᵀ (g − C u_off): the rows of the reduced operators.
       Eigen::RowVectorXd c_hat(r);
       for (int p = 0; p < m; ++p) {
-        const double g_hat = support.reduced_row(p, c_r, g_r, phi_s, lift_s, c_hat);
+        const double g_hat = support.reduced_row(p, c_r, g_r, phi_s, off_s, c_hat);
         BOOST_TEST((c_hat - w.col(p).transpose() * c_dense * phi_s).norm() <= 1e-13 * scale, "column " << p);
-        BOOST_TEST(std::abs(g_hat - w.col(p).dot(g_full - c_dense * lift_s)) <= 1e-13 * scale, "column " << p);
+        BOOST_TEST(std::abs(g_hat - w.col(p).dot(g_full - c_dense * off_s)) <= 1e-13 * scale, "column " << p);
       }
     }
   }
