@@ -6,6 +6,7 @@
 
 #include <contactrom/core/format.hpp>
 #include <contactrom/core/errors.hpp>
+#include <contactrom/core/parallel_for.hpp>
 #include "python/bindings.hpp"
 #include <contactrom/rom/adaptive_training.hpp>
 #include <contactrom/rom/fallback.hpp>
@@ -213,6 +214,7 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
   m.def(
       "offline",
       [](std::shared_ptr<fom::Problem> problem, py::handle params, int threads) {
+        check_threads(threads, "threads");
         rom::OfflineOptions options;
         options.threads = threads;
         Database d;
@@ -240,6 +242,7 @@ works in memory but is refused when read back from a file.)doc");
       [](std::shared_ptr<fom::Problem> problem, double tolerance, int max_snapshots, int candidates, int batch, int seed,
          const std::string& indicator, const std::string& method, double delta, int initial, int threads,
          py::object resume, py::object path_like) {
+        check_threads(threads, "threads");
         rom::AdaptiveOptions o;
         o.tolerance = tolerance;
         o.max_snapshots = max_snapshots;
@@ -425,6 +428,7 @@ tolerances.)doc")
       .def(
           "evaluate",
           [](const ReducedModel& r, py::object params, int threads, bool kkt) {
+            check_threads(threads, "threads");
             const fom::Problem& problem = r.rom->problem();
             if (params.is_none() && !r.db)
               throw InputError("evaluate() of a reduced model loaded from a file needs params; it has no database "

@@ -190,7 +190,6 @@ void run_adaptive(const OfflineArgs& a) {
                        existing.training_kind + " " + std::to_string(existing.training_size) +
                        "; expected a database written by offline --adaptive");
   }
-  if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
   rom::AdaptiveOptions options = adaptive_options(a, appending ? &existing : nullptr);
   if (!appending && a.tolerance < 0) throw InputError("offline --adaptive needs --tolerance EPS (e.g. 0.05)");
 #ifdef CONTACTROM_HAVE_MPI
@@ -265,7 +264,6 @@ OfflinePlan plan_offline(const OfflineArgs& a, const fom::Problem& problem) {
   const bool size_from_db = plan.appending && !a.train && !a.level && sampling.selector() != "list";
   plan.n = size_from_db ? plan.existing.training_size
                         : fom::resolve_training_size(sampling, problem.name(), a.train, a.level, false);
-  if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
   plan.training = fom::training_set(problem, plan.n);
   plan.params = a.part.empty() ? plan.training : training_part(plan.training, a.part);
   if (plan.appending) {
@@ -406,7 +404,7 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
                   "hold yet and rewrite it with all its snapshots, in training order")
       ->check(non_empty_path())
       ->excludes(out);
-  add_integer(sub, "--threads", args->threads, "worker threads (default: hardware concurrency)", 1, 1024);
+  add_threads(sub, args->threads, "worker threads");
   sub->add_option("--part", args->part,
                   "k/K: only the k-th of K contiguous parts of the training set (join the parts with merge)");
   sub->add_flag("--progress", args->progress, "draw the progress bar even when stderr is not a terminal");
