@@ -8,11 +8,19 @@
 #include <thread>
 #include <vector>
 
+#include <contactrom/core/errors.hpp>
+
 namespace contactrom {
 
 int resolve_threads(int requested) {
   if (requested > 0) return requested;
   return std::max(1u, std::thread::hardware_concurrency());
+}
+
+void check_threads(long long threads, const std::string& what) {
+  if (threads < 0 || threads > kMaxThreads)
+    throw InputError(what + " = " + std::to_string(threads) + " invalid; expected an integer in [0, " +
+                     std::to_string(kMaxThreads) + "] (0: all cores)");
 }
 
 void parallel_for(int n, int threads, const std::function<void(int)>& task, const ProgressCallback& progress) {

@@ -3,6 +3,7 @@
 /// \brief A minimal thread pool: `task(i)` for i = 0..n-1 on worker threads, with
 /// progress reported from the calling thread.
 #include <functional>
+#include <string>
 
 namespace contactrom {
 
@@ -19,6 +20,14 @@ void parallel_for(int n, int threads, const std::function<void(int)>& task, cons
 
 /// \brief Number of worker threads `requested` resolves to (≤ 0: hardware concurrency, at least 1).
 int resolve_threads(int requested);
+
+/// \brief Largest thread count a user may ask for (CLI `--threads`, Python `threads=`).
+inline constexpr int kMaxThreads = 1024;
+
+/// \brief Checks a thread count a user gave: 0 (all cores) or 1..kMaxThreads.
+/// \param what how the value is named in the message (`--threads`, `threads`)
+/// \throws InputError "<what> = <threads> invalid; expected an integer in [0, 1024] (0: all cores)".
+void check_threads(long long threads, const std::string& what);
 
 
 }  // namespace contactrom

@@ -155,22 +155,20 @@ std::string point_string(const Eigen::MatrixXd& x, int node) {
   return s.str();
 }
 
-/// Orders the segments of one curve as a chain. The chain runs so that the body
-/// owning the first segment lies on its left (the quad containing the segment
-/// has it as a counter-clockwise edge); for a closed curve it starts at the
-/// smallest node id.
-void order_chain(const std::string& where, const std::string& name, const Eigen::MatrixXd& x,
-                 const std::vector<std::array<int, 4>>& quads, std::vector<std::array<int, 2>> segs,
-                 std::vector<std::array<int, 2>>& out_segments, std::vector<int>& out_nodes) {
+/// The segments at each node of a curve (node -> segment indices) and the chain's
+/// ends (none for a closed curve); a zero-length segment, a branch or several
+/// pieces throw.
+std::map<int, std::vector<int>> chain_incidence(const std::string& where, const std::string& name,
+                                                const Eigen::MatrixXd& x, const std::vector<std::array<int, 2>>& segs,
+                                                std::vector<int>& ends) {
   if (segs.empty()) throw InputError(where + ": physical curve " + quoted(name, 200) + " has no line elements");
-  std::map<int, std::vector<int>> incident;  // node -> segment indices
+  std::map<int, std::vector<int>> incident;
   for (int s = 0; s < static_cast<int>(segs.size()); ++s) {
     if (segs[s][0] == segs[s][1])
       throw InputError(where + ": physical curve " + quoted(name, 200) + " has a zero-length segment at " +
                        point_string(x, segs[s][0]));
     for (int n : segs[s]) incident[n].push_back(s);
   }
-  std::vector<int> ends;
   for (const auto& [node, list] : incident) {
     if (list.size() > 2)
       throw InputError(where + ": physical curve " + quoted(name, 200) + " branches at " + point_string(x, node) +
@@ -180,10 +178,13 @@ void order_chain(const std::string& where, const std::string& name, const Eigen:
   if (!ends.empty() && ends.size() != 2)
     throw InputError(where + ": physical curve " + quoted(name, 200) + " is not connected (" + std::to_string(ends.size() / 2) +
                      " pieces); expected a single chain of segments");
-  const bool closed = ends.empty();
+  return incident;
+}
 
-  // Walk from a provisional start.
-  const int start = closed ? incident.begin()->first : ends.front();
+/// The nodes of the chain walked from `start` (a closed chain does not repeat it);
+/// a segment the walk does not reach throws.
+std::vector<int> walk_chain(const std::string& where, const std::string& name, const std::vector<std::array<int, 2>>& segs,
+                            std::map<int, std::vector<int>>& incident, int start, bool closed) {
   std::vector<int> nodes{start};
   std::vector<char> used(segs.size(), 0);
   int current = start;
@@ -203,21 +204,38 @@ void order_chain(const std::string& where, const std::string& name, const Eigen:
     throw InputError(where + ": physical curve '" + name +
                      "' is not connected (a closed loop plus other pieces); expected a single chain of segments");
   if (closed) nodes.pop_back();  // the walk came back to the start
+  return nodes;
+}
+
+/// +1 if the segment a-b is a counter-clockwise edge of a quad, -1 if b-a is, 0 if
+/// neither.
+int edge_orientation(const std::vector<std::array<int, 4>>& quads, int a, int b) {
+  for (const auto& q : quads)
+    for (int i = 0; i < 4; ++i) {
+      const int p = q[i], r = q[(i + 1) % 4];
+      if (p == a && r == b) return +1;
+      if (p == b && r == a) return -1;
+    }
+  return 0;
+}
+
+/// Orders the segments of one curve as a chain. The chain runs so that the body
+/// owning the first segment lies on its left (the quad containing the segment
+/// has it as a counter-clockwise edge); for a closed curve it starts at the
+/// smallest node id.
+void order_chain(const std::string& where, const std::string& name, const Eigen::MatrixXd& x,
+                 const std::vector<std::array<int, 4>>& quads, const std::vector<std::array<int, 2>>& segs,
+                 std::vector<std::array<int, 2>>& out_segments, std::vector<int>& out_nodes) {
+  std::vector<int> ends;
+  std::map<int, std::vector<int>> incident = chain_incidence(where, name, x, segs, ends);
+  const bool closed = ends.empty();
+  std::vector<int> nodes = walk_chain(where, name, segs, incident, closed ? incident.begin()->first : ends.front(), closed);
 
   // Orientation: body on the left of the first segment.
-  const int a = nodes[0], b = nodes[1];
-  int orientation = 0;  // +1 keep, -1 reverse, 0 unknown
-  for (const auto& q : quads) {
-    for (int i = 0; i < 4 && orientation == 0; ++i) {
-      const int p = q[i], r = q[(i + 1) % 4];
-      if (p == a && r == b) orientation = +1;
-      if (p == b && r == a) orientation = -1;
-    }
-    if (orientation != 0) break;
-  }
+  const int orientation = edge_orientation(quads, nodes[0], nodes[1]);
   if (orientation == 0)
-    throw InputError(where + ": physical curve " + quoted(name, 200) + " segment " + point_string(x, a) + "-" +
-                     point_string(x, b) + " is not an edge of any quad of a physical surface");
+    throw InputError(where + ": physical curve " + quoted(name, 200) + " segment " + point_string(x, nodes[0]) + "-" +
+                     point_string(x, nodes[1]) + " is not an edge of any quad of a physical surface");
   if (orientation < 0) {
     if (closed)
       std::reverse(nodes.begin() + 1, nodes.end());  // keep the start node
@@ -228,6 +246,11 @@ void order_chain(const std::string& where, const std::string& name, const Eigen:
   out_segments.clear();
   const std::size_t nseg = closed ? nodes.size() : nodes.size() - 1;
   for (std::size_t k = 0; k < nseg; ++k) out_segments.push_back({nodes[k], nodes[(k + 1) % nodes.size()]});
+}
+
+void sort_unique(std::vector<int>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
 /// Contiguous node numbering: body after body, and within a body by ascending gmsh
@@ -265,28 +288,29 @@ Eigen::MatrixXd node_coordinates(const std::string& where, const std::unordered_
   return nodes;
 }
 
-Mesh read_current_model(const std::string& where) {
-  const auto surfaces = physical_groups(2);
-  const auto curves = physical_groups(1);
-  if (surfaces.empty() && curves.empty())
-    throw InputError(where + " has no physical groups; expected physical surfaces (bodies) and physical curves "
-                             "(boundaries)");
-  if (surfaces.empty())
-    throw InputError(where + " has no physical surface; expected one per body");
+/// Checks that the physical group `g` of bodies (`kind`: "surface" or "volume")
+/// shares no entity with an earlier body and no name with one; records its entities
+/// in `entity_owner`.
+void check_body_group(const std::string& where, const char* kind, const PhysicalGroup& g,
+                      std::map<int, std::string>& entity_owner, const std::vector<std::string>& body_names) {
+  for (int e : g.entities) {
+    auto [it, inserted] = entity_owner.emplace(e, g.name);
+    if (!inserted)
+      throw InputError(where + ": " + kind + " " + std::to_string(e) + " belongs to physical " + kind + "s " +
+                       quoted(it->second, 200) + " and " + quoted(g.name, 200) + "; each element must belong to one body");
+  }
+  if (std::find(body_names.begin(), body_names.end(), g.name) != body_names.end())
+    throw InputError(where + ": two physical " + kind + "s are named " + quoted(g.name, 200));
+}
 
-  // Quads per body, in gmsh node tags. An entity may belong to one body only.
+/// The quads of each physical surface (one body each), as gmsh node tags; records
+/// the bodies' names in `mesh.body_names`.
+std::vector<std::vector<std::size_t>> read_body_quads(const std::string& where, const std::vector<PhysicalGroup>& surfaces,
+                                                      Mesh& mesh) {
   std::vector<std::vector<std::size_t>> body_quads;
   std::map<int, std::string> entity_owner;
-  Mesh mesh;
   for (const auto& g : surfaces) {
-    for (int e : g.entities) {
-      auto [it, inserted] = entity_owner.emplace(e, g.name);
-      if (!inserted)
-        throw InputError(where + ": surface " + std::to_string(e) + " belongs to physical surfaces '" + it->second +
-                         "' and " + quoted(g.name, 200) + "; each element must belong to one body");
-    }
-    if (std::find(mesh.body_names.begin(), mesh.body_names.end(), g.name) != mesh.body_names.end())
-      throw InputError(where + ": two physical surfaces are named " + quoted(g.name, 200));
+    check_body_group(where, "surface", g, entity_owner, mesh.body_names);
     auto tags = group_elements(2, g, kGmshQuad4, [&](int type) {
       throw InputError(where + ": surface elements must be 4-node quads, found " + element_kind(type));
     });
@@ -294,10 +318,13 @@ Mesh read_current_model(const std::string& where) {
     mesh.body_names.push_back(g.name);
     body_quads.push_back(std::move(tags));
   }
+  return body_quads;
+}
 
-  const std::unordered_map<std::size_t, int> id_of = number_nodes(body_quads);
-  mesh.nodes = node_coordinates(where, id_of, 2);
-
+/// Appends the quads of every body to `mesh` (numbered by `id_of`), counter-clockwise;
+/// a degenerate quad throws.
+void add_quads(const std::string& where, const std::vector<std::vector<std::size_t>>& body_quads,
+               const std::unordered_map<std::size_t, int>& id_of, Mesh& mesh) {
   for (std::size_t b = 0; b < body_quads.size(); ++b) {
     const auto& tags = body_quads[b];
     for (std::size_t e = 0; e + 3 < tags.size(); e += 4) {
@@ -314,42 +341,81 @@ Mesh read_current_model(const std::string& where) {
       mesh.quad_body.push_back(static_cast<int>(b));
     }
   }
+}
 
-  for (const auto& g : curves) {
-    if (mesh.segments.count(g.name))
-      throw InputError(where + ": two physical curves are named " + quoted(g.name, 200));
-    const auto tags = group_elements(1, g, kGmshLine2, [&](int type) {
-      throw InputError(where + ": curve elements of " + quoted(g.name, 200) + " must be 2-node lines, found " +
-                       element_kind(type));
-    });
-    std::vector<std::array<int, 2>> segs;
-    for (std::size_t e = 0; e + 1 < tags.size(); e += 2) {
-      auto a = id_of.find(tags[e]), b = id_of.find(tags[e + 1]);
-      if (a == id_of.end() || b == id_of.end())
-        throw InputError(where + ": physical curve " + quoted(g.name, 200) + " has nodes that belong to no physical surface");
-      segs.push_back({a->second, b->second});
-    }
-    order_chain(where, g.name, mesh.nodes, mesh.quads, segs, mesh.segments[g.name], mesh.curve_nodes[g.name]);
+/// Adds the physical curve `g` to `mesh` as a chain of segments (order_chain).
+void add_curve(const std::string& where, const PhysicalGroup& g, const std::unordered_map<std::size_t, int>& id_of,
+               Mesh& mesh) {
+  if (mesh.segments.count(g.name)) throw InputError(where + ": two physical curves are named " + quoted(g.name, 200));
+  const auto tags = group_elements(1, g, kGmshLine2, [&](int type) {
+    throw InputError(where + ": curve elements of " + quoted(g.name, 200) + " must be 2-node lines, found " +
+                     element_kind(type));
+  });
+  std::vector<std::array<int, 2>> segs;
+  for (std::size_t e = 0; e + 1 < tags.size(); e += 2) {
+    auto a = id_of.find(tags[e]), b = id_of.find(tags[e + 1]);
+    if (a == id_of.end() || b == id_of.end())
+      throw InputError(where + ": physical curve " + quoted(g.name, 200) + " has nodes that belong to no physical surface");
+    segs.push_back({a->second, b->second});
   }
-  // Physical points: a node group without segments (Dirichlet data on a point).
-  for (const auto& g : physical_groups(0)) {
-    if (mesh.curve_nodes.count(g.name))
-      throw InputError(where + ": the physical point " + quoted(g.name, 200) + " has the name of another group");
-    std::vector<int>& nodes = mesh.curve_nodes[g.name];
-    mesh.segments[g.name];  // no segments
-    for (int entity : g.entities) {
-      std::vector<std::size_t> tags;
-      std::vector<double> coord, param;
-      gmsh::model::mesh::getNodes(tags, coord, param, 0, entity);
-      for (std::size_t t : tags) {
-        auto it = id_of.find(t);
-        if (it == id_of.end())
-          throw InputError(where + ": physical point " + quoted(g.name, 200) + " is not a node of a physical surface");
-        nodes.push_back(it->second);
-      }
+  order_chain(where, g.name, mesh.nodes, mesh.quads, segs, mesh.segments[g.name], mesh.curve_nodes[g.name]);
+}
+
+/// The nodes of the physical group `g` of dimension `dim` (`kind`: "curve" or
+/// "point"), numbered by `id_of`, in gmsh's order; a node of no body throws
+/// (`body_kind`: "surface" or "volume"), and so does an empty group.
+std::vector<int> group_nodes(const std::string& where, int dim, const char* kind, const char* body_kind,
+                             const PhysicalGroup& g, const std::unordered_map<std::size_t, int>& id_of) {
+  std::vector<int> nodes;
+  for (int entity : g.entities) {
+    std::vector<std::size_t> tags;
+    std::vector<double> coord, param;
+    gmsh::model::mesh::getNodes(tags, coord, param, dim, entity, true, false);
+    for (std::size_t t : tags) {
+      auto it = id_of.find(t);
+      if (it == id_of.end())
+        throw InputError(where + ": physical " + kind + " " + quoted(g.name, 200) + " has a node of no physical " +
+                         body_kind);
+      nodes.push_back(it->second);
     }
-    if (nodes.empty()) throw InputError(where + ": physical point " + quoted(g.name, 200) + " has no mesh node");
   }
+  if (nodes.empty()) throw InputError(where + ": physical " + kind + " " + quoted(g.name, 200) + " has no mesh node");
+  return nodes;
+}
+
+/// Adds the physical group `g` of dimension `dim` as a node group without segments
+/// or faces (Dirichlet data on a point, or on an edge in 3D).
+void add_node_group(const std::string& where, int dim, const char* body_kind, const PhysicalGroup& g,
+                    const std::unordered_map<std::size_t, int>& id_of, Mesh& mesh) {
+  const char* kind = dim == 1 ? "curve" : "point";
+  if (mesh.curve_nodes.count(g.name))
+    throw InputError(where + ": the physical " + kind + " " + quoted(g.name, 200) + " has the name of another group");
+  std::vector<int>& nodes = mesh.curve_nodes[g.name];
+  nodes = group_nodes(where, dim, kind, body_kind, g, id_of);
+  if (mesh.dim == 2) {
+    mesh.segments[g.name];  // a point: no segments
+  } else {  // (2D keeps gmsh's order, which its mesh fingerprint has always hashed)
+    sort_unique(nodes);
+  }
+}
+
+/// The 2D mesh of gmsh's current model: physical surfaces are bodies of quads,
+/// physical curves chains of boundary segments, physical points node groups.
+Mesh read_current_model(const std::string& where) {
+  const auto surfaces = physical_groups(2);
+  const auto curves = physical_groups(1);
+  if (surfaces.empty() && curves.empty())
+    throw InputError(where + " has no physical groups; expected physical surfaces (bodies) and physical curves "
+                             "(boundaries)");
+  if (surfaces.empty()) throw InputError(where + " has no physical surface; expected one per body");
+
+  Mesh mesh;
+  const std::vector<std::vector<std::size_t>> body_quads = read_body_quads(where, surfaces, mesh);
+  const std::unordered_map<std::size_t, int> id_of = number_nodes(body_quads);
+  mesh.nodes = node_coordinates(where, id_of, 2);
+  add_quads(where, body_quads, id_of, mesh);
+  for (const auto& g : curves) add_curve(where, g, id_of, mesh);
+  for (const auto& g : physical_groups(0)) add_node_group(where, 0, "surface", g, id_of, mesh);
   return mesh;
 }
 
@@ -451,22 +517,20 @@ Eigen::Vector3d facet_normal(const Eigen::MatrixXd& x, const std::array<int, 4>&
   return (point3(x, f[2]) - point3(x, f[0])).cross(point3(x, f[3]) - point3(x, f[1]));
 }
 
-Mesh read_current_model_3d(const std::string& where) {
-  const auto volumes = physical_groups(3);
-  Mesh mesh;
-  mesh.dim = 3;
-  std::vector<std::vector<std::size_t>> body_tags;
-  std::vector<std::vector<std::pair<int, std::size_t>>> body_cells;  // (type, offset into body_tags)
+/// The volume elements of each physical volume (one body each): their gmsh node
+/// tags, and each cell as (gmsh type, offset into the tags).
+struct BodyCells {
+  std::vector<std::vector<std::size_t>> tags;
+  std::vector<std::vector<std::pair<int, std::size_t>>> cells;
+};
+
+/// Reads the cells of every physical volume; records the bodies' names in
+/// `mesh.body_names`.
+BodyCells read_body_cells(const std::string& where, const std::vector<PhysicalGroup>& volumes, Mesh& mesh) {
+  BodyCells bodies;
   std::map<int, std::string> entity_owner;
   for (const auto& g : volumes) {
-    for (int e : g.entities) {
-      auto [it, inserted] = entity_owner.emplace(e, g.name);
-      if (!inserted)
-        throw InputError(where + ": volume " + std::to_string(e) + " belongs to physical volumes '" + it->second +
-                         "' and '" + g.name + "'; each element must belong to one body");
-    }
-    if (std::find(mesh.body_names.begin(), mesh.body_names.end(), g.name) != mesh.body_names.end())
-      throw InputError(where + ": two physical volumes are named '" + g.name + "'");
+    check_body_group(where, "volume", g, entity_owner, mesh.body_names);
     std::vector<std::size_t> tags;
     std::vector<std::pair<int, std::size_t>> cells;
     for (const auto& [type, list] : group_elements_by_type(3, g)) {
@@ -477,85 +541,99 @@ Mesh read_current_model_3d(const std::string& where) {
       for (std::size_t e = 0; e + n <= list.size(); e += n) cells.emplace_back(type, tags.size() + e);
       tags.insert(tags.end(), list.begin(), list.end());
     }
-    if (tags.empty()) throw InputError(where + ": physical volume '" + g.name + "' has no elements");
+    if (tags.empty()) throw InputError(where + ": physical volume " + quoted(g.name, 200) + " has no elements");
     mesh.body_names.push_back(g.name);
-    body_tags.push_back(std::move(tags));
-    body_cells.push_back(std::move(cells));
+    bodies.tags.push_back(std::move(tags));
+    bodies.cells.push_back(std::move(cells));
   }
-  const std::unordered_map<std::size_t, int> id_of = number_nodes(body_tags);
-  mesh.nodes = node_coordinates(where, id_of, 3);
-  for (std::size_t b = 0; b < body_tags.size(); ++b)
-    for (const auto& [type, offset] : body_cells[b]) {
+  return bodies;
+}
+
+/// Appends the cells of every body to `mesh` (numbered by `id_of`), positively
+/// oriented (orient_cell).
+void add_cells(const std::string& where, const BodyCells& bodies, const std::unordered_map<std::size_t, int>& id_of,
+               Mesh& mesh) {
+  for (std::size_t b = 0; b < bodies.tags.size(); ++b)
+    for (const auto& [type, offset] : bodies.cells[b]) {
       std::array<int, 8> c;
       c.fill(-1);
       const int n = type == kGmshTetrahedron4 ? 4 : 8;
-      for (int a = 0; a < n; ++a) c[static_cast<size_t>(a)] = id_of.at(body_tags[b][offset + static_cast<size_t>(a)]);
+      for (int a = 0; a < n; ++a) c[static_cast<size_t>(a)] = id_of.at(bodies.tags[b][offset + static_cast<size_t>(a)]);
       orient_cell(where, mesh.body_names[b], mesh.nodes, c);
       mesh.cells.push_back(c);
       mesh.cell_body.push_back(static_cast<int>(b));
     }
+}
 
-  // Boundary groups: facets of physical surfaces, oriented out of the body whose cell has them.
-  const NodeCells node_cells(mesh.num_nodes(), mesh.cells);
-  for (const auto& g : physical_groups(2)) {
-    if (mesh.curve_nodes.count(g.name)) throw InputError(where + ": two physical surfaces are named '" + g.name + "'");
-    std::vector<std::array<int, 4>>& facets = mesh.faces[g.name];
-    for (const auto& [type, list] : group_elements_by_type(2, g)) {
-      if (type != kGmshTriangle3 && type != kGmshQuad4)
-        throw InputError(where + ": facets of the physical surface '" + g.name +
-                         "' must be 3-node triangles or 4-node quads, found " + element_kind(type));
-      const std::size_t n = type == kGmshTriangle3 ? 3 : 4;
-      for (std::size_t e = 0; e + n <= list.size(); e += n) {
-        std::array<int, 4> f{-1, -1, -1, -1};
-        for (std::size_t a = 0; a < n; ++a) {
-          auto it = id_of.find(list[e + a]);
-          if (it == id_of.end())
-            throw InputError(where + ": physical surface '" + g.name + "' has nodes that belong to no physical volume");
-          f[a] = it->second;
-        }
-        const std::vector<int> owners = node_cells.holding(f, mesh.cells);
-        if (owners.empty())
-          throw InputError(where + ": physical surface '" + g.name + "' has the facet at " +
-                           point_string(mesh.nodes, f[0]) + " that is no face of a volume element");
-        // Outward: the owner's centroid lies behind the facet.
-        const auto& c = mesh.cells[static_cast<size_t>(owners.front())];
-        Eigen::Vector3d centre = Eigen::Vector3d::Zero(), mid = Eigen::Vector3d::Zero();
-        for (int a = 0; a < Mesh::cell_size(c); ++a) centre += point3(mesh.nodes, c[a]) / Mesh::cell_size(c);
-        for (std::size_t a = 0; a < n; ++a) mid += point3(mesh.nodes, f[a]) / static_cast<double>(n);
-        if (facet_normal(mesh.nodes, f).dot(centre - mid) > 0) std::swap(f[1], f[n - 1]);
-        facets.push_back(f);
+/// Orients the facet `f` (`n` nodes) out of the cell `c` that has it: the cell's
+/// centroid lies behind it.
+void orient_outward(const Eigen::MatrixXd& x, const std::array<int, 8>& c, std::size_t n, std::array<int, 4>& f) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero(), mid = Eigen::Vector3d::Zero();
+  for (int a = 0; a < Mesh::cell_size(c); ++a) centre += point3(x, c[a]) / Mesh::cell_size(c);
+  for (std::size_t a = 0; a < n; ++a) mid += point3(x, f[a]) / static_cast<double>(n);
+  if (facet_normal(x, f).dot(centre - mid) > 0) std::swap(f[1], f[n - 1]);
+}
+
+/// The facets of the physical surface `g`, each oriented out of the body whose
+/// cell has it.
+std::vector<std::array<int, 4>> surface_facets(const std::string& where, const PhysicalGroup& g,
+                                               const std::unordered_map<std::size_t, int>& id_of,
+                                               const NodeCells& node_cells, const Mesh& mesh) {
+  std::vector<std::array<int, 4>> facets;
+  for (const auto& [type, list] : group_elements_by_type(2, g)) {
+    if (type != kGmshTriangle3 && type != kGmshQuad4)
+      throw InputError(where + ": facets of the physical surface " + quoted(g.name, 200) +
+                       " must be 3-node triangles or 4-node quads, found " + element_kind(type));
+    const std::size_t n = type == kGmshTriangle3 ? 3 : 4;
+    for (std::size_t e = 0; e + n <= list.size(); e += n) {
+      std::array<int, 4> f{-1, -1, -1, -1};
+      for (std::size_t a = 0; a < n; ++a) {
+        auto it = id_of.find(list[e + a]);
+        if (it == id_of.end())
+          throw InputError(where + ": physical surface " + quoted(g.name, 200) +
+                           " has nodes that belong to no physical volume");
+        f[a] = it->second;
       }
+      const std::vector<int> owners = node_cells.holding(f, mesh.cells);
+      if (owners.empty())
+        throw InputError(where + ": physical surface " + quoted(g.name, 200) + " has the facet at " +
+                         point_string(mesh.nodes, f[0]) + " that is no face of a volume element");
+      orient_outward(mesh.nodes, mesh.cells[static_cast<size_t>(owners.front())], n, f);
+      facets.push_back(f);
     }
-    if (facets.empty()) throw InputError(where + ": physical surface '" + g.name + "' has no elements");
-    std::vector<int>& nodes = mesh.curve_nodes[g.name];
-    for (const auto& f : facets)
-      for (int v : f)
-        if (v >= 0) nodes.push_back(v);
-    std::sort(nodes.begin(), nodes.end());
-    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
   }
-  // Physical curves and points: node groups (Dirichlet data on an edge or a point).
+  if (facets.empty()) throw InputError(where + ": physical surface " + quoted(g.name, 200) + " has no elements");
+  return facets;
+}
+
+/// Adds the physical surface `g` to `mesh`: its outward facets and their nodes.
+void add_surface(const std::string& where, const PhysicalGroup& g, const std::unordered_map<std::size_t, int>& id_of,
+                 const NodeCells& node_cells, Mesh& mesh) {
+  if (mesh.curve_nodes.count(g.name))
+    throw InputError(where + ": two physical surfaces are named " + quoted(g.name, 200));
+  const std::vector<std::array<int, 4>>& facets = mesh.faces[g.name] =
+      surface_facets(where, g, id_of, node_cells, mesh);
+  std::vector<int>& nodes = mesh.curve_nodes[g.name];
+  for (const auto& f : facets)
+    for (int v : f)
+      if (v >= 0) nodes.push_back(v);
+  sort_unique(nodes);
+}
+
+/// The 3D mesh of gmsh's current model: physical volumes are bodies of tetrahedra
+/// and hexahedra, physical surfaces boundary facets, physical curves and points node
+/// groups.
+Mesh read_current_model_3d(const std::string& where) {
+  Mesh mesh;
+  mesh.dim = 3;
+  const BodyCells bodies = read_body_cells(where, physical_groups(3), mesh);
+  const std::unordered_map<std::size_t, int> id_of = number_nodes(bodies.tags);
+  mesh.nodes = node_coordinates(where, id_of, 3);
+  add_cells(where, bodies, id_of, mesh);
+  const NodeCells node_cells(mesh.num_nodes(), mesh.cells);
+  for (const auto& g : physical_groups(2)) add_surface(where, g, id_of, node_cells, mesh);
   for (int dim : {1, 0})
-    for (const auto& g : physical_groups(dim)) {
-      const char* kind = dim == 1 ? "curve" : "point";
-      if (mesh.curve_nodes.count(g.name))
-        throw InputError(where + ": the physical " + kind + " '" + g.name + "' has the name of another group");
-      std::vector<int>& nodes = mesh.curve_nodes[g.name];
-      for (int entity : g.entities) {
-        std::vector<std::size_t> tags;
-        std::vector<double> coord, param;
-        gmsh::model::mesh::getNodes(tags, coord, param, dim, entity, true, false);
-        for (std::size_t t : tags) {
-          auto it = id_of.find(t);
-          if (it == id_of.end())
-            throw InputError(where + ": physical " + kind + " '" + g.name + "' has a node of no physical volume");
-          nodes.push_back(it->second);
-        }
-      }
-      std::sort(nodes.begin(), nodes.end());
-      nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-      if (nodes.empty()) throw InputError(where + ": physical " + kind + " '" + g.name + "' has no mesh node");
-    }
+    for (const auto& g : physical_groups(dim)) add_node_group(where, dim, "volume", g, id_of, mesh);
   return mesh;
 }
 

@@ -6,6 +6,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <contactrom/core/errors.hpp>
 
@@ -54,6 +55,181 @@ FacetProjection closest_on_edges(const Vector3d& p, const Vector3d* x, int nv, L
     }
   }
   return best;
+}
+
+/// Storage of NodeToFaceContact::search_pair, reused from one search to the next
+/// (one per thread): the deformed master nodes, the facets' bounding boxes, the
+/// bucket grid's lists, the facets' visit stamps and the nodal normals.
+struct FacetSearchScratch {
+  Eigen::Matrix3Xd xm, node_normal, lo, hi;
+  std::vector<int> cell_start, cell_facets, stamp;
+};
+
+/// Bounding boxes (columns of lo, hi) of the facets on the nodes xm; returns their
+/// mean size (largest extent).
+double facet_boxes(const std::vector<std::array<int, 4>>& facets, const Eigen::Matrix3Xd& xm, Eigen::Matrix3Xd& lo,
+                   Eigen::Matrix3Xd& hi) {
+  const int nf = static_cast<int>(facets.size());
+  lo.resize(3, nf);
+  hi.resize(3, nf);
+  double mean_size = 0.0;
+  for (int f = 0; f < nf; ++f) {
+    const auto& facet = facets[static_cast<size_t>(f)];
+    lo.col(f) = hi.col(f) = xm.col(facet[0]);
+    for (int a = 1; a < 4 && facet[static_cast<size_t>(a)] >= 0; ++a) {
+      lo.col(f) = lo.col(f).cwiseMin(xm.col(facet[static_cast<size_t>(a)]));
+      hi.col(f) = hi.col(f).cwiseMax(xm.col(facet[static_cast<size_t>(a)]));
+    }
+    mean_size += (hi.col(f) - lo.col(f)).maxCoeff() / nf;
+  }
+  return mean_size;
+}
+
+/// Bucket grid over the facets' bounding boxes: cells of the mean facet size, grown
+/// until there are at most about 8 cells per facet; each cell lists the facets whose
+/// box meets it (compressed rows in the caller's storage).
+class FacetGrid {
+ public:
+  FacetGrid(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi, double mean_size, std::vector<int>& start,
+            std::vector<int>& list)
+      : m_lo(lo.rowwise().minCoeff()), m_h(std::max(mean_size, 1e-300)), m_start(start), m_list(list) {
+    const int nf = static_cast<int>(lo.cols());
+    const Vector3d box_hi = hi.rowwise().maxCoeff();
+    for (;;) {
+      for (int i = 0; i < 3; ++i) m_dims(i) = std::max(1, static_cast<int>(std::ceil((box_hi(i) - m_lo(i)) / m_h)));
+      if (static_cast<double>(m_dims.prod()) <= 8.0 * nf + 64) break;
+      m_h *= 1.5;
+    }
+    fill(lo, hi);
+  }
+
+  /// The cell holding x (clamped to the grid).
+  Eigen::Array3i cell_of(const Vector3d& x) const {
+    Eigen::Array3i c;
+    for (int i = 0; i < 3; ++i) c(i) = std::clamp(static_cast<int>(std::floor((x(i) - m_lo(i)) / m_h)), 0, m_dims(i) - 1);
+    return c;
+  }
+
+  /// The largest ring around a cell that the grid can hold.
+  int max_ring() const { return m_dims.maxCoeff(); }
+
+  /// Calls visit(f) for every facet listed in the cells at ring distance `ring` of c
+  /// (the surface of the cube of cells around it).
+  template <class Visit>
+  void visit_ring(const Eigen::Array3i& c, int ring, Visit&& visit) const {
+    for (int kk = std::max(c(2) - ring, 0); kk <= std::min(c(2) + ring, m_dims(2) - 1); ++kk)
+      for (int j = std::max(c(1) - ring, 0); j <= std::min(c(1) + ring, m_dims(1) - 1); ++j)
+        for (int i = std::max(c(0) - ring, 0); i <= std::min(c(0) + ring, m_dims(0) - 1); ++i) {
+          if (std::max({std::abs(i - c(0)), std::abs(j - c(1)), std::abs(kk - c(2))}) != ring) continue;
+          const size_t cell = static_cast<size_t>(flat({i, j, kk}));
+          for (int e = m_start[cell]; e < m_start[cell + 1]; ++e) visit(m_list[static_cast<size_t>(e)]);
+        }
+  }
+
+  /// Squared lower bound of the distance from x to the cells outside the cube of
+  /// rings 0..r around cell c: the nearest of the (up to six) slabs of the grid
+  /// beyond the cube, each a box (∞: the cube covers the grid).
+  double beyond_ring(const Eigen::Array3i& c, int r, const Vector3d& x) const {
+    double bound = std::numeric_limits<double>::infinity();
+    Vector3d grid_hi;
+    for (int i = 0; i < 3; ++i) grid_hi(i) = m_lo(i) + m_dims(i) * m_h;
+    for (int i = 0; i < 3; ++i)
+      for (int side : {-1, 1}) {
+        Vector3d slab_lo = m_lo, slab_hi = grid_hi;
+        if (side < 0) {
+          if (c(i) - r - 1 < 0) continue;
+          slab_hi(i) = m_lo(i) + (c(i) - r) * m_h;
+        } else {
+          if (c(i) + r + 1 > m_dims(i) - 1) continue;
+          slab_lo(i) = m_lo(i) + (c(i) + r + 1) * m_h;
+        }
+        bound = std::min(bound, (x - x.cwiseMax(slab_lo).cwiseMin(slab_hi)).squaredNorm());
+      }
+    return bound;
+  }
+
+ private:
+  int flat(const Eigen::Array3i& c) const { return (c(2) * m_dims(1) + c(1)) * m_dims(0) + c(0); }
+
+  /// Lists every facet in the cells its box meets: count, then fill.
+  void fill(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi) {
+    const int nf = static_cast<int>(lo.cols());
+    m_start.assign(static_cast<size_t>(m_dims.prod()) + 1, 0);
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int f = 0; f < nf; ++f) {
+        const Eigen::Array3i a = cell_of(lo.col(f)), b = cell_of(hi.col(f));
+        for (int k = a(2); k <= b(2); ++k)
+          for (int j = a(1); j <= b(1); ++j)
+            for (int i = a(0); i <= b(0); ++i) {
+              const size_t c = static_cast<size_t>(flat({i, j, k}));
+              if (pass == 0) ++m_start[c + 1];
+              else m_list[static_cast<size_t>(m_start[c]++)] = f;
+            }
+      }
+      if (pass == 0) {
+        for (size_t c = 1; c < m_start.size(); ++c) m_start[c] += m_start[c - 1];
+        m_list.resize(static_cast<size_t>(m_start.back()));
+      } else {  // the fill advanced every start by its count: shift back
+        for (size_t c = m_start.size() - 1; c > 0; --c) m_start[c] = m_start[c - 1];
+        m_start[0] = 0;
+      }
+    }
+  }
+
+  Vector3d m_lo;  // the grid's lowest corner
+  double m_h;     // cell size
+  Eigen::Array3i m_dims;
+  std::vector<int>& m_start;
+  std::vector<int>& m_list;
+};
+
+/// The closest facet found for a node, with its projection.
+struct ClosestFacet {
+  double dist2 = std::numeric_limits<double>::max();
+  int facet = -1;
+  FacetProjection pr;
+};
+
+/// The facet closest to x (slave row k): the `guess` first (−1: none), then the rings
+/// of cells around x's cell until no cell beyond can hold a closer one. A facet whose
+/// bounding box is farther than the best so far is not projected on; `stamp` marks
+/// the facets tried for row k. `project(f)` is x's projection onto facet f.
+template <class Project>
+ClosestFacet closest_facet(const FacetGrid& grid, const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi,
+                           std::vector<int>& stamp, int k, const Vector3d& x, int guess, Project&& project) {
+  ClosestFacet best;
+  auto visit = [&](int f) {
+    if (stamp[static_cast<size_t>(f)] == k) return;
+    stamp[static_cast<size_t>(f)] = k;
+    const double box2 = (x - x.cwiseMax(lo.col(f)).cwiseMin(hi.col(f))).squaredNorm();
+    if (best.facet >= 0 && box2 > best.dist2 * (1.0 + 1e-12)) return;
+    const FacetProjection pr = project(f);
+    // Ties (a node exactly on a shared edge) go to the lower facet index.
+    if (pr.distance2 < best.dist2 * (1.0 - 1e-14) ||
+        (best.facet >= 0 && pr.distance2 <= best.dist2 * (1.0 + 1e-14) && f < best.facet))
+      best = {pr.distance2, f, pr};
+  };
+  if (guess >= 0) visit(guess);
+  const Eigen::Array3i c = grid.cell_of(x);
+  for (int ring = 0; ring <= grid.max_ring(); ++ring) {
+    grid.visit_ring(c, ring, visit);
+    if (best.facet >= 0 && best.dist2 <= grid.beyond_ring(c, ring, x)) break;
+  }
+  return best;
+}
+
+/// Nodal normals of the deformed master surface (columns of `node_normal`, unit):
+/// area-weighted facet normals.
+void nodal_normals(const std::vector<std::array<int, 4>>& facets, const Eigen::Matrix3Xd& xm,
+                   Eigen::Matrix3Xd& node_normal) {
+  node_normal.setZero(3, xm.cols());
+  for (const auto& facet : facets) {
+    const bool tri = facet[3] < 0;
+    const Vector3d n = tri ? Vector3d(0.5 * (xm.col(facet[1]) - xm.col(facet[0])).cross(xm.col(facet[2]) - xm.col(facet[0])))
+                           : Vector3d(0.5 * (xm.col(facet[2]) - xm.col(facet[0])).cross(xm.col(facet[3]) - xm.col(facet[1])));
+    for (int a = 0; a < (tri ? 3 : 4); ++a) node_normal.col(facet[static_cast<size_t>(a)]) += n;
+  }
+  for (Eigen::Index j = 0; j < xm.cols(); ++j) node_normal.col(j).normalize();
 }
 
 }  // namespace
@@ -306,149 +482,40 @@ void NodeToFaceContact::search_rows(const Eigen::VectorXd& u_surface, const std:
 void NodeToFaceContact::search_pair(const Pair& pair, const Eigen::VectorXd& u_surface, const int* rows, int nrows,
                                     const Pairing* hint, Pairing& p) const {
   const int nm = static_cast<int>(pair.master_surface.size()), nf = static_cast<int>(pair.facets.size());
-  thread_local struct {
-    Eigen::Matrix3Xd xm, node_normal, lo, hi;
-    std::vector<int> cell_start, cell_facets, stamp;
-  } scratch;
-  Eigen::Matrix3Xd& xm = scratch.xm;
-  xm.resize(3, nm);
+  thread_local FacetSearchScratch s;
+  s.xm.resize(3, nm);
   for (int j = 0; j < nm; ++j)
-    xm.col(j) = pair.master_x.col(j) + u_surface.segment<3>(3 * pair.master_surface[static_cast<size_t>(j)]);
+    s.xm.col(j) = pair.master_x.col(j) + u_surface.segment<3>(3 * pair.master_surface[static_cast<size_t>(j)]);
+  const double mean_size = facet_boxes(pair.facets, s.xm, s.lo, s.hi);
+  const FacetGrid grid(s.lo, s.hi, mean_size, s.cell_start, s.cell_facets);
+  s.stamp.assign(static_cast<size_t>(nf), -1);
 
-  // Bucket grid over the facets' bounding boxes, about one cell per facet.
-  Eigen::Matrix3Xd& lo = scratch.lo;
-  Eigen::Matrix3Xd& hi = scratch.hi;
-  lo.resize(3, nf);
-  hi.resize(3, nf);
-  double mean_size = 0.0;
-  for (int f = 0; f < nf; ++f) {
-    const auto& facet = pair.facets[static_cast<size_t>(f)];
-    lo.col(f) = hi.col(f) = xm.col(facet[0]);
-    for (int a = 1; a < 4 && facet[static_cast<size_t>(a)] >= 0; ++a) {
-      lo.col(f) = lo.col(f).cwiseMin(xm.col(facet[static_cast<size_t>(a)]));
-      hi.col(f) = hi.col(f).cwiseMax(xm.col(facet[static_cast<size_t>(a)]));
-    }
-    mean_size += (hi.col(f) - lo.col(f)).maxCoeff() / nf;
-  }
-  const Vector3d box_lo = lo.rowwise().minCoeff(), box_hi = hi.rowwise().maxCoeff();
-  double h = std::max(mean_size, 1e-300);
-  Eigen::Array3i dims;
-  for (;;) {  // at most about 8 cells per facet
-    for (int i = 0; i < 3; ++i) dims(i) = std::max(1, static_cast<int>(std::ceil((box_hi(i) - box_lo(i)) / h)));
-    if (static_cast<double>(dims.prod()) <= 8.0 * nf + 64) break;
-    h *= 1.5;
-  }
-  auto cell_of = [&](const Vector3d& x) {
-    Eigen::Array3i c;
-    for (int i = 0; i < 3; ++i) c(i) = std::clamp(static_cast<int>(std::floor((x(i) - box_lo(i)) / h)), 0, dims(i) - 1);
-    return c;
-  };
-  auto flat = [&](const Eigen::Array3i& c) { return (c(2) * dims(1) + c(1)) * dims(0) + c(0); };
-  std::vector<int>& start = scratch.cell_start;
-  std::vector<int>& list = scratch.cell_facets;
-  start.assign(static_cast<size_t>(dims.prod()) + 1, 0);
-  for (int pass = 0; pass < 2; ++pass) {
-    for (int f = 0; f < nf; ++f) {
-      const Eigen::Array3i a = cell_of(lo.col(f)), b = cell_of(hi.col(f));
-      for (int k = a(2); k <= b(2); ++k)
-        for (int j = a(1); j <= b(1); ++j)
-          for (int i = a(0); i <= b(0); ++i) {
-            const size_t c = static_cast<size_t>(flat({i, j, k}));
-            if (pass == 0) ++start[c + 1];
-            else list[static_cast<size_t>(start[c]++)] = f;
-          }
-    }
-    if (pass == 0) {
-      for (size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
-      list.resize(static_cast<size_t>(start.back()));
-    } else {  // the fill advanced every start by its count: shift back
-      for (size_t c = start.size() - 1; c > 0; --c) start[c] = start[c - 1];
-      start[0] = 0;
-    }
-  }
-  std::vector<int>& stamp = scratch.stamp;
-  stamp.assign(static_cast<size_t>(nf), -1);
-
-  struct Best {
-    double dist2 = std::numeric_limits<double>::max();
-    int facet = -1;
-    FacetProjection pr;
-  };
-  const int max_ring = dims.maxCoeff();
-  // Squared lower bound of the distance from x to the cells outside the cube of
-  // rings 0..r around cell c: the nearest of the (up to six) slabs of the grid
-  // beyond the cube, each a box (∞: the cube covers the grid).
-  auto beyond_ring = [&](const Eigen::Array3i& c, int r, const Vector3d& x) {
-    double bound = std::numeric_limits<double>::infinity();
-    Vector3d grid_hi;
-    for (int i = 0; i < 3; ++i) grid_hi(i) = box_lo(i) + dims(i) * h;
-    for (int i = 0; i < 3; ++i)
-      for (int side : {-1, 1}) {
-        Vector3d slab_lo = box_lo, slab_hi = grid_hi;
-        if (side < 0) {
-          if (c(i) - r - 1 < 0) continue;
-          slab_hi(i) = box_lo(i) + (c(i) - r) * h;
-        } else {
-          if (c(i) + r + 1 > dims(i) - 1) continue;
-          slab_lo(i) = box_lo(i) + (c(i) + r + 1) * h;
-        }
-        bound = std::min(bound, (x - x.cwiseMax(slab_lo).cwiseMin(slab_hi)).squaredNorm());
-      }
-    return bound;
-  };
+  // Each row: its closest facet, unless the node lies beyond the master's boundary.
   for (int r = 0; r < nrows; ++r) {
     const int k = rows ? rows[r] : pair.row_begin + r;
     const Vector3d x = m_slave_x.col(k) + u_surface.segment<3>(3 * k);
-    Best best;
-    auto visit = [&](int f) {
-      if (stamp[static_cast<size_t>(f)] == k) return;
-      stamp[static_cast<size_t>(f)] = k;
-      // A facet whose bounding box is farther than the best so far cannot be closer.
-      const double box2 = (x - x.cwiseMax(lo.col(f)).cwiseMin(hi.col(f))).squaredNorm();
-      if (best.facet >= 0 && box2 > best.dist2 * (1.0 + 1e-12)) return;
-      const FacetProjection pr = project(pair, xm, f, x);
-      // Ties (a node exactly on a shared edge) go to the lower facet index.
-      if (pr.distance2 < best.dist2 * (1.0 - 1e-14) ||
-          (best.facet >= 0 && pr.distance2 <= best.dist2 * (1.0 + 1e-14) && f < best.facet))
-        best = {pr.distance2, f, pr};
-    };
+    int guess = -1;
     if (hint && hint->segment.size() == p.segment.size() && hint->segment[static_cast<size_t>(k)] >= 0 &&
         hint->segment[static_cast<size_t>(k)] < nf)
-      visit(hint->segment[static_cast<size_t>(k)]);
-    const Eigen::Array3i c = cell_of(x);
-    for (int ring = 0; ring <= max_ring; ++ring) {
-      for (int kk = std::max(c(2) - ring, 0); kk <= std::min(c(2) + ring, dims(2) - 1); ++kk)
-        for (int j = std::max(c(1) - ring, 0); j <= std::min(c(1) + ring, dims(1) - 1); ++j)
-          for (int i = std::max(c(0) - ring, 0); i <= std::min(c(0) + ring, dims(0) - 1); ++i) {
-            if (std::max({std::abs(i - c(0)), std::abs(j - c(1)), std::abs(kk - c(2))}) != ring) continue;
-            const size_t cell = static_cast<size_t>(flat({i, j, kk}));
-            for (int e = start[cell]; e < start[cell + 1]; ++e) visit(list[static_cast<size_t>(e)]);
-          }
-      if (best.facet >= 0 && best.dist2 <= beyond_ring(c, ring, x)) break;
-    }
-    if (best.facet < 0 || beyond_boundary(pair, xm, best.facet, best.pr, x)) continue;
+      guess = hint->segment[static_cast<size_t>(k)];
+    const ClosestFacet best = closest_facet(grid, s.lo, s.hi, s.stamp, k, x, guess,
+                                            [&](int f) { return project(pair, s.xm, f, x); });
+    if (best.facet < 0 || beyond_boundary(pair, s.xm, best.facet, best.pr, x)) continue;
     p.segment[static_cast<size_t>(k)] = best.facet;
     p.xi[static_cast<size_t>(k)] = best.pr.xi;
     p.eta[static_cast<size_t>(k)] = best.pr.eta;
   }
 
-  // Nodal normals of the deformed master surface: area-weighted facet normals.
-  Eigen::Matrix3Xd& node_normal = scratch.node_normal;
-  node_normal.setZero(3, nm);
-  for (const auto& facet : pair.facets) {
-    const bool tri = facet[3] < 0;
-    const Vector3d n = tri ? Vector3d(0.5 * (xm.col(facet[1]) - xm.col(facet[0])).cross(xm.col(facet[2]) - xm.col(facet[0])))
-                           : Vector3d(0.5 * (xm.col(facet[2]) - xm.col(facet[0])).cross(xm.col(facet[3]) - xm.col(facet[1])));
-    for (int a = 0; a < (tri ? 3 : 4); ++a) node_normal.col(facet[static_cast<size_t>(a)]) += n;
-  }
-  for (int j = 0; j < nm; ++j) node_normal.col(j).normalize();
+  // The normal of each paired row: the nodal normals interpolated at its point.
+  nodal_normals(pair.facets, s.xm, s.node_normal);
   for (int r = 0; r < nrows; ++r) {
     const int k = rows ? rows[r] : pair.row_begin + r, f = p.segment[static_cast<size_t>(k)];
     if (f < 0) continue;
     const auto& facet = pair.facets[static_cast<size_t>(f)];
     const auto n = facet_shape(facet[3] < 0, p.xi[static_cast<size_t>(k)], p.eta[static_cast<size_t>(k)]);
     Vector3d normal = Vector3d::Zero();
-    for (int a = 0; a < 4 && facet[static_cast<size_t>(a)] >= 0; ++a) normal += n[static_cast<size_t>(a)] * node_normal.col(facet[static_cast<size_t>(a)]);
+    for (int a = 0; a < 4 && facet[static_cast<size_t>(a)] >= 0; ++a)
+      normal += n[static_cast<size_t>(a)] * s.node_normal.col(facet[static_cast<size_t>(a)]);
     p.normal.col(k) = normal.normalized();
   }
 }

@@ -3,6 +3,7 @@
 #include <contactrom/baselines/kkt_verifier.hpp>
 #include <contactrom/core/format.hpp>
 #include <contactrom/core/errors.hpp>
+#include <contactrom/core/parallel_for.hpp>
 #include "python/bindings.hpp"
 #include <contactrom/fom/rope.hpp>
 #include <contactrom/rom/offline.hpp>
@@ -237,6 +238,7 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
       .def(
           "solve_all",
           [](const FullOrderSolver& s, py::handle params, int threads) {
+            check_threads(threads, "threads");
             const std::vector<fom::Param> ps = to_params(*s.problem, params);
             std::vector<FomResult> out(ps.size());
             py::gil_scoped_release release;
@@ -245,7 +247,7 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
             return out;
           },
           py::arg("params"), py::arg("threads") = 0,
-          "Solves at every row of params on `threads` threads (<= 0: all cores); a list of FomSolution.");
+          "Solves at every row of params on `threads` threads (0: all cores; at most 1024); a list of FomSolution.");
 
   m.def(
       "verify",

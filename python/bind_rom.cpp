@@ -6,6 +6,7 @@
 
 #include <contactrom/core/format.hpp>
 #include <contactrom/core/errors.hpp>
+#include <contactrom/core/parallel_for.hpp>
 #include "python/bindings.hpp"
 #include <contactrom/rom/adaptive_training.hpp>
 #include <contactrom/rom/fallback.hpp>
@@ -55,6 +56,41 @@ std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, doub
                    1) != 0)
     throw py::error_already_set();  // the warning was turned into an error
   return r;
+}
+
+/// Reads the keyword settings of offline_adaptive (rom::adaptive_option_table()
+/// keys; numbers as numbers, words as str) into `o`, each checked as the CLI checks it.
+void read_adaptive_settings(const py::dict& settings, rom::AdaptiveOptions& o) {
+  const rom::OptionTable<rom::AdaptiveOptions>& table = rom::adaptive_option_table();
+  for (const auto& [key_object, value] : settings) {
+    const std::string key = py::str(key_object);
+    if (!table.find(key)) {
+      std::vector<std::string> keys;
+      for (const rom::OptionSpec& spec : table.specs()) keys.push_back(spec.key);
+      throw InputError("offline_adaptive setting " + quoted(key, 200) + " unknown; expected one of: " + join(keys, ", ") +
+                       ", threads, resume, path");
+    }
+    table.read(o, key, option_text(value), key);
+  }
+}
+
+/// The docstring of offline_adaptive: its settings from the table.
+std::string adaptive_doc() {
+  std::string doc = R"doc(
+Adaptive offline stage, as `contactrom offline --adaptive` (docs/rom.md, "Adaptive
+training"): FOM snapshots at the candidates where the reduced model's error estimate
+is largest, `batch` per round, until the largest estimate is below `tolerance` or the
+database holds `max_snapshots`. `threads`: 0 (all cores) or 1 to 1024. `resume`: an
+adaptive database to continue, whose settings the ones not given keep (candidates,
+seed, indicator, method and delta must stay the same). `path`: the database is
+written there after every round. Returns the database.
+
+Settings (keywords; `tolerance` is required for a new run):
+)doc";
+  for (const rom::OptionSpec& spec : rom::adaptive_option_table().specs())
+    doc += "  " + spec.key + ": " + spec.help + " (" + rom::describe_option_type(spec) + "; default " +
+           spec.default_value + ")\n";
+  return doc;
 }
 
 /// A reduced model with the FOM behind it (rom::FallbackSolver); keeps the model alive.
@@ -168,14 +204,8 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
             if (d.db->training_kind != "adaptive") return py::none();
             const rom::AdaptiveRecord& a = d.db->adaptive;
             py::dict r;
-            r["tolerance"] = a.tolerance;
-            r["max_snapshots"] = a.max_snapshots;
-            r["candidates"] = a.candidates;
-            r["batch"] = a.batch;
-            r["seed"] = a.seed;
-            r["indicator"] = a.indicator;
-            r["method"] = a.method;
-            r["delta"] = a.delta;
+            for (const auto& [key, value] : a.settings)
+              std::visit([&r, &k = key](const auto& v) { r[k.c_str()] = v; }, value);
             r["initial_snapshots"] = a.initial_snapshots;
             r["round_snapshots"] = py::array_t<int>(a.round_snapshots.size(), a.round_snapshots.data());
             r["round_added"] = py::array_t<int>(a.round_added.size(), a.round_added.data());
@@ -220,6 +250,7 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
   m.def(
       "offline",
       [](std::shared_ptr<fom::Problem> problem, py::handle params, int threads) {
+        check_threads(threads, "threads");
         rom::OfflineOptions options;
         options.threads = threads;
         Database d;
@@ -244,25 +275,20 @@ works in memory but is refused when read back from a file.)doc");
 
   m.def(
       "offline_adaptive",
-      [](std::shared_ptr<fom::Problem> problem, double tolerance, int max_snapshots, int candidates, int batch, int seed,
-         const std::string& indicator, const std::string& method, double delta, int initial, int threads,
-         py::object resume, py::object path_like) {
-        rom::AdaptiveOptions o;
-        o.tolerance = tolerance;
-        o.max_snapshots = max_snapshots;
-        o.candidates = candidates;
-        o.batch = batch;
-        o.seed = seed;
-        o.indicator = indicator;
-        o.method = method;
-        o.model.delta = delta;
-        o.initial = initial;
+      [](std::shared_ptr<fom::Problem> problem, py::object tolerance, int threads, py::object resume,
+         py::object path_like, py::kwargs settings) {
+        check_threads(threads, "threads");
+        const Database* previous = resume.is_none() ? nullptr : &resume.cast<const Database&>();
+        rom::AdaptiveOptions o = previous ? rom::adaptive_options_of(*previous->db) : rom::AdaptiveOptions{};
+        if (tolerance.is_none() && !previous)
+          throw InputError("offline_adaptive needs tolerance (e.g. 0.05) for a new run");
+        if (!tolerance.is_none()) settings["tolerance"] = tolerance;
+        read_adaptive_settings(settings, o);
         o.offline.threads = threads;
         const std::string path = path_like.is_none() ? std::string() : path_arg(path_like);
         if (!path.empty()) o.on_round = [path](const rom::AdaptiveRound&, const rom::SnapshotDatabase& db) {
           rom::write_database(path, db);
         };
-        const Database* previous = resume.is_none() ? nullptr : &resume.cast<const Database&>();
         Database d;
         d.problem = problem;
         py::gil_scoped_release release;
@@ -271,16 +297,13 @@ works in memory but is refused when read back from a file.)doc");
                                                                 : trainer.run());
         return d;
       },
-      py::arg("problem"), py::arg("tolerance"), py::arg("max_snapshots") = 200, py::arg("candidates") = 1000,
-      py::arg("batch") = 4, py::arg("seed") = 1, py::arg("indicator") = "max", py::arg("method") = "greedy",
-      py::arg("delta") = 1e-8, py::arg("initial") = 0, py::arg("threads") = 0, py::arg("resume") = py::none(),
-      py::arg("path") = py::none(), R"doc(
-Adaptive offline stage, as `contactrom offline --adaptive` (docs/rom.md, "Adaptive
-training"): FOM snapshots at the candidates where the reduced model's error estimate
-is largest, `batch` per round, until the largest estimate is below `tolerance` or the
-database holds `max_snapshots`. `resume`: an adaptive database to continue (its
-candidates, seed, indicator, method and delta must be given the same). `path`: the
-database is written there after every round. Returns the database.)doc");
+      py::arg("problem"), py::arg("tolerance") = py::none(), py::arg("threads") = 0, py::arg("resume") = py::none(),
+      py::arg("path") = py::none(), adaptive_doc().c_str());
+
+  m.def(
+      "adaptive_options", [] { return rom::adaptive_option_table().to_values(rom::AdaptiveOptions{}); },
+      "The settings offline_adaptive takes, each with its default (a dict: numbers as int or float, words as str), "
+      "as `contactrom offline --help` states them.");
 
   py::class_<rom::OnlineResult>(m, "RomSolution",
                                 "One online query; arrays are read-only views owned by this object.")
@@ -434,6 +457,7 @@ tolerances.)doc")
       .def(
           "evaluate",
           [](const ReducedModel& r, py::object params, int threads, bool kkt) {
+            check_threads(threads, "threads");
             const fom::Problem& problem = r.rom->problem();
             if (params.is_none() && !r.db)
               throw InputError("evaluate() of a reduced model loaded from a file needs params; it has no database "

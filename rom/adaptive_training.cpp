@@ -44,39 +44,51 @@ void check_same(const std::string& path, const std::string& what, const std::str
 
 }  // namespace
 
+const OptionTable<AdaptiveOptions>& adaptive_option_table() {
+  static const OptionTable<AdaptiveOptions> table = [] {
+    OptionTable<AdaptiveOptions> t;
+    t.number("tolerance", &AdaptiveOptions::tolerance,
+             "ε: stop when the largest indicator over the candidates is below it (a relative error)",
+             Interval::greater_than(0))
+        .integer("max_snapshots", &AdaptiveOptions::max_snapshots,
+                 "N: stop at N snapshots, the initial ones included (the last batch is cut to fit)", 1, 10000000)
+        .integer("candidates", &AdaptiveOptions::candidates,
+                 "M: candidate parameters, a Latin hypercube of the parameter box", 1, kMaxCandidates)
+        .integer("batch", &AdaptiveOptions::batch, "B: FOM snapshots added per round, at most", 1, 100000)
+        .integer("seed", &AdaptiveOptions::seed, "seed of the candidates' Latin hypercube", 0, 2147483647)
+        .choice("indicator", &AdaptiveOptions::indicator,
+                "estimate that ranks the candidates: primal (relative H1), dual (relative L2 on the contact "
+                "surface) or max (the larger of the two)",
+                {{"primal", "primal"}, {"dual", "dual"}, {"max", "max"}})
+        .text("method", &AdaptiveOptions::method, "online method whose answers are estimated",
+              [](const std::string& name, const std::string&) { check_online_method(name); })
+        .number("delta", [](auto& o) -> auto& { return o.model.delta; }, "POD tolerance of the reduced models",
+                Interval::closed(0, 1))
+        .integer("initial", &AdaptiveOptions::initial,
+                 "size or level of the initial training set (0: the coarsest: level 1, 2 uniform points or the "
+                 "listed points)",
+                 0, 10000000);
+    return t;
+  }();
+  return table;
+}
+
+const OptionTable<AdaptiveOptions>& adaptive_record_table() {
+  static const OptionTable<AdaptiveOptions> table = adaptive_option_table().without({"initial"});
+  return table;
+}
+
 void check_adaptive_options(const AdaptiveOptions& o) {
-  const auto bad = [](const std::string& what, const std::string& value, const std::string& expected) {
-    return InputError("adaptive training: " + what + " = " + value + " invalid; expected " + expected);
-  };
-  if (!(o.tolerance > 0.0) || !std::isfinite(o.tolerance))
-    throw bad("tolerance", format_number(o.tolerance), "a finite number > 0 (a relative error, e.g. 0.05)");
-  if (o.max_snapshots < 1) throw bad("max_snapshots", std::to_string(o.max_snapshots), "an integer >= 1");
-  if (o.candidates < 1 || o.candidates > kMaxCandidates)
-    throw bad("candidates", std::to_string(o.candidates), "an integer in [1, " + std::to_string(kMaxCandidates) + "]");
-  if (o.batch < 1) throw bad("batch", std::to_string(o.batch), "an integer >= 1");
-  if (o.seed < 0) throw bad("seed", std::to_string(o.seed), "an integer >= 0");
-  if (o.initial < 0) throw bad("initial", std::to_string(o.initial), "an integer >= 0 (0: the coarsest training set)");
-  if (o.indicator != "primal" && o.indicator != "dual" && o.indicator != "max")
-    throw bad("indicator", quoted(o.indicator, 200), "primal, dual or max");
-  if (!(o.model.delta >= 0.0 && o.model.delta <= 1.0))
-    throw bad("delta", format_number(o.model.delta), "a POD tolerance in [0, 1], such as 1e-8");
+  adaptive_option_table().check(o, "adaptive training: ");
   if (o.share_count < 1 || o.share_index < 0 || o.share_index >= o.share_count)
-    throw bad("share", std::to_string(o.share_index) + " of " + std::to_string(o.share_count),
-              "an index in [0, count) of a count >= 1");
-  check_online_method(o.method);
+    throw InputError("adaptive training: share = " + std::to_string(o.share_index) + " of " +
+                     std::to_string(o.share_count) + " invalid; expected an index in [0, count) of a count >= 1");
 }
 
 AdaptiveOptions adaptive_options_of(const SnapshotDatabase& db) {
-  const AdaptiveRecord& a = db.adaptive;
   AdaptiveOptions o;
-  o.tolerance = a.tolerance;
-  o.max_snapshots = a.max_snapshots;
-  o.candidates = a.candidates;
-  o.batch = a.batch;
-  o.seed = a.seed;
-  o.indicator = a.indicator;
-  o.method = a.method;
-  o.model.delta = a.delta;
+  for (const auto& [key, value] : db.adaptive.settings)
+    adaptive_record_table().assign(o, key, value, "adaptive database setting " + key);
   o.initial = db.training_size;
   return o;
 }
@@ -146,11 +158,12 @@ SnapshotDatabase AdaptiveTrainer::resume(SnapshotDatabase db, const std::string&
                      db.training_kind + " " + std::to_string(db.training_size) +
                      "; expected a database written by offline --adaptive");
   const AdaptiveRecord& a = db.adaptive;
-  check_same(path, "candidates", std::to_string(a.candidates), std::to_string(m_options.candidates));
-  check_same(path, "seed", std::to_string(a.seed), std::to_string(m_options.seed));
-  check_same(path, "indicator", a.indicator, m_options.indicator);
-  check_same(path, "method", a.method, m_options.method);
-  check_same(path, "delta", format_number(a.delta), format_number(m_options.model.delta));
+  // The settings that define the sequence of rounds (ε, N and B may change).
+  const std::map<std::string, OptionValue> ours = adaptive_record_table().to_values(m_options);
+  for (const char* key : {"candidates", "seed", "indicator", "method", "delta"}) {
+    const auto stored = a.settings.find(key);
+    check_same(path, key, stored == a.settings.end() ? "none" : option_text(stored->second), option_text(ours.at(key)));
+  }
   check_same(path, "initial training set", std::to_string(db.training_size), std::to_string(initial_size()));
   // A round that added nothing ended the earlier run; it is evaluated again (same
   // indicators) under the new tolerance and N.
@@ -187,14 +200,7 @@ SnapshotDatabase AdaptiveTrainer::loop(SnapshotDatabase db) const {
 }
 
 void AdaptiveTrainer::record_settings(AdaptiveRecord& record) const {
-  record.tolerance = m_options.tolerance;
-  record.max_snapshots = m_options.max_snapshots;
-  record.candidates = m_options.candidates;
-  record.batch = m_options.batch;
-  record.seed = m_options.seed;
-  record.indicator = m_options.indicator;
-  record.method = m_options.method;
-  record.delta = m_options.model.delta;
+  record.settings = adaptive_record_table().to_values(m_options);
 }
 
 AdaptiveRound AdaptiveTrainer::evaluate_round(const SnapshotDatabase& db, std::vector<double>& indicators) const {

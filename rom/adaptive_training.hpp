@@ -43,6 +43,7 @@
 #include <contactrom/fom/problem.hpp>
 #include <contactrom/rom/offline.hpp>
 #include <contactrom/rom/online_solver.hpp>
+#include <contactrom/rom/option_table.hpp>
 #include <contactrom/rom/reduced_model.hpp>
 #include <contactrom/rom/snapshot_database.hpp>
 
@@ -118,14 +119,26 @@ struct AdaptiveOptions {
   std::function<void(const AdaptiveRound&, const SnapshotDatabase&)> on_round;
 };
 
-/// \brief Refuses option values outside their ranges (ε > 0 finite, N ≥ 1, M in
-/// [1, 100000], B ≥ 1, indicator primal|dual|max, δ in [0, 1], initial ≥ 0, share
-/// index in [0, count)).
+/// \brief The binding table of AdaptiveOptions (rom/option_table.hpp): the key,
+/// member, range or words and help of every setting a user gives (ε, N, M, B, seed,
+/// indicator, method, δ, initial), its default read from AdaptiveOptions{}. The flags
+/// of `offline --adaptive`, Python's `offline_adaptive` keywords,
+/// check_adaptive_options() and the settings an adaptive database records
+/// (AdaptiveRecord::settings, adaptive_record_table()) are generated from it.
+const OptionTable<AdaptiveOptions>& adaptive_option_table();
+
+/// \brief The settings an adaptive database records: adaptive_option_table()
+/// without `initial` (the database's training_size holds it).
+const OptionTable<AdaptiveOptions>& adaptive_record_table();
+
+/// \brief Refuses option values outside their declarations (adaptive_option_table())
+/// and a share index outside [0, count).
 /// \throws InputError naming the option, the value and what was expected.
 void check_adaptive_options(const AdaptiveOptions& options);
 
-/// \brief The options recorded in an adaptive database (tolerance, N, M, B, seed,
-/// indicator, method, δ), for continuing it.
+/// \brief The options recorded in an adaptive database (AdaptiveRecord::settings, and
+/// its training size as `initial`), for continuing it.
+/// \throws InputError if a recorded value is outside its declaration.
 AdaptiveOptions adaptive_options_of(const SnapshotDatabase& db);
 
 /// \brief The adaptive offline stage; see the file comment.

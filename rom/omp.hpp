@@ -107,6 +107,18 @@ class Omp {
   }
 
  private:
+  /// Batch-OMP's state in solve(): the atoms' correlations with x and with the
+  /// residual, the coefficients of the selected (normalised) atoms, |x|² and the
+  /// estimate of |r|².
+  struct Batch {
+    Eigen::VectorXd corr0, corr, gamma, corr0_selected;
+    double x_norm2 = 0.0, residual2 = 0.0;
+  };
+  /// Least squares on the selected atoms after one was appended to the factor.
+  void update_least_squares(Batch& b) const;
+  /// Support, coefficients of the original columns, residual norm and status.
+  Eigen::VectorXd finish(const Eigen::VectorXd& x, const Batch& b, double target2);
+
   Options m_options;
   Eigen::MatrixXd m_normalised;  ///< \f$\hat D\f$ (zero columns stay zero)
   Eigen::VectorXd m_norms;       ///< \f$\|d_j\|_2\f$

@@ -27,6 +27,7 @@ std::string describe_option_type(const OptionSpec& spec) {
       return head.empty() ? join(spec.choices, "") : join(head, ", ") + " or " + spec.choices.back();
     }
     case OptionType::Flag: return "true or false (1 or 0)";
+    case OptionType::Text: return "a non-empty word";
   }
   return "";
 }
@@ -53,6 +54,9 @@ OptionValue parse_option_value(const OptionSpec& spec, const std::string& text, 
       if (text == "true" || text == "1") return true;
       if (text == "false" || text == "0") return false;
       break;
+    case OptionType::Text:
+      if (text.empty()) break;
+      return text;
   }
   refuse(spec, text, what);
 }
@@ -76,6 +80,7 @@ void check_option_value(const OptionSpec& spec, const OptionValue& value, const 
       break;
     }
     case OptionType::Flag: break;
+    case OptionType::Text: ok = !std::get<std::string>(value).empty(); break;
   }
   if (!ok) refuse(spec, option_text(value), what);
 }

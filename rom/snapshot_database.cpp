@@ -19,6 +19,7 @@
 
 #include <contactrom/core/atomic_file.hpp>
 #include <contactrom/core/format.hpp>
+#include <contactrom/rom/adaptive_training.hpp>
 #include <contactrom/rom/hdf5_io.hpp>
 #include <contactrom/rom/problem_record_io.hpp>
 
@@ -111,18 +112,22 @@ std::vector<int> SnapshotDatabase::successful_snapshots() const {
 namespace {
 
 /// The group /adaptive of an adaptive database (AdaptiveRecord): settings as
-/// attributes, one dataset per round column.
+/// attributes (numbers as 64-bit reals, integers as 32-bit integers, words as
+/// strings), one dataset per round column.
 void write_adaptive(hid_t f, hid_t dcpl, const AdaptiveRecord& a) {
   Handle group(H5Gcreate2(f, "adaptive", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose, "group /adaptive");
   const hid_t g = group.id();
-  write_scalar_attribute(g, "tolerance", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &a.tolerance);
-  write_scalar_attribute(g, "delta", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &a.delta);
-  for (const auto& [name, value] : {std::pair<const char*, const int*>{"max_snapshots", &a.max_snapshots},
-                                    {"candidates", &a.candidates}, {"batch", &a.batch}, {"seed", &a.seed},
-                                    {"initial_snapshots", &a.initial_snapshots}})
-    write_scalar_attribute(g, name, H5T_STD_I32LE, H5T_NATIVE_INT, value);
-  write_string_attribute(g, "indicator", a.indicator);
-  write_string_attribute(g, "method", a.method);
+  for (const auto& [key, value] : a.settings) {
+    if (const double* d = std::get_if<double>(&value)) {
+      write_scalar_attribute(g, key.c_str(), H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, d);
+    } else if (const long long* i = std::get_if<long long>(&value)) {
+      const int v = static_cast<int>(*i);  // the table's integer ranges fit 32 bits
+      write_scalar_attribute(g, key.c_str(), H5T_STD_I32LE, H5T_NATIVE_INT, &v);
+    } else {
+      write_string_attribute(g, key.c_str(), option_text(value));
+    }
+  }
+  write_scalar_attribute(g, "initial_snapshots", H5T_STD_I32LE, H5T_NATIVE_INT, &a.initial_snapshots);
   const hsize_t r = static_cast<hsize_t>(a.num_rounds());
   write_dataset(g, dcpl, "round_snapshots", H5T_STD_I32LE, H5T_NATIVE_INT, 1, r, 0, a.round_snapshots.data());
   write_dataset(g, dcpl, "round_added", H5T_STD_I32LE, H5T_NATIVE_INT, 1, r, 0, a.round_added.data());
@@ -139,15 +144,20 @@ AdaptiveRecord read_adaptive(hid_t f) {
   Handle group(H5Gopen2(f, "adaptive", H5P_DEFAULT), H5Gclose, "group /adaptive");
   const hid_t g = group.id();
   AdaptiveRecord a;
-  a.tolerance = hdf5::read_double_attribute(g, "tolerance");
-  a.delta = hdf5::read_double_attribute(g, "delta");
-  a.max_snapshots = hdf5::read_int_attribute(g, "max_snapshots");
-  a.candidates = hdf5::read_int_attribute(g, "candidates");
-  a.batch = hdf5::read_int_attribute(g, "batch");
-  a.seed = hdf5::read_int_attribute(g, "seed");
+  for (const OptionSpec& spec : adaptive_record_table().specs()) {
+    const char* key = spec.key.c_str();
+    OptionValue value;
+    if (spec.type == OptionType::Number) value = hdf5::read_double_attribute(g, key);
+    else if (spec.type == OptionType::Integer) value = static_cast<long long>(hdf5::read_int_attribute(g, key));
+    else value = read_string_attribute(g, key);
+    try {  // the declaration (a registered method is checked when the run continues)
+      check_option_value(spec, value, "attribute /adaptive/" + spec.key);
+    } catch (const InputError& e) {
+      throw hdf5::Refused(e.what());
+    }
+    a.settings[spec.key] = value;
+  }
   a.initial_snapshots = hdf5::read_int_attribute(g, "initial_snapshots");
-  a.indicator = read_string_attribute(g, "indicator");
-  a.method = read_string_attribute(g, "method");
   // Datasets by path from the file: the readers check their sizes against the file's.
   hsize_t rows = 0, cols = 0;
   const hsize_t r = hdf5::dataset_shape(f, "adaptive/round_snapshots")[0];
@@ -159,9 +169,9 @@ AdaptiveRecord read_adaptive(hid_t f) {
   if (a.round_added.size() != r || a.round_max_indicator.size() != r || a.round_mean_indicator.size() != r ||
       a.round_time_s.size() != r)
     throw hdf5::Refused("the datasets of /adaptive differ in length; expected one value per round");
-  if (!(a.tolerance > 0.0) || !std::isfinite(a.tolerance) || !(a.delta >= 0.0 && a.delta <= 1.0) || a.batch < 1 ||
-      a.candidates < 1 || a.max_snapshots < 1 || a.initial_snapshots < 1)
-    throw hdf5::Refused("an attribute of /adaptive holds a value no adaptive run writes");
+  if (a.initial_snapshots < 1)
+    throw hdf5::Refused("attribute /adaptive/initial_snapshots is " + std::to_string(a.initial_snapshots) +
+                        ", expected >= 1");
   for (hsize_t k = 0; k < r; ++k)
     if (a.round_snapshots[k] < 1 || a.round_added[k] < 0 || !(a.round_mean_indicator[k] >= 0.0) ||
         !(a.round_max_indicator[k] >= 0.0) || !(a.round_time_s[k] >= 0.0))

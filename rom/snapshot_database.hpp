@@ -22,6 +22,7 @@
 /// a truncated or corrupt file, a wrong `format_version` (version-1 files are
 /// refused: rebuild them with `contactrom offline`), and (check_database) a
 /// database built for another mesh or problem options.
+#include <map>
 #include <memory>
 #include <Eigen/Dense>
 #include <string>
@@ -29,6 +30,7 @@
 
 #include <contactrom/core/errors.hpp>
 #include <contactrom/fom/problem.hpp>
+#include <contactrom/rom/option_table.hpp>
 #include <contactrom/rom/problem_record.hpp>
 #include <contactrom/rom/snapshot_blocks.hpp>
 
@@ -44,14 +46,10 @@ inline constexpr int kDatabaseFormatVersion = 2;
 /// `round_added[k]` snapshots that follow them (0 in the last round of a run that
 /// stopped). Stored in the group `/adaptive` (docs/database_format.md).
 struct AdaptiveRecord {
-  double tolerance = 0.0;        ///< ε: the run stops when the largest indicator is below it
-  int max_snapshots = 0;         ///< N: the run stops when the database holds N snapshots
-  int candidates = 0;            ///< M: size of the candidate set (a Latin hypercube)
-  int batch = 0;                 ///< B: FOM snapshots added per round, at most
-  int seed = 0;                  ///< seed of the candidates' Latin hypercube
-  std::string indicator;         ///< "primal", "dual" or "max" (of the two estimates)
-  std::string method;            ///< online method whose answers are estimated
-  double delta = 0.0;            ///< POD tolerance of the reduced models
+  /// The settings of the latest run by key (ε, N, M, B, seed, indicator, method, δ:
+  /// the options of rom::adaptive_record_table(), which declares them), stored as
+  /// attributes of /adaptive; rom::adaptive_options_of() reads them back.
+  std::map<std::string, OptionValue> settings;
   int initial_snapshots = 0;     ///< the first snapshots: the initial training set
   std::vector<int> round_snapshots;        ///< snapshots of the model evaluated in each round
   std::vector<double> round_max_indicator; ///< largest indicator over the candidates (inf: a failed answer)

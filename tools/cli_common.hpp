@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <variant>
 
+#include <contactrom/core/parallel_for.hpp>
 #include <contactrom/fom/input_values.hpp>
 #include <contactrom/fom/kkt.hpp>
 #include <contactrom/fom/problem.hpp>
@@ -40,6 +41,13 @@ CLI::Option* add_integer(CLI::App* sub, const std::string& name, Int& target, co
                 },
                 help)
       ->type_name("INT");
+}
+
+/// Adds `--threads`: 0 (the default: all cores) or 1..kMaxThreads, as Python's
+/// `threads=`; `help` says what runs on them.
+template <typename Int>
+CLI::Option* add_threads(CLI::App* sub, Int& target, const std::string& help) {
+  return add_integer(sub, "--threads", target, help + " (default 0: all cores)", 0, kMaxThreads);
 }
 
 /// Adds flag `name` for the option `key` of an options table (rom/option_table.hpp):

@@ -159,7 +159,7 @@ CommandRegistrar reg("bench", [](CLI::App& app) {
   add_integer(sub, "--repeats", a->repeats, "timing passes over the queries (default 3)", 1, 1000);
   add_integer(sub, "--queries", a->queries, "number of validation parameters timed (default 30)", 1, 1000000);
   add_integer(sub, "--ipopt-queries", a->ipopt_queries, "queries timed for Ipopt (0: Ipopt not timed; default 5)", 0, 1000000);
-  add_integer(sub, "--threads", a->threads, "threads of the offline stage (default: all cores)", 1, 1024);
+  add_threads(sub, a->threads, "threads of the offline stage");
   sub->add_flag("--json", a->json, "print one JSON object");
   sub->footer(rom::describe_online_methods());
   sub->callback([a] { run_bench(*a); });

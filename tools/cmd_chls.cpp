@@ -208,7 +208,7 @@ CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
   sub->add_option("--option", args->options, "further convex-hull setting KEY=VALUE (repeatable; keys: " + keys + ")");
   sub->add_option("--out", args->out, "CSV file, one row per query")
       ->check(non_empty_path());
-  add_integer(sub, "--threads", args->threads, "threads for the FOM references (default: hardware concurrency)", 1, 1024);
+  add_threads(sub, args->threads, "threads for the FOM references");
   sub->add_flag("--time", args->time, "also time the online solve (rom::time_online)");
   add_integer(sub, "--repeats", args->repeats, "passes over the set for --time (default 3)", 1, 1000);
   sub->add_flag("--json", args->json, "print one JSON object");

@@ -198,7 +198,7 @@ CommandRegistrar reg("demo", [](CLI::App& app) {
       ->check(non_empty_path());
   add_integer(sub, "--train", args->train, "training size (default 30)", 2, 1000);
   add_number(sub, "--delta", args->delta, "POD energy tolerance (default 1e-8)", Interval::closed(0, 1));
-  add_integer(sub, "--threads", args->threads, "offline threads (default: hardware concurrency)", 1, 1024);
+  add_threads(sub, args->threads, "offline threads");
   sub->callback([args] { run_demo(*args); });
 });
 

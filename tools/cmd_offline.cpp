@@ -17,7 +17,9 @@
 // parameters over the ranks; rank 0 gathers them and writes the same database.
 #include <unistd.h>
 
+#include <algorithm>
 #include <functional>
+#include <map>
 #include <memory>
 #include <cstdio>
 #include <iomanip>
@@ -47,12 +49,10 @@ struct OfflineArgs {
   int train = 0, level = 0, threads = 0, refine = 0;
   std::string part;  // "k/K": only the k-th of K contiguous parts of the training set
   bool progress = false, json = false;
-  // --adaptive and its settings; unset ones (< 0, empty) take the defaults, or the
-  // appended database's values
+  // --adaptive and the settings given (rom::adaptive_option_table() keys, checked
+  // text); those not given take the defaults, or the appended database's values
   bool adaptive = false;
-  double tolerance = -1.0, delta = -1.0;
-  int max_snapshots = -1, candidates = -1, batch = -1, seed = -1;
-  std::string indicator, method;
+  std::map<std::string, std::string> adaptive_settings;
 };
 
 std::string param_text(const fom::Problem& problem, const fom::Param& mu) {
@@ -133,18 +133,41 @@ std::unique_ptr<FileLock> lock_for_append(const std::string& path, const Ranks& 
   });
 }
 
+/// The flag of the adaptive setting `key` (max_snapshots: --max-snapshots).
+std::string adaptive_flag(std::string key) {
+  std::replace(key.begin(), key.end(), '_', '-');
+  return "--" + key;
+}
+
+/// A flag per setting of rom::adaptive_option_table() (but `initial`: --train/--level
+/// give it), needing --adaptive: help, default and range or words are the
+/// declaration's; the text given is checked as it is read and kept by key.
+void add_adaptive_settings(CLI::App* sub, CLI::Option* adaptive, std::map<std::string, std::string>& given) {
+  const rom::OptionTable<rom::AdaptiveOptions>& table = rom::adaptive_option_table();
+  for (const rom::OptionSpec& spec : table.specs()) {
+    if (spec.key == "initial") continue;
+    const std::string flag = adaptive_flag(spec.key), key = spec.key;
+    const std::string given_default = key == "tolerance" ? "required for a new run" : "default " + spec.default_value;
+    const std::string help =
+        "adaptive: " + spec.help + " (" + rom::describe_option_type(spec) + "; " + given_default + ")";
+    sub->add_option_function<std::string>(
+           flag,
+           [&given, &table, key, flag](const std::string& text) {
+             rom::AdaptiveOptions checked;
+             table.read(checked, key, text, flag);
+             given[key] = text;
+           },
+           help)
+        ->type_name(spec.type == rom::OptionType::Number ? "NUMBER" : spec.type == rom::OptionType::Integer ? "INT" : "WORD")
+        ->needs(adaptive);
+  }
+}
+
 /// The adaptive settings: the appended database's (or the defaults), overridden by
 /// those given on the command line.
 rom::AdaptiveOptions adaptive_options(const OfflineArgs& a, const rom::SnapshotDatabase* existing) {
   rom::AdaptiveOptions o = existing ? rom::adaptive_options_of(*existing) : rom::AdaptiveOptions{};
-  if (a.tolerance >= 0) o.tolerance = a.tolerance;
-  if (a.max_snapshots >= 0) o.max_snapshots = a.max_snapshots;
-  if (a.candidates >= 0) o.candidates = a.candidates;
-  if (a.batch >= 0) o.batch = a.batch;
-  if (a.seed >= 0) o.seed = a.seed;
-  if (!a.indicator.empty()) o.indicator = a.indicator;
-  if (!a.method.empty()) o.method = a.method;
-  if (a.delta >= 0) o.model.delta = a.delta;
+  for (const auto& [key, text] : a.adaptive_settings) rom::adaptive_option_table().read(o, key, text, adaptive_flag(key));
   if (a.train || a.level) o.initial = a.train ? a.train : a.level;
   o.offline.threads = a.threads;
   return o;
@@ -166,12 +189,66 @@ void report_round(const fom::Problem& problem, const rom::AdaptiveRound& r) {
   std::cerr << line.str() << std::endl;
 }
 
+/// The adaptive database `--append` continues, checked against the run's problem.
+rom::SnapshotDatabase read_adaptive_database(const std::string& path, const fom::Problem& problem) {
+  rom::SnapshotDatabase db = rom::read_database(path);
+  rom::check_database_problem(db, problem, path);
+  if (db.training_kind != "adaptive")
+    throw InputError("cannot continue " + quoted(path, 200) + " adaptively: it holds the training set " +
+                     db.training_kind + " " + std::to_string(db.training_size) +
+                     "; expected a database written by offline --adaptive");
+  return db;
+}
+
+/// Under mpirun every rank runs the loop: each answers its share of the candidates,
+/// the indicators are gathered on every rank, the FOM batches are distributed over
+/// the ranks and every rank gets the whole batch.
+void distribute_over_ranks([[maybe_unused]] rom::AdaptiveOptions& options, [[maybe_unused]] const Ranks& ranks) {
+#ifdef CONTACTROM_HAVE_MPI
+  if (!rom::mpi::active() || ranks.size <= 1) return;
+  options.generate = rom::mpi::generate_snapshots_on_every_rank;
+  options.share_index = ranks.rank;
+  options.share_count = ranks.size;
+  options.gather_indicators = rom::mpi::max_over_ranks;
+#endif
+}
+
+/// The run's result on stdout: one JSON object, or three lines.
+void print_adaptive_summary(const OfflineArgs& a, const fom::Problem& problem, const rom::SnapshotDatabase& db,
+                            int before, const Ranks& ranks) {
+  const rom::AdaptiveRecord& rec = db.adaptive;
+  const rom::AdaptiveOptions settings = rom::adaptive_options_of(db);
+  const double worst = rec.round_max_indicator.back();
+  const bool converged = worst < settings.tolerance, appending = !a.append.empty();
+  const std::string& out = appending ? a.append : a.out;
+  if (a.json) {
+    nlohmann::json j;
+    j["problem"] = problem.name();
+    j["adaptive"] = true;
+    j["snapshots"] = db.num_snapshots() - before;
+    j["total_snapshots"] = db.num_snapshots();
+    j["rounds"] = rec.num_rounds();
+    j["max_indicator"] = worst;
+    j["mean_indicator"] = rec.round_mean_indicator.back();
+    j["tolerance"] = settings.tolerance;
+    j["converged"] = converged;
+    j["indicator"] = settings.indicator;
+    j["threads"] = db.threads;
+    j["ranks"] = ranks.size;
+    j["wall_time_s"] = db.wall_time_s;
+    j["out"] = out;
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::cout << std::setprecision(3) << "offline " << problem.name() << " adaptive: " << db.num_snapshots()
+            << " snapshots in " << rec.num_rounds() << " rounds, max indicator (" << settings.indicator << ") " << worst
+            << (converged ? " < " : " >= ") << settings.tolerance << (converged ? "" : " (not reached)") << "\n"
+            << "wall time " << db.wall_time_s << " s\n"
+            << (appending ? "appended to " : "database written to ") << out << "\n";
+}
+
 void run_adaptive(const OfflineArgs& a) {
 #ifdef CONTACTROM_HAVE_MPI
-  // Under mpirun every rank runs the loop: each answers its share of the candidates,
-  // the indicators are gathered on every rank, the FOM batches are distributed over
-  // the ranks and every rank gets the whole batch.
-  const bool distributed = rom::mpi::active() && rom::mpi::world_size() > 1;
   const Ranks ranks{rom::mpi::world_rank(), rom::mpi::world_size()};
 #else
   const Ranks ranks;
@@ -182,25 +259,11 @@ void run_adaptive(const OfflineArgs& a) {
   const std::string& out = appending ? a.append : a.out;
   const std::unique_ptr<FileLock> lock = lock_for_append(a.append, ranks);
   rom::SnapshotDatabase existing;
-  if (appending) {
-    existing = rom::read_database(a.append);
-    rom::check_database_problem(existing, *problem, a.append);
-    if (existing.training_kind != "adaptive")
-      throw InputError("cannot continue " + quoted(a.append, 200) + " adaptively: it holds the training set " +
-                       existing.training_kind + " " + std::to_string(existing.training_size) +
-                       "; expected a database written by offline --adaptive");
-  }
-  if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
+  if (appending) existing = read_adaptive_database(a.append, *problem);
   rom::AdaptiveOptions options = adaptive_options(a, appending ? &existing : nullptr);
-  if (!appending && a.tolerance < 0) throw InputError("offline --adaptive needs --tolerance EPS (e.g. 0.05)");
-#ifdef CONTACTROM_HAVE_MPI
-  if (distributed) {
-    options.generate = rom::mpi::generate_snapshots_on_every_rank;
-    options.share_index = ranks.rank;
-    options.share_count = ranks.size;
-    options.gather_indicators = rom::mpi::max_over_ranks;
-  }
-#endif
+  if (!appending && !a.adaptive_settings.count("tolerance"))
+    throw InputError("offline --adaptive needs --tolerance EPS (e.g. 0.05)");
+  distribute_over_ranks(options, ranks);
   options.on_round = [&](const rom::AdaptiveRound& r, const rom::SnapshotDatabase& db) {
     // atomically, on rank 0: the file always holds whole rounds
     write_on_root(out, [&]() -> const rom::SnapshotDatabase& { return db; }, ranks);
@@ -209,34 +272,7 @@ void run_adaptive(const OfflineArgs& a) {
   const rom::AdaptiveTrainer trainer(*problem, options);
   const int before = appending ? existing.num_snapshots() : 0;
   const rom::SnapshotDatabase db = appending ? trainer.resume(std::move(existing), a.append) : trainer.run();
-  if (!ranks.root()) return;
-  const rom::AdaptiveRecord& rec = db.adaptive;
-  const double worst = rec.round_max_indicator.back();
-  const bool converged = worst < rec.tolerance;
-  if (a.json) {
-    nlohmann::json j;
-    j["problem"] = problem->name();
-    j["adaptive"] = true;
-    j["snapshots"] = db.num_snapshots() - before;
-    j["total_snapshots"] = db.num_snapshots();
-    j["rounds"] = rec.num_rounds();
-    j["max_indicator"] = worst;
-    j["mean_indicator"] = rec.round_mean_indicator.back();
-    j["tolerance"] = rec.tolerance;
-    j["converged"] = converged;
-    j["indicator"] = rec.indicator;
-    j["threads"] = db.threads;
-    j["ranks"] = ranks.size;
-    j["wall_time_s"] = db.wall_time_s;
-    j["out"] = out;
-    std::cout << j.dump() << std::endl;
-    return;
-  }
-  std::cout << std::setprecision(3) << "offline " << problem->name() << " adaptive: " << db.num_snapshots()
-            << " snapshots in " << rec.num_rounds() << " rounds, max indicator (" << rec.indicator << ") " << worst
-            << (converged ? " < " : " >= ") << rec.tolerance << (converged ? "" : " (not reached)") << "\n"
-            << "wall time " << db.wall_time_s << " s\n"
-            << (appending ? "appended to " : "database written to ") << out << "\n";
+  if (ranks.root()) print_adaptive_summary(a, *problem, db, before, ranks);
 }
 
 /// What a run computes: the training set (or its part), less the parameters the
@@ -265,7 +301,6 @@ OfflinePlan plan_offline(const OfflineArgs& a, const fom::Problem& problem) {
   const bool size_from_db = plan.appending && !a.train && !a.level && sampling.selector() != "list";
   plan.n = size_from_db ? plan.existing.training_size
                         : fom::resolve_training_size(sampling, problem.name(), a.train, a.level, false);
-  if (a.threads < 0) throw InputError("--threads " + std::to_string(a.threads) + " invalid; expected >= 1");
   plan.training = fom::training_set(problem, plan.n);
   plan.params = a.part.empty() ? plan.training : training_part(plan.training, a.part);
   if (plan.appending) {
@@ -406,30 +441,14 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
                   "hold yet and rewrite it with all its snapshots, in training order")
       ->check(non_empty_path())
       ->excludes(out);
-  add_integer(sub, "--threads", args->threads, "worker threads (default: hardware concurrency)", 1, 1024);
+  add_threads(sub, args->threads, "worker threads");
   sub->add_option("--part", args->part,
                   "k/K: only the k-th of K contiguous parts of the training set (join the parts with merge)");
   sub->add_flag("--progress", args->progress, "draw the progress bar even when stderr is not a terminal");
   auto* adaptive = sub->add_flag("--adaptive", args->adaptive,
                                  "train where the reduced model's error estimate is largest (docs/rom.md, "
                                  "\"Adaptive training\"); --train/--level give the initial set (default: the coarsest)");
-  const auto adaptive_only = [&](CLI::Option* o) { o->needs(adaptive); };
-  adaptive_only(add_number(sub, "--tolerance", args->tolerance,
-                           "adaptive: stop when the largest indicator over the candidates is below EPS (> 0)",
-                           Interval::greater_than(0)));
-  adaptive_only(add_integer(sub, "--max-snapshots", args->max_snapshots,
-                            "adaptive: stop at N snapshots, the initial ones included (default 200)", 1, 10000000));
-  adaptive_only(add_integer(sub, "--candidates", args->candidates,
-                            "adaptive: M candidate parameters, a Latin hypercube (default 1000, at most 100000)", 1, 100000));
-  adaptive_only(add_integer(sub, "--batch", args->batch, "adaptive: FOM snapshots added per round, at most (default 4)",
-                            1, 100000));
-  adaptive_only(add_integer(sub, "--seed", args->seed, "adaptive: seed of the candidates (default 1)", 0, 2147483647));
-  adaptive_only(sub->add_option("--indicator", args->indicator,
-                                "adaptive: estimate that ranks the candidates: primal | dual | max (default max)")
-                    ->check(CLI::IsMember({"primal", "dual", "max"})));
-  adaptive_only(sub->add_option("--method", args->method, "adaptive: online method estimated (default greedy)"));
-  adaptive_only(add_number(sub, "--delta", args->delta, "adaptive: POD tolerance of the reduced models (default 1e-8)",
-                           Interval::closed(0, 1)));
+  add_adaptive_settings(sub, adaptive, args->adaptive_settings);
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_offline(*args); });
 });

@@ -180,7 +180,7 @@ CommandRegistrar reg("online", [](CLI::App& app) {
       ->check(non_empty_path());
   sub->add_option("--out", args->out, "CSV file (validation) or folder for VTU/CSV fields (--param)")
       ->check(non_empty_path());
-  add_integer(sub, "--threads", args->threads, "threads for the FOM references (default: hardware concurrency)", 1, 1024);
+  add_threads(sub, args->threads, "threads for the FOM references");
   sub->add_flag("--kkt", args->kkt, "also compute the FOM KKT residuals of every ROM solution");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_online(*args); });

@@ -94,7 +94,7 @@ CommandRegistrar reg("reduce", [](CLI::App& app) {
                   "POD algorithm: auto (svd up to 2^24 snapshot entries, else snapshots), svd (BDCSVD in memory) or "
                   "snapshots (method of snapshots with a Rayleigh-Ritz step, read by blocks)")
       ->check(CLI::IsMember({"auto", "svd", "snapshots"}));
-  add_integer(sub, "--threads", args->threads, "worker threads of the POD (default: hardware concurrency)", 1, 1024);
+  add_threads(sub, args->threads, "worker threads of the POD");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_reduce(*args); });
 });

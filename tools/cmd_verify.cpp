@@ -253,7 +253,7 @@ CommandRegistrar reg("verify", [](CLI::App& app) {
   sub->add_option("--init", args->init, "starting point of the methods that take one (as --option init): " +
                                              shared_setting_help("init"));
   sub->add_option("--reference", args->reference, "reference solver: ipopt (default) | fom (custom active set)");
-  add_integer(sub, "--threads", args->threads, "threads for the reference solves (default: hardware concurrency)", 1, 1024);
+  add_threads(sub, args->threads, "threads for the reference solves");
   add_integer(sub, "--limit", args->limit, "use N evenly spaced validation parameters (default: all)", 1, 1000000);
   sub->add_flag("--bench", args->bench, "also time each method and the FOM, in interleaved rounds (rom::time_interleaved)");
   add_integer(sub, "--repeats", args->repeats, "timing passes over the parameters with --bench (default 3)", 1, 1000);

@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/run_command.hpp"
@@ -83,6 +84,15 @@ const std::string& cli_doc() {
   return doc;
 }
 
+/// The `--help` output of `command` and the section `heading` of docs/cli.md (both must exist).
+std::pair<std::string, std::string> help_and_section(const std::string& command, const std::string& heading) {
+  const auto r = run_command(exe + " " + command + " --help");
+  BOOST_REQUIRE_EQUAL(r.exit_code, 0);
+  std::string section = doc_section(cli_doc(), heading);
+  BOOST_REQUIRE_MESSAGE(!section.empty(), "docs/cli.md has no section '" + heading + "'");
+  return {r.out, section};
+}
+
 }  // namespace
 
 BOOST_AUTO_TEST_CASE(every_subcommand_and_option_of_the_help_is_in_the_reference) {
@@ -100,13 +110,10 @@ BOOST_AUTO_TEST_CASE(every_subcommand_and_option_of_the_help_is_in_the_reference
 }
 
 BOOST_AUTO_TEST_CASE(every_online_method_and_setting_of_the_help_is_in_the_reference) {
-  const auto r = run_command(exe + " online --help");
-  BOOST_REQUIRE_EQUAL(r.exit_code, 0);
-  const std::string section = doc_section(cli_doc(), "## Online methods and their settings");
-  BOOST_REQUIRE_MESSAGE(!section.empty(), "docs/cli.md has no section '## Online methods and their settings'");
+  const auto [help, section] = help_and_section("online", "## Online methods and their settings");
   const std::regex method(R"(^  ([a-z][a-z-]*): )"), key(R"(^    ([a-z_]+): )");
   int methods = 0, keys = 0;
-  for (const std::string& line : section_lines(r.out, "Online methods and their options (--option KEY=VALUE):")) {
+  for (const std::string& line : section_lines(help, "Online methods and their options (--option KEY=VALUE):")) {
     std::smatch m;
     if (std::regex_search(line, m, method)) {
       ++methods;
@@ -164,15 +171,13 @@ BOOST_AUTO_TEST_CASE(every_documented_setting_default_is_the_programs) {
   // The default of every setting in docs/cli.md is the one --help prints (read from
   // the options structs): looked up in the method's own table, then in the shared
   // tables above the methods, then in the method its text refers to ("as for `cpg`").
-  const auto r = run_command(exe + " online --help");
-  BOOST_REQUIRE_EQUAL(r.exit_code, 0);
-  const std::string section = doc_section(cli_doc(), "## Online methods and their settings");
+  const auto [help, section] = help_and_section("online", "## Online methods and their settings");
   const std::string shared = section.substr(0, section.find("\n### "));
   const std::regex method(R"(^  ([a-z][a-z-]*): )"), key(R"(^    ([a-z_]+): .*; default (.*)\]$)"),
       refers(R"((?:as for|settings of)\s+`([a-z-]+)`)");
   std::string name, own, referred;
   int checked = 0;
-  for (const std::string& line : section_lines(r.out, "Online methods and their options (--option KEY=VALUE):")) {
+  for (const std::string& line : section_lines(help, "Online methods and their options (--option KEY=VALUE):")) {
     std::smatch m;
     if (std::regex_search(line, m, method)) {
       name = m[1];
@@ -191,4 +196,28 @@ BOOST_AUTO_TEST_CASE(every_documented_setting_default_is_the_programs) {
     }
   }
   BOOST_TEST(checked >= 60, checked << " defaults checked");
+}
+
+BOOST_AUTO_TEST_CASE(every_documented_adaptive_default_is_the_programs) {
+  // The settings of `offline --adaptive` (one declaration: rom::adaptive_option_table())
+  // print their defaults in `offline --help`; the table of docs/cli.md states the same.
+  const auto [help, section] = help_and_section("offline", "### `offline --adaptive`");
+  // CLI11 prints an option's name, then (on the same line or the next) its help.
+  const std::regex name(R"(^\s+(--[a-z][a-z-]*)\s)"), setting(R"(adaptive: .*; (default ([^)]*)|required for a new run)\)\s*$)");
+  int checked = 0;
+  std::string flag;
+  for (const std::string& line : section_lines(help, "Options:")) {
+    std::smatch m;
+    if (std::regex_search(line, m, name)) flag = m[1];
+    if (!std::regex_search(line, m, setting)) continue;
+    const std::string doc = documented_default(section, flag);
+    BOOST_TEST(!doc.empty(), "docs/cli.md: no row of " << flag << " in the table of offline --adaptive");
+    ++checked;
+    if (!m[2].matched) {
+      BOOST_TEST(doc.rfind("required", 0) == 0, "docs/cli.md: " << flag << " default '" << doc << "', the program requires it");
+      continue;
+    }
+    BOOST_TEST(states(doc, m[2]), "docs/cli.md: " << flag << " default '" << doc << "', the program's is " << m[2]);
+  }
+  BOOST_TEST(checked == 8, checked << " adaptive settings found in offline --help");
 }

@@ -3,7 +3,9 @@
 # installed CLI (which must find its data relative to the prefix), then configures,
 # builds and runs examples/cpp against the installed package, then builds
 # tests/install/consumer (every installed header as <contactrom/...>, no HDF5).
-# cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DWORK_DIR=... -DGENERATOR=... [-DSANITIZE=ON] -P run_install_test.cmake
+# cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DWORK_DIR=... -DGENERATOR=... -DHEADERS=contactrom/core/a.hpp,...
+#       [-DSANITIZE=ON] -P run_install_test.cmake
+# HEADERS lists the installed headers (tests/CMakeLists.txt takes them from the libraries).
 #
 # SANITIZE=ON (a CONTACTROM_SANITIZE build): GCC writes the source paths of
 # AddressSanitizer's and UBSan's diagnostics into the objects without applying
@@ -84,7 +86,7 @@ if(NOT rc EQUAL 1)
   message(FATAL_ERROR "installed headers include <hdf5.h>:\n${hits}")
 endif()
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/install/consumer -B ${WORK_DIR}/consumer -G ${GENERATOR}
-    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} ${example_flags})
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} -DCONTACTROM_HEADERS=${HEADERS} ${example_flags})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/consumer -j 2)
 run(${WORK_DIR}/consumer/all_headers)
 expect("${out}" "contactrom [0-9]+\\.[0-9]+\\.[0-9]+, [0-9]+ headers" "the program including every installed header")

@@ -48,3 +48,27 @@ def test_bad_settings_raise_the_cli_message():
         contactrom.offline_adaptive(problem, tolerance=0.1, indicator="both")
     assert "batch" in cli_error("offline", "--problem", "hertz", "--adaptive", "--tolerance", "0.1", "--batch", "0",
                                 "--out", "x.h5")
+
+
+def test_settings_and_defaults_are_the_clis():
+    # One declaration: Python's keywords and defaults are the flags and defaults of
+    # `offline --help`, and a run records every setting with its value.
+    import re
+    defaults = contactrom.adaptive_options()
+    assert defaults["tolerance"] == 0.05 and defaults["initial"] == 0
+    help_text = run_cli("offline", "--help").stdout
+    # CLI11 prints each option's name, then its help on the next line.
+    flags = dict(re.findall(r"^\s+--([a-z-]+) .*\n\s+adaptive: .*; default ([^)\n]*)\)$", help_text, re.MULTILINE))
+    assert len(flags) == 7, flags
+    for flag, text in flags.items():
+        value = defaults[flag.replace("-", "_")]
+        assert (float(text) == value) if isinstance(value, (int, float)) else (text == value), (flag, text, value)
+    db = contactrom.offline_adaptive(contactrom.problem("hertz"), tolerance=0.5, candidates=20, threads=1)
+    expected = dict(defaults, tolerance=0.5, candidates=20)
+    for key in defaults:
+        if key != "initial":  # recorded as the database's training size
+            assert db.adaptive[key] == expected[key] and type(db.adaptive[key]) is type(expected[key]), key
+    with pytest.raises(ValueError, match="unknown; expected one of: tolerance, max_snapshots"):
+        contactrom.offline_adaptive(contactrom.problem("hertz"), tolerance=0.5, max_snapshot=3)
+    with pytest.raises(ValueError, match="needs tolerance"):
+        contactrom.offline_adaptive(contactrom.problem("hertz"))

@@ -3,7 +3,7 @@ import contactrom
 import numpy as np
 import pytest
 
-from conftest import cli_error
+from conftest import cli_error, run_cli
 
 
 def message_of(excinfo):
@@ -128,3 +128,25 @@ def test_paths_may_be_path_like(tmp_path):
     rom.save(tmp_path / "rom.h5")
     assert contactrom.ReducedModel.load(tmp_path / "rom.h5").problem.name == "rope"
     assert contactrom.Problem.from_file(source / "problems" / "hertz.toml").name == "hertz"
+
+
+def test_threads_take_the_clis_values(tmp_path):
+    # 0 means all cores in both; values outside [0, 1024] are refused by both, each
+    # message naming the value and the accepted range.
+    hertz = contactrom.problem("hertz")
+    db = contactrom.offline(hertz, 2, threads=0)
+    cli_db = tmp_path / "hertz2.h5"
+    run_cli("offline", "--problem", "hertz", "--train", "2", "--threads", "0", "--out", str(cli_db))
+    assert np.array_equal(db.dual, contactrom.load_database(cli_db).dual)
+    fom = contactrom.FullOrderSolver(hertz)
+    for bad in (-1, 1025):
+        expected = cli_error("offline", "--problem", "hertz", "--train", "2", "--threads", str(bad),
+                             "--out", str(tmp_path / "bad.h5"))
+        assert f"'{bad}'" in expected and "[0, 1024]" in expected
+        for call in (lambda: contactrom.offline(hertz, 2, threads=bad),
+                     lambda: fom.solve_all([0.1], threads=bad),
+                     lambda: contactrom.offline_adaptive(hertz, tolerance=0.1, threads=bad)):
+            with pytest.raises(ValueError) as e:
+                call()
+            assert message_of(e) == f"threads = {bad} invalid; expected an integer in [0, 1024] (0: all cores)"
+    assert not (tmp_path / "bad.h5").exists()

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include <hdf5.h>
+
 #include "common/run_command.hpp"
 #include <contactrom/fom/active_set_solver.hpp>
 #include <contactrom/fom/problem.hpp>
@@ -122,8 +124,9 @@ BOOST_AUTO_TEST_CASE(rounds_are_recorded_and_the_indicator_falls) {
   rom::write_database(path, db);
   const rom::SnapshotDatabase back = rom::read_database(path);
   check_same_database(db, back);
-  BOOST_TEST(back.adaptive.tolerance == o.tolerance);
-  BOOST_TEST(back.adaptive.indicator == "max");
+  BOOST_TEST(rom::adaptive_options_of(back).tolerance == o.tolerance);
+  BOOST_TEST(rom::adaptive_options_of(back).indicator == "max");
+  BOOST_TEST((back.adaptive.settings == rom::adaptive_record_table().to_values(o)));
   rom::check_database(back, *problem, path);  // an adaptive database is a valid database
   BOOST_CHECK_THROW(rom::database_validation_set(back, *problem), InputError);
 }
@@ -221,4 +224,104 @@ BOOST_AUTO_TEST_CASE(bad_options_are_refused) {
   refused([](auto& o) { o.indicator = "both"; }, "indicator");
   refused([](auto& o) { o.method = "nope"; }, "nope");
   refused([](auto& o) { o.model.delta = 2.0; }, "delta");
+}
+
+namespace {
+
+/// The group /adaptive of a database file, open for writing attributes with the
+/// HDF5 API alone.
+class AdaptiveGroup {
+ public:
+  explicit AdaptiveGroup(const std::string& path)
+      : m_file(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT)), m_group(H5Gopen2(m_file, "adaptive", H5P_DEFAULT)),
+        m_scalar(H5Screate(H5S_SCALAR)) {
+    BOOST_REQUIRE(m_file >= 0 && m_group >= 0);
+  }
+  ~AdaptiveGroup() {
+    H5Sclose(m_scalar);
+    H5Gclose(m_group);
+    H5Fclose(m_file);
+  }
+  /// (Re)writes the scalar attribute `name`.
+  void put(const char* name, hid_t file_type, hid_t memory_type, const void* value) {
+    if (H5Aexists(m_group, name) > 0) H5Adelete(m_group, name);
+    const hid_t attr = H5Acreate2(m_group, name, file_type, m_scalar, H5P_DEFAULT, H5P_DEFAULT);
+    BOOST_REQUIRE(attr >= 0);
+    BOOST_REQUIRE(H5Awrite(attr, memory_type, value) >= 0);
+    H5Aclose(attr);
+  }
+
+ private:
+  hid_t m_file, m_group, m_scalar;
+};
+
+/// Replaces the settings of the group /adaptive of `path` by attributes in the
+/// layout adaptive databases have always had: ε and δ 64-bit reals, N, M, B and the
+/// seed 32-bit integers, the indicator and the method fixed-length strings.
+void rewrite_settings_by_hand(const std::string& path) {
+  AdaptiveGroup group(path);
+  const double tolerance = 0.0375, delta = 1e-6;
+  group.put("tolerance", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &tolerance);
+  group.put("delta", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &delta);
+  const int max_snapshots = 11, candidates = 40, batch = 3, seed = 5;
+  group.put("max_snapshots", H5T_STD_I32LE, H5T_NATIVE_INT, &max_snapshots);
+  group.put("candidates", H5T_STD_I32LE, H5T_NATIVE_INT, &candidates);
+  group.put("batch", H5T_STD_I32LE, H5T_NATIVE_INT, &batch);
+  group.put("seed", H5T_STD_I32LE, H5T_NATIVE_INT, &seed);
+  for (const auto& [name, text] : {std::pair<const char*, std::string>{"indicator", "dual"}, {"method", "greedy"}}) {
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, text.size());
+    H5Tset_strpad(type, H5T_STR_NULLPAD);
+    group.put(name, type, type, text.data());
+    H5Tclose(type);
+  }
+}
+
+}  // namespace
+
+BOOST_AUTO_TEST_CASE(a_database_whose_settings_were_written_by_hand_in_the_layout_loads) {
+  // The settings are read by their declarations (adaptive_record_table()): a file in
+  // the layout of /adaptive (docs/database_format.md) loads, with each value.
+  const auto problem = fom::make_problem("hertz");
+  rom::AdaptiveOptions o = small_options();
+  o.max_snapshots = 4;
+  const std::string path = test::temp_dir() + "/by_hand.h5";
+  rom::write_database(path, rom::AdaptiveTrainer(*problem, o).run());
+  rewrite_settings_by_hand(path);
+  const rom::SnapshotDatabase db = rom::read_database(path);
+  const rom::AdaptiveOptions back = rom::adaptive_options_of(db);
+  BOOST_TEST(back.tolerance == 0.0375);
+  BOOST_TEST(back.model.delta == 1e-6);
+  BOOST_TEST(back.max_snapshots == 11);
+  BOOST_TEST(back.candidates == 40);
+  BOOST_TEST(back.batch == 3);
+  BOOST_TEST(back.seed == 5);
+  BOOST_TEST(back.indicator == "dual");
+  BOOST_TEST(back.method == "greedy");
+  BOOST_TEST(back.initial == db.training_size);
+  BOOST_TEST(db.adaptive.settings.size() == rom::adaptive_record_table().specs().size());
+  // Written again, the file holds the same attributes with the same values.
+  rom::write_database(path + ".again.h5", db);
+  BOOST_TEST((rom::read_database(path + ".again.h5").adaptive.settings == db.adaptive.settings));
+}
+
+BOOST_AUTO_TEST_CASE(a_recorded_setting_outside_its_declaration_is_refused_on_reading) {
+  const auto problem = fom::make_problem("hertz");
+  rom::AdaptiveOptions o = small_options();
+  o.max_snapshots = 2;  // the initial set only: one round
+  const std::string path = test::temp_dir() + "/bad_setting.h5";
+  rom::write_database(path, rom::AdaptiveTrainer(*problem, o).run());
+  {
+    const int zero = 0;
+    AdaptiveGroup(path).put("batch", H5T_STD_I32LE, H5T_NATIVE_INT, &zero);
+  }
+  try {
+    rom::read_database(path);
+    BOOST_ERROR("a batch of 0 was read");
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    BOOST_TEST(msg.find("attribute /adaptive/batch = '0' invalid; expected an integer in [1, 100000]") !=
+                   std::string::npos,
+               msg);
+  }
 }
