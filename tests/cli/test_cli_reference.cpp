@@ -5,6 +5,7 @@
 #define BOOST_TEST_MODULE cli_reference
 #include <boost/test/unit_test.hpp>
 
+#include <filesystem>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -220,4 +221,38 @@ BOOST_AUTO_TEST_CASE(every_documented_adaptive_default_is_the_programs) {
     BOOST_TEST(states(doc, m[2]), "docs/cli.md: " << flag << " default '" << doc << "', the program's is " << m[2]);
   }
   BOOST_TEST(checked == 8, checked << " adaptive settings found in offline --help");
+}
+
+// Test sources are listed by name in tests/CMakeLists.txt (no globs): a file that is
+// not listed would never run. Every tests/<folder>/test_*.cpp must appear there as
+// <folder>/<stem>, every tests/python/test_*.py as its stem.
+BOOST_AUTO_TEST_CASE(every_test_source_is_listed_in_the_test_build) {
+  namespace fs = std::filesystem;
+  const fs::path tests = fs::path(CONTACTROM_SOURCE_DIR) / "tests";
+  const std::string listing = slurp((tests / "CMakeLists.txt").string());
+  BOOST_REQUIRE(!listing.empty());
+  const std::regex word_end("[A-Za-z0-9_]");
+  const auto listed = [&](const std::string& name) {
+    for (size_t at = listing.find(name); at != std::string::npos; at = listing.find(name, at + 1)) {
+      const size_t end = at + name.size();
+      const bool starts = at == 0 || !std::regex_match(std::string(1, listing[at - 1]), word_end);
+      const bool ends = end == listing.size() || !std::regex_match(std::string(1, listing[end]), word_end);
+      if (starts && ends) return true;
+    }
+    return false;
+  };
+  int files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(tests)) {
+    const fs::path& p = entry.path();
+    const std::string stem = p.stem().string(), folder = p.parent_path().filename().string();
+    if (!entry.is_regular_file() || stem.rfind("test_", 0) != 0) continue;
+    if (p.extension() == ".cpp" && p.parent_path().parent_path() == tests) {
+      ++files;
+      BOOST_TEST(listed(folder + "/" + stem), "tests/" << folder << "/" << stem << ".cpp is not in tests/CMakeLists.txt");
+    } else if (p.extension() == ".py" && folder == "python") {
+      ++files;
+      BOOST_TEST(listed(stem), "tests/python/" << stem << ".py is not in tests/CMakeLists.txt");
+    }
+  }
+  BOOST_TEST(files > 50);  // the walk found the test sources at all
 }
