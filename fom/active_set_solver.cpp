@@ -196,7 +196,8 @@ PairingFixedPointResult solve_pairing_loop(const Problem& problem, const Condens
                                            const ActiveSetOptions& options,
                                            const PairingFixedPointOptions& fixed_point, const Eigen::VectorXd& u0_s,
                                            const Eigen::VectorXd& x_s, Pairing pairing,
-                                           const Eigen::VectorXd& lambda_start, int& iterations) {
+                                           const Eigen::VectorXd& lambda_start, int& iterations,
+                                           const SearchMemory* memory) {
   const ContactModel& contact = problem.contact();
   WorkingSetQp qp(problem, cond, options, u0_s, lambda_start);
   return solve_pairing_fixed_point(
@@ -207,7 +208,8 @@ PairingFixedPointResult solve_pairing_loop(const Problem& problem, const Condens
       [&](const Pairing& p, const ConstraintMatrix& c, const PairedSolution& at, const Pairing& next, Pairing& out) {
         return newton_pairing(contact, cond.s, p, c, at.lambda, at.surface_displacement, next,
                               options.newton_max_active, out);
-      });
+      },
+      memory ? *memory : SearchMemory());
 }
 
 Eigen::MatrixXd unconstrained_load_responses(const Problem& problem, const Param& mu) {

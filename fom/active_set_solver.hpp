@@ -165,11 +165,14 @@ PairingFixedPointOptions pairing_options(const ActiveSetOptions& options);
 /// which starts it from a reduced answer.
 /// \param u0_s unconstrained displacement on the surface dofs
 /// \param iterations incremented by the QPs' active-set iterations
+/// \param memory memory of a search made near x_s (the one that found `pairing`), or
+///   nullptr: the loop's searches start from it (same pairings, less searching)
 PairingFixedPointResult solve_pairing_loop(const Problem& problem, const Condensation& cond,
                                            const ActiveSetOptions& options,
                                            const PairingFixedPointOptions& fixed_point, const Eigen::VectorXd& u0_s,
                                            const Eigen::VectorXd& x_s, Pairing pairing,
-                                           const Eigen::VectorXd& lambda_start, int& iterations);
+                                           const Eigen::VectorXd& lambda_start, int& iterations,
+                                           const SearchMemory* memory = nullptr);
 
 /// \brief Custom active-set FOM solver; see the file comment.
 class ActiveSetSolver final : public FullOrderSolver {

@@ -17,7 +17,11 @@ double pairing_change(const ConstraintMatrix& c, const Eigen::VectorXd& g, const
   const Eigen::VectorXd v_next = (c_next * u_s - g_next).cwiseQuotient(weights);
   for (Eigen::Index s = 0; s < v.size(); ++s) {
     if (penetration) change = std::max(change, v_next(s) / u_scale);  // penetration under the new pairing
-    if (lambda(s) > 0.0 || v(s) > -tolerance * u_scale) change = std::max(change, std::abs(v_next(s) - v(s)) / u_scale);
+    // A row without a pair (empty row, v = 0) is no contact: only its penetration
+    // under the new pairing counts, not the gap at which the new pairing puts it.
+    const bool paired = static_cast<bool>(ConstraintMatrix::InnerIterator(c, s));
+    if (paired && (lambda(s) > 0.0 || v(s) > -tolerance * u_scale))
+      change = std::max(change, std::abs(v_next(s) - v(s)) / u_scale);
   }
   return change;
 }

@@ -33,8 +33,9 @@
 /// pairing, U the problem's displacement scale,
 /// \f[ r = \max\Big( \frac{\|C'^T\lambda - C^T\lambda\|}{\|C^T\lambda\|},\;
 ///     \max_{s \in A} \frac{|v'_s - v_s|}{U},\; \max_s \frac{\max(v'_s, 0)}{U} \Big), \f]
-/// A the rows that carry pressure (\f$ \lambda_s > 0 \f$) or are within
-/// tolerance·U of contact: the contact forces, the gaps that matter and the
+/// A the paired rows that carry pressure (\f$ \lambda_s > 0 \f$) or are within
+/// tolerance·U of contact (a row without a pair is no contact, whatever gap the new
+/// pairing gives it): the contact forces, the gaps that matter and the
 /// penetration must each be unchanged to `tolerance` (relative).
 ///
 /// The penetration term asks more than an unchanged pairing: that the solution be
@@ -122,10 +123,14 @@ double pairing_change(const ConstraintMatrix& c, const Eigen::VectorXd& g, const
 ///   const PairedSolution& solution, const Pairing& next, Pairing& out)`: the pairing
 ///   of a Newton step from the solution at `pairing` whose re-pairing is `next`
 ///   (false: none this time); nullptr: Anderson steps only.
+/// \param memory the searches' memory to start from (a caller that searched near x
+///   already: the first re-pairing is then settled from it, not searched in full);
+///   default empty. The pairings found are the same either way.
 template <class SolveAtPairing, class NewtonStep = std::nullptr_t>
 PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, double u_scale, Eigen::VectorXd x,
                                                   Pairing pairing, const PairingFixedPointOptions& options,
-                                                  SolveAtPairing&& solve_at, NewtonStep&& newton = nullptr) {
+                                                  SolveAtPairing&& solve_at, NewtonStep&& newton = nullptr,
+                                                  SearchMemory memory = {}) {
   PairingFixedPointResult out;
   AndersonMixer mixer(options.anderson_depth, options.anderson_restart);
   ConstraintMatrix c_next;
@@ -134,7 +139,6 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
   // The iterates move less and less: the memory settles most rows of the two
   // searches per iteration without searching the whole master chain, with the
   // full search's result.
-  SearchMemory memory;
   bool assembled = false;  // out.c, out.g already hold the operator of `pairing`
   bool newton_on = options.newton_start > 0.0;
   double newton_change = std::numeric_limits<double>::infinity();  // change when the last Newton step was taken

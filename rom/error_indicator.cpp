@@ -87,7 +87,7 @@ void ErrorIndicator::build(const ReducedModel& model) {
 
 ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& lambda,
                                        const fom::Pairing& pairing, const Eigen::VectorXd& u_surface,
-                                       int pairings) const {
+                                       int pairings, const fom::SearchMemory* memory) const {
   const auto t0 = std::chrono::steady_clock::now();
   ErrorEstimate e;
   const fom::Problem& problem = m_problem;
@@ -113,7 +113,8 @@ ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::Vector
     fixed_point.max_iterations = cap;
     fixed_point.tolerance = m_options.pairing_tolerance;
     fom::PairingFixedPointResult fp = fom::solve_pairing_loop(problem, m_cond, m_options.fom, fixed_point, z_s,
-                                                              u_surface, pairing, lambda_start, e.qp_iterations);
+                                                              u_surface, pairing, lambda_start, e.qp_iterations,
+                                                              memory);
     sol = std::move(fp.solution);
     c = std::move(fp.c);
     e.pairings = fp.iterations;
@@ -135,12 +136,14 @@ ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::Vector
   support.clear();
   for (Eigen::Index j = 0; j < y.size(); ++j)
     if (y(j) != 0.0) support.push_back(static_cast<int>(j));
-  for (int j : support) {
+  for (size_t b = 0; b < support.size(); ++b) {  // yᵀ Q y over the lower triangle (Q symmetric)
+    const int j = support[b];
     vy.noalias() += y(j) * m_vhs.col(j);
     zy.noalias() += y(j) * m_zhs.col(j);
+    const double* q_j = m_shs.data() + static_cast<Eigen::Index>(j) * m_shs.rows();
     double row = 0.0;
-    for (int i : support) row += m_shs(i, j) * y(i);
-    yqy += y(j) * row;
+    for (size_t a = 0; a < b; ++a) row += q_j[support[a]] * y(support[a]);
+    yqy += y(j) * (2.0 * row + q_j[j] * y(j));
   }
   const double error2 = a.dot(m_vhv * a) + 2.0 * a.dot(vy) + yqy;
   const double norm2 = phi.dot(m_zhz * phi) - 2.0 * phi.dot(zy) + yqy;

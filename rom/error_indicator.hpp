@@ -97,8 +97,11 @@ class ErrorIndicator {
   /// \param lambda pressure per constraint row
   /// \param pairing the pairing searched at the answer's surface displacement `u_surface`
   /// \param pairings cap on the correction's pairings (≤ 0: ErrorIndicatorOptions::pairing_iterations)
+  /// \param memory memory of the search that found `pairing` (its re-pairings start
+  ///   from it: the same estimate, less searching), or nullptr
   ErrorEstimate estimate(const fom::Param& mu, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& lambda,
-                         const fom::Pairing& pairing, const Eigen::VectorXd& u_surface, int pairings = 0) const;
+                         const fom::Pairing& pairing, const Eigen::VectorXd& u_surface, int pairings = 0,
+                         const fom::SearchMemory* memory = nullptr) const;
 
  private:
   void build(const ReducedModel& model);

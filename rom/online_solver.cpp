@@ -72,17 +72,18 @@ void OnlineSolver::finish_query(std::chrono::steady_clock::time_point t0, Online
   res.time_s = std::chrono::duration<double>(t1 - t0).count();
   res.u = reconstruct_primal(res);
   res.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
-  const fom::Pairing* pairing = check_contact(model(), contact_tolerances(), res);
-  if (m_indicator && pairing) estimate_errors(*m_indicator, *pairing, res, m_estimate_pairings);
+  const AnswerSearch* search = check_contact(model(), contact_tolerances(), res);
+  if (m_indicator && search) estimate_errors(*m_indicator, *search, res, m_estimate_pairings);
 }
 
 Eigen::VectorXd OnlineSolver::reconstruct_primal(const OnlineResult& res) const {
   return model().reconstruct_primal(res.u_hat, res.mu);
 }
 
-void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairing, OnlineResult& res, int pairings) {
+void estimate_errors(const ErrorIndicator& indicator, const AnswerSearch& search, OnlineResult& res, int pairings) {
   const Eigen::VectorXd u_s = indicator.problem().contact().restrict_to_surface(res.u);
-  const ErrorEstimate e = indicator.estimate(res.mu, res.u_hat, res.lambda, pairing, u_s, pairings);
+  const ErrorEstimate e =
+      indicator.estimate(res.mu, res.u_hat, res.lambda, search.pairing, u_s, pairings, &search.memory);
   res.primal_estimate = e.primal;
   res.dual_estimate = e.dual;
   res.absolute_estimates = e.absolute;
@@ -90,30 +91,30 @@ void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairin
   res.time_s += e.time_s;
 }
 
-const fom::Pairing* check_contact(const ReducedModel& model, const fom::ContactTolerances& tolerances, OnlineResult& res) {
+const AnswerSearch* check_contact(const ReducedModel& model, const fom::ContactTolerances& tolerances,
+                                  OnlineResult& res) {
   const fom::Problem& problem = model.problem();
   if (res.u.size() != problem.num_dofs() || res.lambda.size() != problem.contact().num_constraints()) return nullptr;
   res.contact_force = fom::contact_force(problem, res.lambda);
   const auto t0 = std::chrono::steady_clock::now();
   // The search starts from the memory of the one made offline at the nearest
   // training snapshot: same pairing as a full search, most rows settled at once.
-  thread_local fom::SearchMemory memory;
-  thread_local fom::Pairing pairing;
+  thread_local AnswerSearch search;
   const int nearest = ReducedModel::nearest_column(model.interpolation_stencil(res.mu));
   if (nearest >= 0)
-    memory = model.snapshot_search_memory(nearest);
+    search.memory = model.snapshot_search_memory(nearest);
   else
-    memory = fom::SearchMemory();
+    search.memory = fom::SearchMemory();
   const Eigen::VectorXd u_s = problem.contact().restrict_to_surface(res.u);
-  problem.contact().search_rows(u_s, nullptr, nullptr, memory, pairing);
-  res.contact = fom::contact_residuals(problem, pairing, u_s, res.lambda);
+  problem.contact().search_rows(u_s, nullptr, nullptr, search.memory, search.pairing);
+  res.contact = fom::contact_residuals(problem, search.pairing, u_s, res.lambda);
   res.check_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   res.time_s += res.check_time_s;
   if (res.status == Status::Success && !res.contact.within(tolerances)) {
     res.status = Status::Inaccurate;
     res.message = "full-order contact residuals above tolerance: " + res.contact.describe(tolerances);
   }
-  return &pairing;
+  return &search;
 }
 
 }  // namespace contactrom::rom

@@ -157,14 +157,22 @@ class OnlineSolver {
 /// \brief The full-order contact check of an online answer: sets `res.contact` and
 /// `res.check_time_s`, and turns a Success whose residuals exceed `tolerances` into
 /// Status::Inaccurate (message: the residuals above tolerance and their rows).
-/// \returns the pairing searched at the answer (storage of the calling thread, valid
-///   until its next check), or nullptr when the answer has no fields.
-const fom::Pairing* check_contact(const ReducedModel& model, const fom::ContactTolerances& tolerances, OnlineResult& res);
+/// \brief The pairing check_contact() searched at an answer, with the memory of that
+/// search (fom::SearchMemory), from which the error estimate's re-pairings start.
+struct AnswerSearch {
+  fom::Pairing pairing;
+  fom::SearchMemory memory;
+};
+
+/// \returns the search at the answer (storage of the calling thread, valid until its
+///   next check), or nullptr when the answer has no fields.
+const AnswerSearch* check_contact(const ReducedModel& model, const fom::ContactTolerances& tolerances,
+                                  OnlineResult& res);
 
 /// \brief The error estimate of an answer (OnlineResult::primal_estimate, dual_estimate,
-/// absolute_estimates, estimate_time_s, added to time_s), at the pairing that
-/// check_contact() searched at it.
-void estimate_errors(const ErrorIndicator& indicator, const fom::Pairing& pairing, OnlineResult& res,
+/// absolute_estimates, estimate_time_s, added to time_s), from the search that
+/// check_contact() made at it.
+void estimate_errors(const ErrorIndicator& indicator, const AnswerSearch& search, OnlineResult& res,
                      int pairings = 0);
 
 /// \brief How the threshold τ is applied to the dictionary violations.

@@ -1,5 +1,6 @@
 // fom/pairing_fixed_point.hpp: pairing_change() on hand-made two-row operators
-// (closed forms, with and without its penetration term); through
+// (closed forms, with and without its penetration term; a row without a pair counts
+// only by its penetration under the new pairing); through
 // fom::ActiveSetSolver on hertz: a converged
 // solution passes the stopping test it reports (re-pairing at it changes nothing
 // beyond the tolerance), the cap gives no_convergence with the last change in the
@@ -74,6 +75,26 @@ BOOST_AUTO_TEST_CASE(pairing_change_on_a_hand_made_case) {
   for (const bool penetration : {true, false})
     BOOST_TEST(std::abs(pairing_change(c, g, c_turned, g, u_s, lambda, weights, u_scale, tol, penetration) -
                         std::sqrt(0.4)) <= 1e-15);
+}
+
+BOOST_AUTO_TEST_CASE(a_row_without_a_pair_counts_only_by_its_penetration) {
+  // Row 1 has no pair (empty row: v = 0, which would look like contact); the new
+  // pairing pairs it 0.5 away (v' = -0.5). That is no change of the contact: the
+  // test is the unchanged row 0's. Paired at a penetration of 0.1 instead, it is.
+  const Eigen::VectorXd weights = Eigen::VectorXd::Ones(2), lambda = Eigen::Vector2d(1.0, 0.0);
+  const Eigen::VectorXd u_s = Eigen::Vector2d(0.0, 0.0), g = Eigen::VectorXd::Zero(2);
+  const double u_scale = 2.0, tol = 1e-8;
+  Eigen::Matrix2d one_row = Eigen::Matrix2d::Zero();
+  one_row(0, 0) = 1.0;
+  const ConstraintMatrix c = operator_of(one_row), c_next = operator_of(Eigen::Matrix2d::Identity());
+  const Eigen::VectorXd g_far = Eigen::Vector2d(0.0, 0.5), g_in = Eigen::Vector2d(0.0, -0.1);
+  for (const bool penetration : {true, false})
+    BOOST_TEST(pairing_change(c, g, c_next, g_far, u_s, lambda, weights, u_scale, tol, penetration) == 0.0);
+  BOOST_TEST(std::abs(pairing_change(c, g, c_next, g_in, u_s, lambda, weights, u_scale, tol, true) - 0.1 / u_scale) <=
+             1e-17);
+  // The same row paired at v = 0 now, moved to −0.5: a gap that matters changed.
+  BOOST_TEST(std::abs(pairing_change(c_next, g, c_next, g_far, u_s, lambda, weights, u_scale, tol, false) -
+                      0.5 / u_scale) <= 1e-17);
 }
 
 BOOST_AUTO_TEST_CASE(a_converged_solution_passes_its_stopping_test) {

@@ -2,7 +2,8 @@
 // the true errors against the FOM (rank correlation, effectivity of the primal
 // estimate), follows the FOM's pairing on ironing where the answers' pairings are
 // wrong, is small at training parameters and large away from them, flags a
-// query that the dictionary cannot represent, and is absent when switched off.
+// query that the dictionary cannot represent, is the same whether or not its
+// re-pairings start from the answer's search memory, and is absent when switched off.
 #define BOOST_TEST_MODULE rom_error_indicator
 #include <boost/test/unit_test.hpp>
 
@@ -143,6 +144,26 @@ BOOST_AUTO_TEST_CASE(flags_a_query_whose_contact_zone_no_column_covers) {
   // An interpolated query inside the dictionary's range stays well below.
   const rom::OnlineResult inside = solver->solve(param(0.035));
   BOOST_TEST(inside.dual_estimate < 0.5 * res.dual_estimate);
+}
+
+BOOST_AUTO_TEST_CASE(the_answers_search_memory_changes_nothing_but_the_searching) {
+  // Each answer's estimate starts its re-pairings from the memory of the contact
+  // check's search; from a fresh search and no memory it is the same estimate.
+  Hertz h;
+  const rom::SnapshotDatabase db = rom::generate_snapshots(*h.problem, 12, {});
+  const rom::ReducedModel model(*h.problem, db);
+  const rom::ErrorIndicator& indicator = *model.error_indicator();
+  const auto solver = rom::make_online_solver("greedy", model);
+  const fom::ContactModel& contact = h.problem->contact();
+  for (const double d : {0.01, 0.07, 0.13, 0.29}) {
+    const rom::OnlineResult res = solver->solve(param(d));
+    const Eigen::VectorXd u_s = contact.restrict_to_surface(res.u);
+    const rom::ErrorEstimate fresh = indicator.estimate(param(d), res.u_hat, res.lambda, contact.search(u_s), u_s);
+    BOOST_REQUIRE(fresh.status == Status::Success);
+    BOOST_TEST(res.primal_estimate == fresh.primal, boost::test_tools::tolerance(1e-12));
+    BOOST_TEST(res.dual_estimate == fresh.dual, boost::test_tools::tolerance(1e-12));
+    BOOST_TEST(fresh.pairings >= 1);
+  }
 }
 
 BOOST_AUTO_TEST_CASE(no_estimate_when_switched_off) {
