@@ -138,9 +138,10 @@ struct ReducedActiveSet::Query : rom::ActiveSetStart {
   }
 
   /// Step 1: the operators at x (surface rows only).
-  void rebuild_operators(const Eigen::VectorXd& x) {
+  /// `surface_known`: u_s already holds Φ_s x + u_off,s (x is the û whose step was just taken).
+  void rebuild_operators(const Eigen::VectorXd& x, bool surface_known) {
     operators.start();
-    surface_displacement(x);
+    if (!surface_known) surface_displacement(x);
     ops.rebuild(solver.m_model.problem().contact(), solver.m_support, u_s);
     operators.stop();
   }
@@ -275,15 +276,17 @@ void ReducedActiveSet::solve_from(const fom::Param& mu, rom::WarmStart init, rom
     AndersonMixer mixer;
     Eigen::VectorXd x, x_s;  // where the operators are built, and its surface displacement
     rom::SupportRows::ResidualsScratch scratch;
-    void rebuild(bool) {
-      q.rebuild_operators(x);
+    void rebuild(bool at_u_hat) {
+      q.rebuild_operators(x, at_u_hat);  // at û, u_s is the one step() computed
       x_s = q.u_s;
     }
     bool physically_converged() { return q.gaps_within(tolerances, scratch); }
     int solves() const { return q.solves; }
     bool solve_frozen(int) { return q.solve_on_frozen_operators(res); }
     double step() {
+      q.operators.start();  // surface displacements count as operator time, as in the greedy
       q.surface_displacement(q.u_hat);
+      q.operators.stop();
       return rom::surface_step(q.u_s, x_s, q.solver.m_model.problem().displacement_scale());
     }
     void accept() { x = q.u_hat; }
