@@ -41,6 +41,22 @@ std::vector<double> read_doubles(hid_t f, const char* name, hsize_t rows, hsize_
   return out;
 }
 
+/// The body of every element (dataset /mesh/<element>_body, one entry per element of
+/// `count`) and the body names, each body index checked against the names.
+void read_element_bodies(hid_t f, const std::string& element, hsize_t count, fom::Mesh& mesh, std::vector<int>& body) {
+  const std::string name = "mesh/" + element + "_body";
+  hsize_t rows = 0, cols = 0;
+  hdf5::read_int_dataset(f, name.c_str(), body, rows, cols);
+  if (rows != count || cols != 1)
+    throw hdf5::Refused("dataset /" + name + " has " + std::to_string(rows) + " entries, expected one per " + element +
+                        " (" + std::to_string(count) + ")");
+  mesh.body_names = hdf5::read_string_list(f, "mesh/body_names", hdf5::file_size(f));
+  for (int b : body)
+    if (b < 0 || b >= static_cast<int>(mesh.body_names.size()))
+      throw hdf5::Refused("dataset /" + name + " holds the body " + std::to_string(b) + " of " +
+                          std::to_string(mesh.body_names.size()));
+}
+
 /// The 3D part of a mesh: cells, their bodies, and facet groups (docs/database_format.md).
 template <class CheckIds>
 std::shared_ptr<const fom::Mesh> read_mesh_3d(hid_t f, std::shared_ptr<fom::Mesh> mesh, CheckIds&& check_ids) {
@@ -55,16 +71,7 @@ std::shared_ptr<const fom::Mesh> read_mesh_3d(hid_t f, std::shared_ptr<fom::Mesh
     if (c[3] < 0 || (c[4] < 0) != (c[7] < 0)) throw hdf5::Refused("dataset /mesh/cells holds a cell of neither 4 nor 8 nodes");
     mesh->cells.push_back(c);
   }
-  const hsize_t num_cells = rows;
-  hdf5::read_int_dataset(f, "mesh/cell_body", mesh->cell_body, rows, cols);
-  if (rows != num_cells || cols != 1)
-    throw hdf5::Refused("dataset /mesh/cell_body has " + std::to_string(rows) + " entries, expected one per cell (" +
-                        std::to_string(num_cells) + ")");
-  mesh->body_names = hdf5::read_string_list(f, "mesh/body_names", hdf5::file_size(f));
-  for (int b : mesh->cell_body)
-    if (b < 0 || b >= static_cast<int>(mesh->body_names.size()))
-      throw hdf5::Refused("dataset /mesh/cell_body holds the body " + std::to_string(b) + " of " +
-                          std::to_string(mesh->body_names.size()));
+  read_element_bodies(f, "cell", rows, *mesh, mesh->cell_body);
   const std::vector<std::string> groups = hdf5::read_string_list(f, "mesh/curve_names", hdf5::file_size(f));
   for (size_t i = 0; i < groups.size(); ++i) {
     const std::string base = "mesh/curve_" + std::to_string(i);
@@ -107,16 +114,7 @@ std::shared_ptr<const fom::Mesh> read_mesh(hid_t f) {
   check_ids(quads, "mesh/quads");
   for (size_t q = 0; q + 3 < quads.size(); q += 4)
     mesh->quads.push_back({quads[q], quads[q + 1], quads[q + 2], quads[q + 3]});
-  const hsize_t num_quads = rows;
-  hdf5::read_int_dataset(f, "mesh/quad_body", mesh->quad_body, rows, cols);
-  if (rows != num_quads || cols != 1)
-    throw hdf5::Refused("dataset /mesh/quad_body has " + std::to_string(rows) + " entries, expected one per quad (" +
-                        std::to_string(num_quads) + ")");
-  mesh->body_names = hdf5::read_string_list(f, "mesh/body_names", hdf5::file_size(f));
-  for (int b : mesh->quad_body)
-    if (b < 0 || b >= static_cast<int>(mesh->body_names.size()))
-      throw hdf5::Refused("dataset /mesh/quad_body holds the body " + std::to_string(b) + " of " +
-                          std::to_string(mesh->body_names.size()));
+  read_element_bodies(f, "quad", rows, *mesh, mesh->quad_body);
   const std::vector<std::string> curves = hdf5::read_string_list(f, "mesh/curve_names", hdf5::file_size(f));
   for (size_t i = 0; i < curves.size(); ++i) {
     const std::string base = "mesh/curve_" + std::to_string(i);
