@@ -528,6 +528,45 @@ void NodeToSegmentContact::assemble_rows(const Pairing& p, const std::vector<int
   c.resizeNonZeros(nnz);
 }
 
+namespace {
+
+/// Writes a row-major sparse matrix row after row straight into its compressed
+/// arrays (reused storage): entries of a row may come in any order and repeat a
+/// column (they are summed); each row ends sorted.
+class RowWriter {
+ public:
+  RowWriter(ConstraintMatrix& m, int rows, int cols, int max_nonzeros) : m_m(m) {
+    m.resize(rows, cols);
+    m.resizeNonZeros(max_nonzeros);
+    m.outerIndexPtr()[0] = 0;
+  }
+  void add(int col, double v) {
+    int* inner = m_m.innerIndexPtr();
+    double* value = m_m.valuePtr();
+    for (int e = m_m.outerIndexPtr()[m_row]; e < m_nnz; ++e)
+      if (inner[e] == col) {
+        value[e] += v;
+        return;
+      }
+    inner[m_nnz] = col, value[m_nnz++] = v;
+  }
+  void end_row() {
+    int* inner = m_m.innerIndexPtr();
+    double* value = m_m.valuePtr();
+    for (int e = m_m.outerIndexPtr()[m_row] + 1; e < m_nnz; ++e)  // insertion sort: a dozen entries
+      for (int f = e; f > m_m.outerIndexPtr()[m_row] && inner[f - 1] > inner[f]; --f)
+        std::swap(inner[f - 1], inner[f]), std::swap(value[f - 1], value[f]);
+    m_m.outerIndexPtr()[++m_row] = m_nnz;
+  }
+  void finish() { m_m.resizeNonZeros(m_nnz); }
+
+ private:
+  ConstraintMatrix& m_m;
+  int m_row = 0, m_nnz = 0;
+};
+
+}  // namespace
+
 bool NodeToSegmentContact::linearise_pairing(const Eigen::VectorXd& u_surface, const Pairing& p,
                                              const std::vector<int>& rows, PairingLinearisation& out) const {
   // Row k on segment j = (a, b) of its chain, deformed positions x = X + u:
@@ -540,7 +579,8 @@ bool NodeToSegmentContact::linearise_pairing(const Eigen::VectorXd& u_surface, c
   out.per_row = 2;
   out.q.resize(2 * nr);
   out.dg.resize(2 * nr);
-  std::vector<Eigen::Triplet<double>> dq, dc;
+  // Rows 2r and 2r+1 of row r: a dozen entries each at most.
+  RowWriter dc(out.dc, 2 * nr, nsd, 12 * nr), dq(out.dq_du, 2 * nr, nsd, 28 * nr);
   const auto rot = [](const Eigen::Vector2d& v) { return Eigen::Vector2d(v.y(), -v.x()); };    // R
   const auto rot_t = [](const Eigen::Vector2d& v) { return Eigen::Vector2d(-v.y(), v.x()); };  // Rᵀ
   for (int r = 0; r < nr; ++r) {
@@ -562,10 +602,12 @@ bool NodeToSegmentContact::linearise_pairing(const Eigen::VectorXd& u_surface, c
     const Eigen::Vector2d dc_xi[3] = {Eigen::Vector2d::Zero(), -w * n, w * n};
     const Eigen::Vector2d dc_theta[3] = {-w * t, w * (1.0 - xi) * t, w * xi * t};
     for (int e = 0; e < 3; ++e)
-      for (int d = 0; d < 2; ++d) {
-        if (dc_xi[e](d) != 0.0) dc.emplace_back(2 * r, dofs[e] + d, dc_xi[e](d));
-        dc.emplace_back(2 * r + 1, dofs[e] + d, dc_theta[e](d));
-      }
+      for (int d = 0; d < 2; ++d)
+        if (dc_xi[e](d) != 0.0) dc.add(dofs[e] + d, dc_xi[e](d));
+    dc.end_row();
+    for (int e = 0; e < 3; ++e)
+      for (int d = 0; d < 2; ++d) dc.add(dofs[e] + d, dc_theta[e](d));
+    dc.end_row();
     out.dg(2 * r) = w * n.dot(xa_ref - xb_ref);
     out.dg(2 * r + 1) = w * t.dot(xs_ref - ((1.0 - xi) * xa_ref + xi * xb_ref));
 
@@ -608,23 +650,23 @@ bool NodeToSegmentContact::linearise_pairing(const Eigen::VectorXd& u_surface, c
         gtheta_master[seg - (j - 1)] -= ws;
       }
     }
-    for (int d = 0; d < 2; ++d) {
-      for (int e = 0; e < 3; ++e) {
-        if (gxi[e](d) == 0.0) continue;
-        dq.emplace_back(2 * r, dofs[e] + d, gxi[e](d));
-        dq.emplace_back(2 * r + 1, dofs[e] + d, c_xi * gxi[e](d));
-      }
-      for (int e = 0; e < 4; ++e) {
-        const int i = j - 1 + e;
-        if (i < 0 || i >= nm || gtheta_master[e](d) == 0.0) continue;
-        dq.emplace_back(2 * r + 1, master_dof(i) + d, gtheta_master[e](d));
-      }
+    for (int e = 0; e < 3; ++e)
+      for (int d = 0; d < 2; ++d)
+        if (gxi[e](d) != 0.0) dq.add(dofs[e] + d, gxi[e](d));
+    dq.end_row();
+    for (int e = 0; e < 3; ++e)
+      for (int d = 0; d < 2; ++d)
+        if (gxi[e](d) != 0.0) dq.add(dofs[e] + d, c_xi * gxi[e](d));
+    for (int e = 0; e < 4; ++e) {
+      const int i = j - 1 + e;
+      if (i < 0 || i >= nm) continue;
+      for (int d = 0; d < 2; ++d)
+        if (gtheta_master[e](d) != 0.0) dq.add(master_dof(i) + d, gtheta_master[e](d));
     }
+    dq.end_row();
   }
-  out.dq_du.resize(2 * nr, nsd);
-  out.dq_du.setFromTriplets(dq.begin(), dq.end());
-  out.dc.resize(2 * nr, nsd);
-  out.dc.setFromTriplets(dc.begin(), dc.end());
+  dc.finish();
+  dq.finish();
   return true;
 }
 
