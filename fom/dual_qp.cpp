@@ -2,22 +2,26 @@
 
 #include <algorithm>
 #include <cmath>
-#include <set>
 
 #include <contactrom/core/nnls.hpp>
 
 namespace contactrom::fom {
 
 bool DualQpSolver::solve_on(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<int>& set,
-                            Eigen::VectorXd& z) const {
-  const Eigen::MatrixXd gs = g(set, set);
-  const Eigen::VectorXd hs = h(set);
-  Eigen::LLT<Eigen::MatrixXd> llt(gs);
-  if (llt.info() == Eigen::Success) {
-    z = llt.solve(hs);
+                            Eigen::VectorXd& z) {
+  const Eigen::Index k = static_cast<Eigen::Index>(set.size());
+  m_gs.resize(k, k);
+  m_hs.resize(k);
+  for (Eigen::Index b = 0; b < k; ++b) {
+    for (Eigen::Index a = 0; a < k; ++a) m_gs(a, b) = g(set[a], set[b]);
+    m_hs(b) = h(set[b]);
+  }
+  m_llt.compute(m_gs);
+  if (m_llt.info() == Eigen::Success) {
+    z = m_llt.solve(m_hs);
   } else {
     // Semi-definite on this set (dependent rows): least-norm solution.
-    z = gs.completeOrthogonalDecomposition().solve(hs);
+    z = m_gs.completeOrthogonalDecomposition().solve(m_hs);
   }
   return z.allFinite();
 }
@@ -28,7 +32,12 @@ Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::Vecto
   m_iterations = 0;
   m_fallback = false;
   m_info = Status::Success;
-  std::vector<char> eligible = eligible_in.empty() ? std::vector<char>(n, 1) : eligible_in;
+  // The working arrays are members: repeated solves of the pairing loops do not allocate.
+  std::vector<char>& eligible = m_eligible;
+  if (eligible_in.empty())
+    eligible.assign(static_cast<size_t>(n), 1);
+  else
+    eligible = eligible_in;
   if (g.rows() != n || g.cols() != n || static_cast<int>(eligible.size()) != n || !g.allFinite() || !h.allFinite()) {
     m_info = Status::InvalidInput;
     return Eigen::VectorXd::Zero(n);
@@ -40,32 +49,40 @@ Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::Vecto
   const double tol = m_options.relative_tolerance * scale;
 
   // Initial active set: warm start support, else rows penetrating at λ = 0.
-  std::vector<char> active(n, 0);
+  std::vector<char>& active = m_active;
+  std::vector<char>& next = m_next;
+  active.assign(static_cast<size_t>(n), 0);
   for (int i = 0; i < n; ++i) {
     const bool seed = warm_start.size() == n ? warm_start(i) > 0.0 : h(i) > tol;
     active[i] = eligible[i] && seed;
   }
-  std::set<std::vector<char>> seen;
+  // The active sets seen so far, one after the other (a cycle returns to one).
+  m_seen.clear();
+  const auto seen = [&](const std::vector<char>& set) {
+    for (size_t start = 0; start < m_seen.size(); start += static_cast<size_t>(n))
+      if (std::equal(set.begin(), set.end(), m_seen.begin() + static_cast<std::ptrdiff_t>(start))) return true;
+    return false;
+  };
   Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
   while (m_iterations < m_options.max_iterations) {
     ++m_iterations;
-    seen.insert(active);
-    std::vector<int> set;
+    if (!seen(active)) m_seen.insert(m_seen.end(), active.begin(), active.end());
+    m_set.clear();
     for (int i = 0; i < n; ++i)
-      if (active[i]) set.push_back(i);
-    Eigen::VectorXd z;
+      if (active[i]) m_set.push_back(i);
     lambda.setZero();
-    if (!set.empty()) {
-      if (!solve_on(g, h, set, z)) {
+    if (!m_set.empty()) {
+      if (!solve_on(g, h, m_set, m_z)) {
         m_info = Status::NumericalIssue;
         return lambda;
       }
-      for (size_t a = 0; a < set.size(); ++a) lambda(set[a]) = z(a);
+      for (size_t a = 0; a < m_set.size(); ++a) lambda(m_set[a]) = m_z(static_cast<Eigen::Index>(a));
     }
-    const Eigen::VectorXd w = g * lambda - h;
-    std::vector<char> next(n, 0);
-    for (int i = 0; i < n; ++i) next[i] = eligible[i] && (active[i] ? lambda(i) > -tol : w(i) < -tol);
-    if (next == active && active_gaps_close(w, h, active, scale)) {
+    m_w.noalias() = g * lambda;
+    m_w -= h;
+    next.resize(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) next[i] = eligible[i] && (active[i] ? lambda(i) > -tol : m_w(i) < -tol);
+    if (next == active && active_gaps_close(m_w, h, active, scale)) {
       // Converged: clean round-off negatives (|λ_i| <= tol) on the active set.
       lambda = lambda.cwiseMax(0.0);
       return lambda;
@@ -73,11 +90,11 @@ Eigen::VectorXd DualQpSolver::solve(const Eigen::MatrixXd& g, const Eigen::Vecto
     // A stable active set whose rows still have a gap was solved in the least-squares
     // sense (G singular on it: dependent rows); PDAS cannot improve on it, and
     // Lawson–Hanson solves the QP exactly, like a cycle.
-    if (next == active || seen.count(next)) {
+    if (next == active || seen(next)) {
       m_fallback = true;
       return lawson_hanson(g, h, eligible);
     }
-    active = next;
+    std::swap(active, next);
   }
   m_info = Status::NoConvergence;
   return lambda;

@@ -49,7 +49,7 @@ class DualQpSolver {
   bool used_fallback() const { return m_fallback; }
 
  private:
-  bool solve_on(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<int>& set, Eigen::VectorXd& z) const;
+  bool solve_on(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<int>& set, Eigen::VectorXd& z);
   bool active_gaps_close(const Eigen::VectorXd& w, const Eigen::VectorXd& h, const std::vector<char>& active,
                          double scale) const;
   Eigen::VectorXd lawson_hanson(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<char>& eligible);
@@ -58,6 +58,12 @@ class DualQpSolver {
   Status m_info = Status::Success;
   int m_iterations = 0;
   bool m_fallback = false;
+  // Working arrays of solve(), kept between solves.
+  std::vector<char> m_eligible, m_active, m_next, m_seen;
+  std::vector<int> m_set;
+  Eigen::MatrixXd m_gs;
+  Eigen::VectorXd m_hs, m_z, m_w;
+  Eigen::LLT<Eigen::MatrixXd> m_llt;
 };
 
 }  // namespace contactrom::fom
