@@ -357,6 +357,7 @@ PairingFixedPointOptions pairing_options(const ActiveSetOptions& options) {
   o.anderson_depth = options.anderson_depth;
   o.anderson_restart = options.anderson_restart;
   o.newton_start = options.newton_start;
+  o.newton_retry = options.newton_retry;
   return o;
 }
 

@@ -101,8 +101,12 @@ struct ActiveSetOptions {
   /// iterations with the history kept; hertz never grows and is unchanged).
   bool anderson_restart = false;
   /// Newton steps on the pairing (fom/pairing_newton.hpp; 2D node-to-segment contact)
-  /// once the pairing change is at most this; 0: Anderson steps only. Default 0.1.
-  double newton_start = 0.1;
+  /// once the pairing change is at most this; 0: Anderson steps only. Default 0.3.
+  double newton_start = 0.3;
+  /// After a Newton step that did not reduce the pairing change, Newton steps resume
+  /// once Anderson steps bring it below this fraction of its value there; 0: Anderson
+  /// for the rest of the solve. Default 0.5.
+  double newton_retry = 0.5;
   /// ... while at most this many rows carry pressure: a Newton step costs O(|A|³)
   /// against O(n_s |W|) for an Anderson step, and pays only for small contact zones
   /// (measured: ironing, 6 rows, yes; hertz, 27 rows, no). Default 16.

@@ -17,7 +17,9 @@
 ///     solution is unchanged (pairing_change() ≤ `tolerance`);
 ///  4. otherwise, when the caller supplies Newton steps (fom/pairing_newton.hpp) and
 ///     the change is at most `newton_start`: the next pairing is the Newton step's,
-///     for as long as each step reduces the change (then Anderson from there);
+///     for as long as each step reduces the change; after one that does not,
+///     Anderson steps until the change is below `newton_retry` times its value
+///     there, then Newton steps again;
 ///  5. otherwise \f$ x \leftarrow \f$ Anderson mixing of \f$ x, F(x) \f$
 ///     (AndersonMixer, Walker & Ni 2011, type II, depth `anderson_depth`) and go to 1;
 ///     a solve that reports PairedSolution::map_changed (a reduced solver changed
@@ -70,9 +72,13 @@ struct PairingFixedPointOptions {
   /// penetrate slightly whatever their pairing. Default true.
   bool penetration = true;
   /// Newton steps on the pairing (when the caller supplies them) once pairing_change()
-  /// is at most this; 0: never. Default 0.1 (from farther away a step may leave the
+  /// is at most this; 0: never. Default 0.3 (from farther away a step may leave the
   /// active set it linearises; the Anderson iterates get there in a few steps).
-  double newton_start = 0.1;
+  double newton_start = 0.3;
+  /// After a Newton step that did not reduce the change, Newton steps resume once
+  /// Anderson steps bring the change below this fraction of its value there; 0:
+  /// Anderson for the rest of the solve. Default 0.5.
+  double newton_retry = 0.5;
 };
 
 /// \brief What the solve at a fixed pairing returns to the fixed point.
@@ -141,7 +147,10 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
   // full search's result.
   bool assembled = false;  // out.c, out.g already hold the operator of `pairing`
   bool newton_on = options.newton_start > 0.0;
-  double newton_change = std::numeric_limits<double>::infinity();  // change when the last Newton step was taken
+  // Change when the last Newton step was taken; after a step that did not reduce it,
+  // the change below which Newton steps resume (`waiting`).
+  double newton_change = std::numeric_limits<double>::infinity();
+  bool waiting = false;
   Pairing proposal;
   out.status = Status::NoConvergence;
   for (int it = 0; it < options.max_iterations; ++it) {
@@ -172,9 +181,13 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
     if (it + 1 == options.max_iterations) break;
     if constexpr (!std::is_same_v<std::decay_t<NewtonStep>, std::nullptr_t>) {
       if (newton_on && out.residual <= options.newton_start) {
-        if (out.residual >= newton_change) {
-          newton_on = false;  // the last step did not reduce the change: Anderson from here on
-        } else if (newton(pairing, out.c, out.solution, next, proposal)) {
+        bool step = out.residual < newton_change;
+        if (!step && !waiting) {  // the last step did not reduce the change: Anderson for now
+          newton_on = options.newton_retry > 0.0;
+          newton_change = options.newton_retry * out.residual;
+        }
+        waiting = !step;
+        if (step && newton(pairing, out.c, out.solution, next, proposal)) {
           newton_change = out.residual;
           x = f;
           std::swap(pairing, proposal);
