@@ -146,7 +146,7 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
   // searches per iteration without searching the whole master chain, with the
   // full search's result.
   bool assembled = false;  // out.c, out.g already hold the operator of `pairing`
-  bool newton_on = options.newton_start > 0.0;
+  const bool newton_on = options.newton_start > 0.0;
   // Change when the last Newton step was taken; after a step that did not reduce it,
   // the change below which Newton steps resume (`waiting`).
   double newton_change = std::numeric_limits<double>::infinity();
@@ -182,10 +182,9 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
     if constexpr (!std::is_same_v<std::decay_t<NewtonStep>, std::nullptr_t>) {
       if (newton_on && out.residual <= options.newton_start) {
         bool step = out.residual < newton_change;
-        if (!step && !waiting) {  // the last step did not reduce the change: Anderson for now
-          newton_on = options.newton_retry > 0.0;
-          newton_change = options.newton_retry * out.residual;
-        }
+        // The last step did not reduce the change: Anderson until it falls below
+        // newton_retry times its value here (never, with newton_retry 0).
+        if (!step && !waiting) newton_change = options.newton_retry * out.residual;
         waiting = !step;
         if (step && newton(pairing, out.c, out.solution, next, proposal)) {
           newton_change = out.residual;

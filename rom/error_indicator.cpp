@@ -112,8 +112,6 @@ ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::Vector
     fom::PairingFixedPointOptions fixed_point = fom::pairing_options(m_options.fom);
     fixed_point.max_iterations = cap;
     fixed_point.tolerance = m_options.pairing_tolerance;
-    fixed_point.newton_start = m_options.newton_start;
-    fixed_point.newton_retry = m_options.newton_retry;
     fom::PairingFixedPointResult fp = fom::solve_pairing_loop(problem, m_cond, m_options.fom, fixed_point, z_s,
                                                               u_surface, pairing, lambda_start, e.qp_iterations,
                                                               memory);

@@ -59,19 +59,19 @@ struct ErrorIndicatorOptions {
   /// (fom::pairing_change) at which the loop stops: the estimates need the correction
   /// to a few per cent, not to the FOM's 1e-12. Default 1e-2.
   double pairing_tolerance = 1e-2;
-  /// Pairing change from which the loop takes Newton steps (fom::PairingFixedPointOptions::
-  /// newton_start). Default 0.1, below the FOM's 0.3: with the loose stop above, Newton
-  /// steps taken from farther away end the loop at pairings whose pressures are
-  /// farther from the FOM's (ironing level 5: dual effectivity 0.34–1.63 against
-  /// 0.8–1.25).
-  double newton_start = 0.1;
-  /// Newton steps again after one that did not reduce the change, once Anderson
-  /// steps bring it below this fraction of it (fom::PairingFixedPointOptions::
-  /// newton_retry). Default 0, unlike the FOM: the loop stops at 1 %, and the retried
-  /// steps cost more than they save there (hertz 30: 86 → 101 µs a query).
-  double newton_retry = 0.0;
-  /// Options of the FOM's dual QP (working-set margin, QP tolerances). Default: the FOM's.
-  fom::ActiveSetOptions fom;
+  /// Options of the FOM's dual QP (working-set margin, QP tolerances) and pairing loop.
+  /// Default: the FOM's, except its Newton steps on the pairing: from a change of 0.1
+  /// (`newton_start`; the FOM's 0.3 lets the loose stop above end at pairings reached
+  /// by steps from farther away, whose pressures are farther from the FOM's — ironing
+  /// level 5: dual effectivity 0.34–1.63 against 0.8–1.25) and not again after one that
+  /// did not reduce the change (`newton_retry` 0; retried steps cost more than they
+  /// save when the loop stops at 1 % — hertz 30: 86 → 101 µs a query).
+  fom::ActiveSetOptions fom = [] {
+    fom::ActiveSetOptions o;
+    o.newton_start = 0.1;
+    o.newton_retry = 0.0;
+    return o;
+  }();
 };
 
 /// \brief The estimate of one answer.
