@@ -1,5 +1,5 @@
 # Finds the Debian-packaged dependencies of the build; those without a CMake
-# config (CHOLMOD, gmsh, Ipopt) become IMPORTED targets in
+# config (CHOLMOD, Ipopt) become IMPORTED targets in
 # ContactromImportedDependencies.cmake, which the installed package reuses.
 find_package(Eigen3 3.4 REQUIRED CONFIG)
 find_package(HDF5 REQUIRED COMPONENTS C)
@@ -13,3 +13,16 @@ if(NOT CLI11_FOUND)
   set_target_properties(CLI11::CLI11 PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${CLI11_INCLUDE_DIR}")
 endif()
 include(ContactromImportedDependencies)
+# gmsh: its C API header, and the library that fom/gmsh_api.cpp opens when a mesh is
+# first made (nothing links it, so an installed contactrom does not look for it);
+# gmsh::gmsh for the .msh fuzz target, which links it.
+find_path(GMSH_INCLUDE_DIR gmshc.h REQUIRED)
+find_library(GMSH_LIBRARY gmsh REQUIRED)
+get_filename_component(CONTACTROM_GMSH_REALPATH "${GMSH_LIBRARY}" REALPATH)
+get_filename_component(CONTACTROM_GMSH_NAME "${CONTACTROM_GMSH_REALPATH}" NAME)
+if(NOT TARGET gmsh::gmsh)
+  add_library(gmsh::gmsh INTERFACE IMPORTED)
+  set_target_properties(gmsh::gmsh PROPERTIES
+    INTERFACE_INCLUDE_DIRECTORIES "${GMSH_INCLUDE_DIR}"
+    INTERFACE_LINK_LIBRARIES "${GMSH_LIBRARY}")
+endif()

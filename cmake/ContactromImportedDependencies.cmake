@@ -1,6 +1,6 @@
-# IMPORTED targets for the dependencies without a CMake package: CHOLMOD and gmsh
-# (found by header and library name), Ipopt (pkg-config) and LAPACK (CMake's
-# FindLAPACK). Included by the build and by the installed contactromConfig.cmake.
+# IMPORTED targets for the dependencies without a CMake package: CHOLMOD (found by
+# header and library name), Ipopt (pkg-config) and LAPACK (CMake's FindLAPACK).
+# Included by the build and by the installed contactromConfig.cmake.
 if(NOT TARGET SuiteSparse::CHOLMOD)
   find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
   find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
@@ -15,15 +15,6 @@ endif()
 # where it is installed (tools/setup.sh), as under CHOLMOD.
 if(NOT TARGET LAPACK::LAPACK)
   find_package(LAPACK REQUIRED)
-endif()
-
-if(NOT TARGET gmsh::gmsh)
-  find_path(GMSH_INCLUDE_DIR gmsh.h REQUIRED)
-  find_library(GMSH_LIBRARY gmsh REQUIRED)
-  add_library(gmsh::gmsh INTERFACE IMPORTED)
-  set_target_properties(gmsh::gmsh PROPERTIES
-    INTERFACE_INCLUDE_DIRECTORIES "${GMSH_INCLUDE_DIR}"
-    INTERFACE_LINK_LIBRARIES "${GMSH_LIBRARY}")
 endif()
 
 if(NOT TARGET PkgConfig::IPOPT)

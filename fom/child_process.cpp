@@ -16,6 +16,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include <contactrom/core/errors.hpp>
+
 // A .geo file is a program, and gmsh can end the process that reads it: `Exit;`
 // calls exit(0), some options and inputs crash it (Mesh.Algorithm = 8 segfaults in
 // gmsh 4.8.4), a NaN radius makes it loop forever. load_mesh therefore runs gmsh in
@@ -31,7 +33,7 @@ namespace {
 /// Exit code of a child in which the work called exit() (a `.geo` `Exit` command).
 constexpr int kChildCalledExit = 121;
 /// Message tags on the pipe: an answer follows, or an error message follows.
-constexpr char kAnswerFollows = 'A', kErrorFollows = 'E';
+constexpr char kAnswerFollows = 'A', kInputErrorFollows = 'I', kErrorFollows = 'E';
 
 void write_all(int fd, const std::string& bytes) {
   std::size_t done = 0;
@@ -60,6 +62,8 @@ void write_all(int fd, const std::string& bytes) {
   std::string message;
   try {
     message = kAnswerFollows + work();
+  } catch (const InputError& e) {
+    message = std::string(1, kInputErrorFollows) + e.what();
   } catch (const std::exception& e) {
     message = std::string(1, kErrorFollows) + e.what();
   } catch (...) {
@@ -95,8 +99,11 @@ ChildOutcome outcome(int status, const std::string& bytes) {
     return out;
   }
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  if (code == 0 && !bytes.empty() && (bytes[0] == kAnswerFollows || bytes[0] == kErrorFollows)) {
-    out.end = bytes[0] == kAnswerFollows ? ChildOutcome::End::Answered : ChildOutcome::End::Failed;
+  if (code == 0 && !bytes.empty() &&
+      (bytes[0] == kAnswerFollows || bytes[0] == kInputErrorFollows || bytes[0] == kErrorFollows)) {
+    out.end = bytes[0] == kAnswerFollows       ? ChildOutcome::End::Answered
+              : bytes[0] == kInputErrorFollows ? ChildOutcome::End::Failed
+                                               : ChildOutcome::End::Error;
     out.text = bytes.substr(1);
   } else if (code == kChildCalledExit || code == 0) {
     out.end = ChildOutcome::End::CalledExit;

@@ -12,7 +12,8 @@ namespace contactrom::fom {
 struct ChildOutcome {
   enum class End {
     Answered,    ///< the work returned: `text` is its answer
-    Failed,      ///< the work threw: `text` is the exception's message
+    Failed,      ///< the work threw an InputError: `text` is its message
+    Error,       ///< the work threw anything else: `text` is its message
     TimedOut,    ///< still running at the time limit: killed (SIGKILL)
     Crashed,     ///< ended by `signal`
     CalledExit,  ///< the work called exit() (or ended with code 0 without an answer)

@@ -1,6 +1,6 @@
 #include <contactrom/fom/gmsh_reader.hpp>
 
-#include <gmsh.h>
+#include <contactrom/fom/gmsh_api.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -17,6 +17,8 @@
 
 namespace contactrom::fom {
 namespace {
+
+namespace gmsh = gmsh_api;  // gmsh's C++ API, opened on first use
 
 // gmsh element type codes (gmsh.info, "MSH file format"): only the two we keep.
 constexpr int kGmshLine2 = 1;

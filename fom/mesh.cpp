@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 
 #include <contactrom/core/errors.hpp>
@@ -12,6 +13,7 @@
 #include <contactrom/core/input_file.hpp>
 #include <contactrom/fom/child_process.hpp>
 #include <contactrom/fom/data_directory.hpp>
+#include <contactrom/fom/gmsh_api.hpp>
 #include <contactrom/fom/gmsh_reader.hpp>
 #include <contactrom/fom/mesh_serialization.hpp>
 
@@ -149,6 +151,7 @@ Mesh load_mesh(const std::string& path, const MeshOptions& options) {
 
   check_mesh_file(path);
   const std::string where = "mesh " + quoted(path, 200);
+  gmsh_api::load();  // once per process, before the fork: every later child shares it
   const ChildOutcome child = run_in_child_process(
       [&] { return serialize_mesh(mesh_with_gmsh(path, options)); }, options.time_limit_s, where);
   switch (child.end) {
@@ -156,6 +159,8 @@ Mesh load_mesh(const std::string& path, const MeshOptions& options) {
       return deserialize_mesh(child.text, where);
     case ChildOutcome::End::Failed:
       throw InputError(child.text);
+    case ChildOutcome::End::Error:  // not the file's fault (e.g. no gmsh library): exit code 1, not 2
+      throw std::runtime_error(where + ": " + child.text);
     case ChildOutcome::End::TimedOut: {
       std::ostringstream limit;
       limit << options.time_limit_s;

@@ -15,6 +15,7 @@
 // load_mesh's file check lives in an anonymous namespace of fom/mesh.cpp: this
 // target is that translation unit and the reader's plus the entry point (it links
 // contactrom::core and gmsh, not contactrom::fom, so they are compiled once, here).
+#include "../fom/gmsh_api.cpp"
 #include "../fom/gmsh_reader.cpp"
 #include "../fom/mesh.cpp"
 
