@@ -3,14 +3,15 @@
 /// \brief The part of gmsh's C++ API that fom/gmsh_reader.cpp uses, with gmsh's
 /// names and signatures, on a gmsh library loaded when it is first called.
 ///
-/// Why: libgmsh brings OpenCASCADE, FLTK and X11 with it, and loading them costs
-/// every process about 0.1 s at start-up — several times a typical `contactrom`
-/// command's own work, and most commands (query, online, reduce, bench on a
-/// database) never mesh anything. Here the library is opened (dlopen) by the first
-/// call (or by load()), in the first process that meshes. The functions call gmsh's C API (gmshc.h) and, as
-/// gmsh's C++ API does, throw the C API's error code (an int) when a call fails; the
-/// message is in gmsh's log. A gmsh library that cannot be opened throws
-/// std::runtime_error naming it. A private header of contactrom::fom.
+/// Why: libgmsh brings about 80 libraries with it (OpenCASCADE, FLTK, X11), and
+/// linking them costs every process about 0.1 s at start-up, more than most
+/// commands' own work; commands on a database or a reduced model (online --db,
+/// query, reduce, merge, verify) and Python's `import contactrom` never mesh. Here the
+/// library is opened (dlopen) by load() or the first call, in the first process
+/// that meshes (docs/results.md, "Process start-up"). The functions call gmsh's C API
+/// (gmshc.h) and, as gmsh's C++ API does, throw the C API's error code (an int)
+/// when a call fails; the message is in gmsh's log. A gmsh library that cannot be
+/// opened throws std::runtime_error naming it. A private header of contactrom::fom.
 #include <cstddef>
 #include <string>
 #include <utility>
