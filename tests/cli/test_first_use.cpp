@@ -116,3 +116,21 @@ BOOST_AUTO_TEST_CASE(one_version_everywhere) {
   BOOST_TEST(contactrom::rom::read_database(db).created_by == "contactrom " + expected);
   std::remove(db.c_str());
 }
+
+BOOST_AUTO_TEST_CASE(the_executable_searches_no_relative_library_folder) {
+  // An empty or relative entry in RUNPATH/RPATH makes the loader look for libraries
+  // in the current folder: `build/tools/contactrom` run in a folder holding a
+  // libmpi.so.40 would load it.
+  const auto r = run_command("readelf -d " + kExe);
+  BOOST_REQUIRE_MESSAGE(r.exit_code == 0, r.err);
+  std::istringstream in(r.out);
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (!std::regex_search(line, m, std::regex(R"(\((RUNPATH|RPATH)\).*\[(.*)\])"))) continue;
+    const std::string path = m[2];
+    std::string entry;
+    std::istringstream entries(path + ":");
+    while (std::getline(entries, entry, ':'))
+      BOOST_TEST((entry.rfind('/', 0) == 0 || entry.rfind("$ORIGIN", 0) == 0), "entry '" << entry << "' of " << path);
+  }
+}
