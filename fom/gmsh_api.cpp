@@ -11,7 +11,9 @@ namespace {
 
 /// The gmsh library, opened once per process: the file found at configure time, else
 /// a file of that name on the loader's search path (LD_LIBRARY_PATH included). Its
-/// symbols stay local: ours cannot stand in for theirs, nor theirs for ours.
+/// symbols stay out of the global scope (RTLD_LOCAL): nothing loaded later binds to
+/// them. (Ours cannot stand in for theirs either: the executable exports none,
+/// CMakeLists.txt's hidden visibility.)
 void* library() {
   static void* const handle = [] {
     std::string tried, errors;
