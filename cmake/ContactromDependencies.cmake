@@ -14,15 +14,11 @@ if(NOT CLI11_FOUND)
 endif()
 include(ContactromImportedDependencies)
 # gmsh: its C API header, and the library that fom/gmsh_api.cpp opens when a mesh is
-# first made (nothing links it, so an installed contactrom does not look for it);
-# gmsh::gmsh for the .msh fuzz target, which links it.
+# first made (nothing links it, so an installed contactrom does not look for it). The
+# definitions give gmsh_api.cpp the library's path and, as a fallback, its file name.
 find_path(GMSH_INCLUDE_DIR gmshc.h REQUIRED)
 find_library(GMSH_LIBRARY gmsh REQUIRED)
 get_filename_component(CONTACTROM_GMSH_REALPATH "${GMSH_LIBRARY}" REALPATH)
 get_filename_component(CONTACTROM_GMSH_NAME "${CONTACTROM_GMSH_REALPATH}" NAME)
-if(NOT TARGET gmsh::gmsh)
-  add_library(gmsh::gmsh INTERFACE IMPORTED)
-  set_target_properties(gmsh::gmsh PROPERTIES
-    INTERFACE_INCLUDE_DIRECTORIES "${GMSH_INCLUDE_DIR}"
-    INTERFACE_LINK_LIBRARIES "${GMSH_LIBRARY}")
-endif()
+set(CONTACTROM_GMSH_DEFINITIONS CONTACTROM_GMSH_LIBRARY="${CONTACTROM_GMSH_REALPATH}"
+    CONTACTROM_GMSH_NAME="${CONTACTROM_GMSH_NAME}")

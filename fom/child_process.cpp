@@ -32,7 +32,8 @@ namespace {
 
 /// Exit code of a child in which the work called exit() (a `.geo` `Exit` command).
 constexpr int kChildCalledExit = 121;
-/// Message tags on the pipe: an answer follows, or an error message follows.
+/// Message tags on the pipe: an answer follows, an InputError's message follows, or
+/// another error's message follows.
 constexpr char kAnswerFollows = 'A', kInputErrorFollows = 'I', kErrorFollows = 'E';
 
 void write_all(int fd, const std::string& bytes) {

@@ -84,7 +84,9 @@ void finalize() { call(CONTACTROM_GMSH(gmshFinalize)); }
 void open(const std::string& file_name) { call(CONTACTROM_GMSH(gmshOpen), file_name.c_str()); }
 
 namespace option {
-void setNumber(const std::string& name, double value) { call(CONTACTROM_GMSH(gmshOptionSetNumber), name.c_str(), value); }
+void setNumber(const std::string& name, double value) {
+  call(CONTACTROM_GMSH(gmshOptionSetNumber), name.c_str(), value);
+}
 }  // namespace option
 
 namespace logger {
@@ -135,7 +137,7 @@ void getNodes(std::vector<std::size_t>& node_tags, std::vector<double>& coord, s
   std::size_t *tags = nullptr, n_tags = 0, n_coord = 0, n_param = 0;
   double *xyz = nullptr, *param = nullptr;
   call(CONTACTROM_GMSH(gmshModelMeshGetNodes), &tags, &n_tags, &xyz, &n_coord, &param, &n_param, dim, tag,
-                       include_boundary ? 1 : 0, return_parametric_coord ? 1 : 0);
+       include_boundary ? 1 : 0, return_parametric_coord ? 1 : 0);
   node_tags = take_array(tags, n_tags);
   coord = take_array(xyz, n_coord);
   parametric_coord = take_array(param, n_param);
@@ -147,7 +149,7 @@ void getElements(std::vector<int>& element_types, std::vector<std::vector<std::s
   std::size_t n_types = 0, **elements = nullptr, *n_elements = nullptr, nn_elements = 0, **nodes = nullptr,
               *n_nodes = nullptr, nn_nodes = 0;
   call(CONTACTROM_GMSH(gmshModelMeshGetElements), &types, &n_types, &elements, &n_elements, &nn_elements, &nodes,
-                       &n_nodes, &nn_nodes, dim, tag);
+       &n_nodes, &nn_nodes, dim, tag);
   element_types = take_array(types, n_types);
   element_tags = take_arrays(elements, n_elements, nn_elements);
   node_tags = take_arrays(nodes, n_nodes, nn_nodes);
@@ -159,7 +161,7 @@ void getElementProperties(int element_type, std::string& element_name, int& dim,
   double* local = nullptr;
   std::size_t n_local = 0;
   call(CONTACTROM_GMSH(gmshModelMeshGetElementProperties), element_type, &name, &dim, &order, &num_nodes, &local,
-                       &n_local, &num_primary_nodes);
+       &n_local, &num_primary_nodes);
   element_name = take_string(name);
   local_node_coord = take_array(local, n_local);
 }

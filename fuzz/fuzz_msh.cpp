@@ -14,7 +14,8 @@
 
 // load_mesh's file check lives in an anonymous namespace of fom/mesh.cpp: this
 // target is that translation unit and the reader's plus the entry point (it links
-// contactrom::core and gmsh, not contactrom::fom, so they are compiled once, here).
+// contactrom::core, not contactrom::fom, so they are compiled once, here; gmsh_api.cpp
+// opens gmsh as the library does).
 #include "../fom/gmsh_api.cpp"
 #include "../fom/gmsh_reader.cpp"
 #include "../fom/mesh.cpp"
