@@ -1,6 +1,7 @@
 #include <contactrom/fom/active_set_solver.hpp>
 
 #include <Eigen/CholmodSupport>
+#include <algorithm>
 #include <chrono>
 
 #include <contactrom/core/errors.hpp>
@@ -12,29 +13,87 @@
 namespace contactrom::fom {
 namespace {
 
-/// S C_Wᵀ (n_s x |W|) for the constraint rows W: column a is the sum of the
-/// columns of the symmetric S picked by row W[a]'s (at most six) entries.
-void delassus_parts(const ConstraintMatrix& c, const std::vector<int>& rows, const Eigen::MatrixXd& s,
-                    Eigen::MatrixXd& sct) {
-  sct.resize(s.rows(), static_cast<Eigen::Index>(rows.size()));
-  for (size_t a = 0; a < rows.size(); ++a) {
-    ConstraintMatrix::InnerIterator it(c, rows[a]);
-    if (!it) {
-      sct.col(a).setZero();
-      continue;
-    }
-    sct.col(a).noalias() = it.value() * s.col(it.col());
-    for (++it; it; ++it) sct.col(a).noalias() += it.value() * s.col(it.col());
+/// dst = Σ_k v[k] src[k] (accumulate: dst + Σ_k …) over n entries, the terms added
+/// one after the other in k's order for every entry, as a sequence of axpys would,
+/// but with one pass over dst instead of one per term.
+template <int K>
+void combine_columns(double* dst, const double* const* src, const double* v, Eigen::Index n, bool accumulate) {
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double sum = accumulate ? dst[i] + v[0] * src[0][i] : v[0] * src[0][i];
+    for (int k = 1; k < K; ++k) sum += v[k] * src[k][i];
+    dst[i] = sum;
   }
 }
 
-/// G_W = C_W S C_Wᵀ from S C_Wᵀ (|W| x |W|).
+/// S C_Wᵀ (n_s x |W|) for the constraint rows W: column a is the sum of the
+/// columns of the symmetric S picked by row W[a]'s entries (six for a 2D
+/// node-to-segment row), taken in the row's order, eight at a time.
+void delassus_parts(const ConstraintMatrix& c, const std::vector<int>& rows, const Eigen::MatrixXd& s,
+                    Eigen::MatrixXd& sct) {
+  const Eigen::Index n = s.rows();
+  sct.resize(n, static_cast<Eigen::Index>(rows.size()));
+  const int* outer = c.outerIndexPtr();
+  const int* inner = c.innerIndexPtr();
+  const double* value = c.valuePtr();
+  for (size_t a = 0; a < rows.size(); ++a) {
+    double* dst = sct.col(static_cast<Eigen::Index>(a)).data();
+    const int begin = outer[rows[a]], end = c.isCompressed() ? outer[rows[a] + 1] : begin + c.innerNonZeroPtr()[rows[a]];
+    if (begin == end) {
+      std::fill(dst, dst + n, 0.0);
+      continue;
+    }
+    for (int first = begin; first < end; first += 8) {
+      const double* src[8];
+      const int count = std::min(8, end - first);
+      for (int k = 0; k < count; ++k) src[k] = s.col(inner[first + k]).data();
+      const bool accumulate = first > begin;
+      switch (count) {
+        case 1: combine_columns<1>(dst, src, value + first, n, accumulate); break;
+        case 2: combine_columns<2>(dst, src, value + first, n, accumulate); break;
+        case 3: combine_columns<3>(dst, src, value + first, n, accumulate); break;
+        case 4: combine_columns<4>(dst, src, value + first, n, accumulate); break;
+        case 5: combine_columns<5>(dst, src, value + first, n, accumulate); break;
+        case 6: combine_columns<6>(dst, src, value + first, n, accumulate); break;
+        case 7: combine_columns<7>(dst, src, value + first, n, accumulate); break;
+        default: combine_columns<8>(dst, src, value + first, n, accumulate); break;
+      }
+    }
+  }
+}
+
+/// G_W = C_W S C_Wᵀ from S C_Wᵀ (|W| x |W|): entry (a, b) is row W[a] applied to
+/// column b of S C_Wᵀ, its terms added in the row's order. Four columns at a time:
+/// each entry is a chain of dependent additions, and four chains run side by side.
 Eigen::MatrixXd delassus(const ConstraintMatrix& c, const std::vector<int>& rows, const Eigen::MatrixXd& sct) {
   const int nw = static_cast<int>(rows.size());
+  const Eigen::Index ld = sct.rows();
+  const int* outer = c.outerIndexPtr();
+  const int* inner = c.innerIndexPtr();
+  const double* value = c.valuePtr();
   Eigen::MatrixXd g(nw, nw);
   for (int a = 0; a < nw; ++a) {
-    g.row(a).setZero();
-    for (ConstraintMatrix::InnerIterator it(c, rows[a]); it; ++it) g.row(a).noalias() += it.value() * sct.row(it.col());
+    const int begin = outer[rows[a]];
+    const int end = c.isCompressed() ? outer[rows[a] + 1] : begin + c.innerNonZeroPtr()[rows[a]];
+    int b = 0;
+    for (; b + 4 <= nw; b += 4) {
+      const double* col = sct.col(b).data();
+      double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+      for (int k = begin; k < end; ++k) {
+        const double v = value[k];
+        const double* x = col + inner[k];
+        s0 += v * x[0];
+        s1 += v * x[ld];
+        s2 += v * x[2 * ld];
+        s3 += v * x[3 * ld];
+      }
+      g(a, b) = s0, g(a, b + 1) = s1, g(a, b + 2) = s2, g(a, b + 3) = s3;
+    }
+    for (; b < nw; ++b) {
+      const double* col = sct.col(b).data();
+      double sum = 0.0;
+      for (int k = begin; k < end; ++k) sum += value[k] * col[inner[k]];
+      g(a, b) = sum;
+    }
   }
   return g;
 }
