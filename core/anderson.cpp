@@ -17,6 +17,7 @@ void AndersonMixer::size_for(Eigen::Index n) {
   if (m_df.rows() == n && m_df.cols() == m_depth) return;
   m_df.setZero(n, m_depth), m_dr.setZero(n, m_depth);
   m_gram.setIdentity(m_depth, m_depth);
+  m_dots.setZero(m_depth, m_depth);
   m_rhs.setZero(m_depth), m_gamma.setZero(m_depth);
   m_ldlt.compute(m_gram);  // sizes its storage (the size-only constructor leaves its status unset)
   m_r.resize(n);
@@ -26,8 +27,9 @@ void AndersonMixer::size_for(Eigen::Index n) {
 void AndersonMixer::next(const Eigen::VectorXd& x, const Eigen::VectorXd& f, Eigen::VectorXd& out) {
   size_for(x.size());
   m_r = f - x;  // before `out` is written: it may be x
+  const double r_norm = m_r.norm();
   if (m_started && m_depth > 0) {
-    if (m_restart_on_growth && m_r.norm() > m_r_prev.norm()) restart();
+    if (m_restart_on_growth && r_norm > m_r_prev_norm) restart();
     int slot;
     if (m_count < m_depth) {
       slot = (m_oldest + m_count) % m_depth, ++m_count;
@@ -36,10 +38,17 @@ void AndersonMixer::next(const Eigen::VectorXd& x, const Eigen::VectorXd& f, Eig
     }
     m_df.col(slot) = f - m_f_prev;
     m_dr.col(slot) = m_r - m_r_prev;
+    // The new difference's dot products with the ones held (itself included); the
+    // others' are unchanged, so a step costs m_count dot products, not m_count².
+    for (int a = 0; a < m_count; ++a) {
+      const int other = (m_oldest + a) % m_depth;
+      m_dots(slot, other) = m_dots(other, slot) = m_dr.col(slot).dot(m_dr.col(other));
+    }
   }
   m_started = true;
   m_f_prev = f;
   m_r_prev = m_r;
+  m_r_prev_norm = r_norm;
   if (m_count == 0) {
     if (&out != &f) out = f;
     return;
@@ -51,7 +60,7 @@ void AndersonMixer::next(const Eigen::VectorXd& x, const Eigen::VectorXd& f, Eig
   m_rhs.setZero();
   for (int a = 0; a < m_count; ++a) {
     m_rhs(a) = m_dr.col(column(a)).dot(m_r);
-    for (int b = 0; b <= a; ++b) m_gram(a, b) = m_gram(b, a) = m_dr.col(column(a)).dot(m_dr.col(column(b)));
+    for (int b = 0; b <= a; ++b) m_gram(a, b) = m_gram(b, a) = m_dots(column(a), column(b));
   }
   m_ldlt.compute(m_gram);
   m_gamma = m_ldlt.solve(m_rhs);

@@ -55,6 +55,8 @@ class AndersonMixer {
   Eigen::VectorXd m_f_prev, m_r_prev, m_r;
   Eigen::MatrixXd m_df, m_dr;  // n × depth ring buffers of ΔF and ΔR
   Eigen::MatrixXd m_gram;      // depth × depth normal equations
+  Eigen::MatrixXd m_dots;      // depth × depth ΔR dot products by ring-buffer column
+  double m_r_prev_norm = 0.0;  // |m_r_prev|
   Eigen::VectorXd m_rhs, m_gamma;
   Eigen::LDLT<Eigen::MatrixXd> m_ldlt;
 };
