@@ -37,7 +37,8 @@ void delassus_parts(const ConstraintMatrix& c, const std::vector<int>& rows, con
   const double* value = c.valuePtr();
   for (size_t a = 0; a < rows.size(); ++a) {
     double* dst = sct.col(static_cast<Eigen::Index>(a)).data();
-    const int begin = outer[rows[a]], end = c.isCompressed() ? outer[rows[a] + 1] : begin + c.innerNonZeroPtr()[rows[a]];
+    const int begin = outer[rows[a]];
+    const int end = c.isCompressed() ? outer[rows[a] + 1] : begin + c.innerNonZeroPtr()[rows[a]];
     if (begin == end) {
       std::fill(dst, dst + n, 0.0);
       continue;
@@ -62,23 +63,25 @@ void delassus_parts(const ConstraintMatrix& c, const std::vector<int>& rows, con
 }
 
 /// G_W = C_W S C_Wᵀ from S C_Wᵀ (|W| x |W|): entry (a, b) is row W[a] applied to
-/// column b of S C_Wᵀ, its terms added in the row's order. Four columns at a time:
-/// each entry is a chain of dependent additions, and four chains run side by side.
+/// column b of S C_Wᵀ, its terms added in the row's order. Four columns at a time,
+/// every row against them before the next four (they stay in cache): each entry is
+/// a chain of dependent additions, and four chains run side by side.
 Eigen::MatrixXd delassus(const ConstraintMatrix& c, const std::vector<int>& rows, const Eigen::MatrixXd& sct) {
   const int nw = static_cast<int>(rows.size());
   const Eigen::Index ld = sct.rows();
   const int* outer = c.outerIndexPtr();
   const int* inner = c.innerIndexPtr();
   const double* value = c.valuePtr();
+  const auto row_end = [&](int a) {
+    return c.isCompressed() ? outer[rows[a] + 1] : outer[rows[a]] + c.innerNonZeroPtr()[rows[a]];
+  };
   Eigen::MatrixXd g(nw, nw);
-  for (int a = 0; a < nw; ++a) {
-    const int begin = outer[rows[a]];
-    const int end = c.isCompressed() ? outer[rows[a] + 1] : begin + c.innerNonZeroPtr()[rows[a]];
-    int b = 0;
-    for (; b + 4 <= nw; b += 4) {
-      const double* col = sct.col(b).data();
+  int b = 0;
+  for (; b + 4 <= nw; b += 4) {
+    const double* col = sct.col(b).data();
+    for (int a = 0; a < nw; ++a) {
       double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-      for (int k = begin; k < end; ++k) {
+      for (int k = outer[rows[a]], end = row_end(a); k < end; ++k) {
         const double v = value[k];
         const double* x = col + inner[k];
         s0 += v * x[0];
@@ -88,10 +91,12 @@ Eigen::MatrixXd delassus(const ConstraintMatrix& c, const std::vector<int>& rows
       }
       g(a, b) = s0, g(a, b + 1) = s1, g(a, b + 2) = s2, g(a, b + 3) = s3;
     }
-    for (; b < nw; ++b) {
-      const double* col = sct.col(b).data();
+  }
+  for (; b < nw; ++b) {
+    const double* col = sct.col(b).data();
+    for (int a = 0; a < nw; ++a) {
       double sum = 0.0;
-      for (int k = begin; k < end; ++k) sum += value[k] * col[inner[k]];
+      for (int k = outer[rows[a]], end = row_end(a); k < end; ++k) sum += value[k] * col[inner[k]];
       g(a, b) = sum;
     }
   }
