@@ -161,7 +161,8 @@ CommandRegistrar reg("bench", [](CLI::App& app) {
   add_integer(sub, "--ipopt-queries", a->ipopt_queries, "queries timed for Ipopt (0: Ipopt not timed; default 5)", 0, 1000000);
   add_threads(sub, a->threads, "threads of the offline stage");
   sub->add_flag("--json", a->json, "print one JSON object");
-  sub->footer(rom::describe_online_methods());
+  sub->footer("Every online method is timed with its default settings; the greedy also from the empty start, with\n"
+              "the nested schedule and with its error estimate (docs/cli.md lists the JSON keys of each variant).");
   sub->callback([a] { run_bench(*a); });
 });
 

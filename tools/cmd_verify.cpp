@@ -1,6 +1,7 @@
 // contactrom verify --db DB.h5 --method M[,M2,...] [--delta D] [--tau T] [--tau-scaling S]
 //                   [--cpg-tolerance E] [--inner-solve nonnegative|equality]
 //                   [--reference ipopt|fom] [--threads T] [--limit N] [--bench] [--repeats R] [--out FILE.csv] [--progress] [--json]
+//                   [--option KEY=VALUE]...
 // KKT verification of reduced solutions against the Ipopt reference (or the FOM,
 // --reference fom): baselines::verify (baselines/verification.hpp) computes it, this
 // file parses the arguments and prints. --bench adds the median online time per
@@ -14,7 +15,9 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <memory>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -49,6 +52,7 @@ struct VerifyArgs {
   double delta = 1e-8, tau = setting_default<double>("tau"), cpg_tolerance = baselines::CpgOptions{}.tolerance;
   int threads = 0, max_iterations = setting_default<int>("max_iterations"), limit = 0, repeats = 3;
   bool json = false, progress = false, bench = false;
+  std::vector<std::string> options;  // --option KEY=VALUE, for every listed method that declares KEY
 };
 
 std::string sci(double v) {
@@ -59,22 +63,36 @@ std::string sci(double v) {
 
 /// The methods of --method with the settings of the flags each knows: --cpg-tolerance
 /// concerns cpg, --inner-solve the reduced active sets (cpg, full-dictionary), --init
-/// the methods with a warm start (each checks the value itself).
+/// the methods with a warm start (each checks the value itself); an --option goes to
+/// every listed method that declares its key and overrides the flag of that key.
 std::vector<baselines::VerifyMethod> methods_of(const VerifyArgs& a) {
-  rom::OnlineSolverOptions options;
-  options.tau = a.tau;
-  rom::active_set_settings_table().read(options, "tau_scaling", a.tau_scaling, "--tau-scaling");
-  options.max_iterations = a.max_iterations;
+  std::map<std::string, std::string> extra;
+  for (const std::string& kv : a.options) {
+    auto [key, value] = rom::split_option(kv);
+    extra[key] = value;
+  }
+  std::set<std::string> used;
   std::vector<baselines::VerifyMethod> out;
   for (const std::string& m : split_list(a.methods, "--method")) {
-    (void)rom::online_method(m);  // unknown names are refused before the database is read
-    rom::OnlineSolverOptions o = options;
-    if (m == "cpg" && a.cpg_tolerance >= 0.0) o.extra["cpg_tolerance"] = format_number(a.cpg_tolerance);
-    if ((m == "cpg" || m == "full-dictionary") && !a.inner_solve.empty()) o.extra["inner_solve"] = a.inner_solve;
+    const rom::OnlineMethod method = rom::online_method(m);  // unknown names are refused before the database is read
+    std::map<std::string, std::string> values;
+    if (m == "cpg" && a.cpg_tolerance >= 0.0) values["cpg_tolerance"] = format_number(a.cpg_tolerance);
+    if ((m == "cpg" || m == "full-dictionary") && !a.inner_solve.empty()) values["inner_solve"] = a.inner_solve;
     if ((m == "greedy" || m == "greedy-nested" || m == "cpg" || m == "full-dictionary") && !a.init.empty())
-      o.extra["init"] = a.init;
+      values["init"] = a.init;
+    for (const auto& [key, value] : extra)
+      for (const rom::OptionSpec& spec : method.options)
+        if (spec.key == key) values[key] = value, used.insert(key);
+    rom::OnlineSolverOptions o = rom::options_from_map(m, values);
+    if (!values.count("tau")) o.tau = a.tau;
+    if (!values.count("tau_scaling")) rom::active_set_settings_table().read(o, "tau_scaling", a.tau_scaling, "--tau-scaling");
+    if (!values.count("max_iterations")) o.max_iterations = a.max_iterations;
     out.push_back({m, o});
   }
+  for (const auto& [key, value] : extra)
+    if (!used.count(key))
+      throw InputError("--option " + key + "=" + value + ": none of the methods '" + a.methods +
+                       "' has a setting '" + key + "' (each method's settings are listed by verify --help)");
   return out;
 }
 
@@ -261,6 +279,9 @@ CommandRegistrar reg("verify", [](CLI::App& app) {
       ->check(non_empty_path());
   sub->add_flag("--progress", args->progress, "draw progress bars even when stderr is not a terminal");
   sub->add_flag("--json", args->json, "print one JSON object");
+  sub->add_option("--option", args->options,
+                  "method setting KEY=VALUE, repeatable; given to every listed method that has the setting (each "
+                  "method's keys are listed below)");
   sub->footer(rom::describe_online_methods());
   sub->callback([args] { run_verify(*args); });
 });

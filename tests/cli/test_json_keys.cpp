@@ -105,3 +105,22 @@ BOOST_AUTO_TEST_CASE(commands_name_the_same_quantity_alike) {
   BOOST_TEST(first_line(dir + "/hull.csv").rfind("d,primal_error,dual_error,errors,", 0) == 0u);
   BOOST_TEST(first_line(dir + "/verify.csv").rfind("method,d,primal_error,dual_error,errors,", 0) == 0u);
 }
+
+// verify --option gives a setting to every listed method that has it and to no other:
+// a loose CPG tolerance shrinks CPG's basis while the greedy (which has no such
+// setting) answers as without it; init=empty, which both have, sends the greedy back
+// to the paper's empty start and its many more iterations; estimate=false is taken.
+BOOST_AUTO_TEST_CASE(verify_option_reaches_the_methods_that_have_it) {
+  const std::string dir = contactrom::test::temp_dir();
+  const std::string db = dir + "/h8.h5";
+  BOOST_REQUIRE(run_command(kExe + " offline --problem hertz --train 8 --threads 2 --out " + db).exit_code == 0);
+  const std::string base = "verify --db " + db + " --method greedy,cpg --reference fom --limit 4 --threads 2 --json";
+  const nlohmann::json plain = json_of(base);
+  const nlohmann::json loose = json_of(base + " --option cpg_tolerance=0.5 --option estimate=false");
+  const nlohmann::json empty = json_of(base + " --option init=empty");
+  BOOST_TEST(loose["methods"]["cpg"]["dual_basis_size"].get<int>() < plain["methods"]["cpg"]["dual_basis_size"].get<int>());
+  BOOST_TEST(loose["methods"]["greedy"]["mean_primal_error"].get<double>() ==
+             plain["methods"]["greedy"]["mean_primal_error"].get<double>());
+  BOOST_TEST(empty["methods"]["greedy"]["mean_iterations"].get<double>() >
+             plain["methods"]["greedy"]["mean_iterations"].get<double>() + 1.0);
+}
