@@ -154,7 +154,7 @@ void run_query(const QueryArgs& a) {
 
 CommandRegistrar reg("query", [](CLI::App& app) {
   auto args = std::make_shared<QueryArgs>();
-  auto* sub = app.add_subcommand("query", "Answer queries from a reduced-model file (no FOM)");
+  auto* sub = app.add_subcommand("query", "Answer queries from a reduced-model file (the FOM only with --fallback fom)");
   sub->add_option("--rom", args->rom, "reduced-model file written by contactrom reduce")
       ->check(non_empty_path())->required();
   sub->add_option("--param", args->param, "one query V or V1,V2");
