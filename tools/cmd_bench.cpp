@@ -161,8 +161,11 @@ CommandRegistrar reg("bench", [](CLI::App& app) {
   add_integer(sub, "--ipopt-queries", a->ipopt_queries, "queries timed for Ipopt (0: Ipopt not timed; default 5)", 0, 1000000);
   add_threads(sub, a->threads, "threads of the offline stage");
   sub->add_flag("--json", a->json, "print one JSON object");
-  sub->footer("Every online method is timed with its default settings; the greedy also from the empty start, with\n"
-              "the nested schedule and with its error estimate (docs/cli.md lists the JSON keys of each variant).");
+  std::string methods;
+  for (const rom::OnlineMethod& m : rom::online_methods()) methods += (methods.empty() ? "" : ", ") + m.name;
+  sub->footer("Every online method (" + methods + ") is timed with its default settings;\n"
+              "the greedy also from the empty start, with the nested schedule and with its error estimate\n"
+              "(docs/cli.md lists the JSON keys of each variant).");
   sub->callback([a] { run_bench(*a); });
 });
 

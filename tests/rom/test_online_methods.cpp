@@ -241,13 +241,20 @@ BOOST_AUTO_TEST_CASE(split_option_needs_a_key_and_an_equals_sign) {
   BOOST_CHECK_THROW(rom::split_option("key"), InputError);
 }
 
+// The commands that take --option list every setting of every method; bench, which
+// times every method with its defaults, names each method and takes no --option.
 BOOST_AUTO_TEST_CASE(cli_help_lists_every_option_of_every_method) {
-  for (const char* command : {"online", "bench", "verify"}) {
+  for (const char* command : {"online", "reduce", "verify"}) {
     const auto r = contactrom::test::run_command(std::string(CONTACTROM_EXE) + " " + command + " --help");
     BOOST_REQUIRE_EQUAL(r.exit_code, 0);
+    BOOST_TEST(contains(r.out, "--option"), command);
     for (const rom::OnlineMethod& m : rom::online_methods()) {
       BOOST_TEST(contains(r.out, "  " + m.name + ": "), command << " " << m.name);
       for (const rom::OptionSpec& s : m.options) BOOST_TEST(contains(r.out, "    " + s.key + ": "), m.name << " " << s.key);
     }
   }
+  const auto bench = contactrom::test::run_command(std::string(CONTACTROM_EXE) + " bench --help");
+  BOOST_REQUIRE_EQUAL(bench.exit_code, 0);
+  BOOST_TEST(!contains(bench.out, "--option"));
+  for (const rom::OnlineMethod& m : rom::online_methods()) BOOST_TEST(contains(bench.out, m.name), "bench " << m.name);
 }
