@@ -33,18 +33,18 @@ Registry& registry() {
   return *r;
 }
 
-const OptionSpec* find_spec(const OnlineMethod& m, const std::string& key) {
-  for (const OptionSpec& s : m.options)
-    if (s.key == key) return &s;
-  return nullptr;
-}
-
 /// Whether `key` is a typed field of OnlineSolverOptions (not an `extra` entry).
 bool is_field(const std::string& key) {
   return active_set_settings_table().find(key) || contact_check_table().find(key);
 }
 
 }  // namespace
+
+const OptionSpec* OnlineMethod::option(const std::string& key) const {
+  for (const OptionSpec& s : options)
+    if (s.key == key) return &s;
+  return nullptr;
+}
 
 std::vector<OnlineMethod> rom_online_methods() {
   auto greedy = [](const ReducedModel& model, const OnlineSolverOptions& options) {
@@ -112,7 +112,7 @@ void validate_online_options(const std::string& method, const OnlineSolverOption
     if (is_field(key))
       throw InputError("online method " + quoted(method, 200) + " option " + key +
                        " is a field of OnlineSolverOptions; set the field (or use options_from_map)");
-    if (!find_spec(m, key)) throw_unknown_option(method, key, m.options);
+    if (!m.option(key)) throw_unknown_option(method, key, m.options);
   }
   (void)m.read(options);
 }
@@ -132,7 +132,7 @@ OnlineSolverOptions options_from_map(const std::string& method, const std::map<s
   const OnlineMethod m = online_method(method);
   OnlineSolverOptions o;
   for (const auto& [key, value] : values) {
-    if (!find_spec(m, key)) throw_unknown_option(method, key, m.options);
+    if (!m.option(key)) throw_unknown_option(method, key, m.options);
     const std::string what = "online method " + quoted(method, 200) + " option " + key;
     if (active_set_settings_table().find(key))
       active_set_settings_table().read(o, key, value, what);

@@ -70,6 +70,8 @@ struct OnlineMethod {
   /// Whether the method combines the primal training snapshots themselves
   /// (ReducedModel::primal_snapshots(), n × m): a reduced-model file then stores them.
   bool needs_primal_snapshots = false;
+  /// The declared option `key`, or nullptr when the method has no such option.
+  const OptionSpec* option(const std::string& key) const;
 };
 
 /// \brief A method whose options are those of `tables` (one per options struct it

@@ -81,8 +81,7 @@ std::vector<baselines::VerifyMethod> methods_of(const VerifyArgs& a) {
     if ((m == "greedy" || m == "greedy-nested" || m == "cpg" || m == "full-dictionary") && !a.init.empty())
       values["init"] = a.init;
     for (const auto& [key, value] : extra)
-      for (const rom::OptionSpec& spec : method.options)
-        if (spec.key == key) values[key] = value, used.insert(key);
+      if (method.option(key)) values[key] = value, used.insert(key);
     rom::OnlineSolverOptions o = rom::options_from_map(m, values);
     if (!values.count("tau")) o.tau = a.tau;
     if (!values.count("tau_scaling")) rom::active_set_settings_table().read(o, "tau_scaling", a.tau_scaling, "--tau-scaling");
