@@ -3,6 +3,7 @@
 #include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <chrono>
+#include <utility>
 
 #include <contactrom/core/errors.hpp>
 #include <contactrom/core/format.hpp>
@@ -25,6 +26,12 @@ void combine_columns(double* dst, const double* const* src, const double* v, Eig
   }
 }
 
+/// The entries of row `r` of `c`: positions begin … end of its inner index and value arrays.
+std::pair<int, int> row_entries(const ConstraintMatrix& c, int r) {
+  const int begin = c.outerIndexPtr()[r];
+  return {begin, c.isCompressed() ? c.outerIndexPtr()[r + 1] : begin + c.innerNonZeroPtr()[r]};
+}
+
 /// S C_Wᵀ (n_s x |W|) for the constraint rows W: column a is the sum of the
 /// columns of the symmetric S picked by row W[a]'s entries (six for a 2D
 /// node-to-segment row), taken in the row's order, eight at a time.
@@ -32,13 +39,11 @@ void delassus_parts(const ConstraintMatrix& c, const std::vector<int>& rows, con
                     Eigen::MatrixXd& sct) {
   const Eigen::Index n = s.rows();
   sct.resize(n, static_cast<Eigen::Index>(rows.size()));
-  const int* outer = c.outerIndexPtr();
   const int* inner = c.innerIndexPtr();
   const double* value = c.valuePtr();
   for (size_t a = 0; a < rows.size(); ++a) {
     double* dst = sct.col(static_cast<Eigen::Index>(a)).data();
-    const int begin = outer[rows[a]];
-    const int end = c.isCompressed() ? outer[rows[a] + 1] : begin + c.innerNonZeroPtr()[rows[a]];
+    const auto [begin, end] = row_entries(c, rows[a]);
     if (begin == end) {
       std::fill(dst, dst + n, 0.0);
       continue;
@@ -69,19 +74,16 @@ void delassus_parts(const ConstraintMatrix& c, const std::vector<int>& rows, con
 Eigen::MatrixXd delassus(const ConstraintMatrix& c, const std::vector<int>& rows, const Eigen::MatrixXd& sct) {
   const int nw = static_cast<int>(rows.size());
   const Eigen::Index ld = sct.rows();
-  const int* outer = c.outerIndexPtr();
   const int* inner = c.innerIndexPtr();
   const double* value = c.valuePtr();
-  const auto row_end = [&](int a) {
-    return c.isCompressed() ? outer[rows[a] + 1] : outer[rows[a]] + c.innerNonZeroPtr()[rows[a]];
-  };
   Eigen::MatrixXd g(nw, nw);
   int b = 0;
   for (; b + 4 <= nw; b += 4) {
     const double* col = sct.col(b).data();
     for (int a = 0; a < nw; ++a) {
       double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-      for (int k = outer[rows[a]], end = row_end(a); k < end; ++k) {
+      const auto [begin, end] = row_entries(c, rows[a]);
+      for (int k = begin; k < end; ++k) {
         const double v = value[k];
         const double* x = col + inner[k];
         s0 += v * x[0];
@@ -96,7 +98,8 @@ Eigen::MatrixXd delassus(const ConstraintMatrix& c, const std::vector<int>& rows
     const double* col = sct.col(b).data();
     for (int a = 0; a < nw; ++a) {
       double sum = 0.0;
-      for (int k = outer[rows[a]], end = row_end(a); k < end; ++k) sum += value[k] * col[inner[k]];
+      const auto [begin, end] = row_entries(c, rows[a]);
+      for (int k = begin; k < end; ++k) sum += value[k] * col[inner[k]];
       g(a, b) = sum;
     }
   }
