@@ -74,12 +74,12 @@ def evaluate_case(args, problem, kind, n):
                   "--threads", str(args.threads), "--json"])
     # The methods are compared as the paper times them: the error estimate, which every
     # method shares and which is timed on its own by `bench`, is off.
-    delta = ["--delta", repr(args.delta), "--option", "estimate=false"]
+    shared = ["--delta", repr(args.delta), "--option", "estimate=false"]
     columns = []
     online = {m: run_json([args.exe, "online", "--db", db, "--method", m, "--validation", "--threads",
-                           str(args.threads), "--json"] + delta) for m in METHODS}
+                           str(args.threads), "--json"] + shared) for m in METHODS}
     verify = run_json([args.exe, "verify", "--db", db, "--method", ",".join(METHODS), "--reference", "fom",
-                       "--bench", "--threads", str(args.threads), "--json"] + delta)
+                       "--bench", "--threads", str(args.threads), "--json"] + shared)
     for m in METHODS:
         o, v = online[m], verify["methods"][m]
         label = m if m != "cpg" else "cpg (tol %g, default)" % default_tolerance(problem)
@@ -89,7 +89,7 @@ def evaluate_case(args, problem, kind, n):
         if tol == default_tolerance(problem):
             continue  # already the default column
         v = run_json([args.exe, "verify", "--db", db, "--method", "cpg", "--reference", "fom", "--bench",
-                      "--cpg-tolerance", repr(tol), "--threads", str(args.threads), "--json"] + delta)["methods"]["cpg"]
+                      "--cpg-tolerance", repr(tol), "--threads", str(args.threads), "--json"] + shared)["methods"]["cpg"]
         columns.append(column("cpg (tol %g)" % tol, v["primal_rank"], v["dual_basis_size"], v["mean_time_s"], v,
                               v["mean_primal_error"], v["mean_dual_error"], v["mean_sparsity"], v["mean_iterations"],
                               v["nonconverged"]))
@@ -98,9 +98,9 @@ def evaluate_case(args, problem, kind, n):
     for m, init, label in (("greedy", "empty", "greedy (init=empty, paper Alg. 1)"),
                            ("cpg", "cell", "cpg (default tol, init=cell)")):
         o = run_json([args.exe, "online", "--db", db, "--method", m, "--option", "init=" + init, "--validation",
-                      "--threads", str(args.threads), "--json"] + delta)
+                      "--threads", str(args.threads), "--json"] + shared)
         v = run_json([args.exe, "verify", "--db", db, "--method", m, "--init", init, "--reference", "fom", "--bench",
-                      "--threads", str(args.threads), "--json"] + delta)["methods"][m]
+                      "--threads", str(args.threads), "--json"] + shared)["methods"][m]
         columns.append(column(label, o["primal_rank"], v["dual_basis_size"], o["mean_time_s"], v, o["mean_primal_error"],
                               o["mean_dual_error"], o["mean_sparsity"], o["mean_iterations"], o["nonconverged"]))
     return {"problem": problem, "kind": kind, "n": n, "db": db, "fom_median_time_s": verify["fom_median_time_s"],
