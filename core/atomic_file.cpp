@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <mutex>
 
 #include <contactrom/core/errors.hpp>
 #include <contactrom/core/format.hpp>
@@ -31,6 +32,24 @@ std::string base_of(const std::string& path) {
 }
 
 std::string cannot_write(const std::string& path) { return "cannot write " + quoted(path, 200) + ": "; }
+
+// --- declared inputs -----------------------------------------------------------
+struct DeclaredInput {
+  std::string path;
+  dev_t dev;
+  ino_t ino;
+};
+std::mutex g_inputs_mutex;
+std::vector<DeclaredInput> g_inputs;
+
+/// Throws InputError if the existing file `st` (of `path`) is a declared input.
+void check_not_declared_input(const std::string& path, const struct stat& st) {
+  const std::lock_guard<std::mutex> lock(g_inputs_mutex);
+  for (const DeclaredInput& in : g_inputs)
+    if (in.dev == st.st_dev && in.ino == st.st_ino)
+      throw InputError(cannot_write(path) + "it is the input file " + quoted(in.path, 200) +
+                       ", which would be replaced; expected another output file");
+}
 
 // --- temporaries removed on signals ------------------------------------------
 //
@@ -111,6 +130,7 @@ void check_output_path(const std::string& path) {
     if (S_ISDIR(st.st_mode)) throw InputError(cannot_write(path) + "it is a folder; expected a file name");
     if (!S_ISREG(st.st_mode))
       throw InputError(cannot_write(path) + "it is a device, pipe or socket, not a regular file; refusing to replace it");
+    check_not_declared_input(path, st);
   } else if (errno != ENOENT) {
     throw InputError(cannot_write(path) + std::strerror(errno));
   }
@@ -132,14 +152,12 @@ void check_output_path(const std::string& path) {
   discard_temporary(probe);
 }
 
-void check_output_not_input(const std::string& output, const std::vector<std::string>& inputs) {
-  struct stat out {};
-  if (::stat(output.c_str(), &out) != 0) return;
-  for (const std::string& input : inputs) {
-    struct stat in {};
-    if (::stat(input.c_str(), &in) == 0 && in.st_dev == out.st_dev && in.st_ino == out.st_ino)
-      throw InputError(cannot_write(output) + "it is the input file " + quoted(input, 200) +
-                       ", which would be replaced; expected another output file");
+void declare_input_files(const std::vector<std::string>& paths) {
+  const std::lock_guard<std::mutex> lock(g_inputs_mutex);
+  for (const std::string& path : paths) {
+    struct stat st {};
+    if (!path.empty() && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode))
+      g_inputs.push_back({path, st.st_dev, st.st_ino});
   }
 }
 

@@ -40,14 +40,19 @@ using FileWriter = std::function<void(std::ostream&)>;
 /// \brief Throws InputError (one line, naming `path` and why) unless `path` can
 /// be written as an output file: non-empty, its folder exists and a file can be
 /// created in it (a temporary file is created and removed), and it is either
-/// absent or a regular file (not a symbolic link, folder, device, pipe or socket).
-/// Commands call it before any long computation.
+/// absent or a regular file (not a symbolic link, folder, device, pipe or socket)
+/// that is not a declared input (declare_input_files()). Commands call it before
+/// any long computation.
 void check_output_path(const std::string& path);
 
-/// \brief Throws InputError if `output` is the same file as one of `inputs`
-/// (same device and inode: another name, a hard link or a relative path of the
-/// file count as the same); absent files are never the same.
-void check_output_not_input(const std::string& output, const std::vector<std::string>& inputs);
+/// \brief Declares files the running program reads (a command's problem file, mesh,
+/// database, parameter list): from then on check_output_path() — and so every write
+/// of this file's functions — refuses a target that is one of them (same device and
+/// inode: another name, a hard link or a relative path of the file count as the
+/// same). Paths that do not name an existing file are ignored. The declarations last
+/// for the life of the process; the command-line tool makes them, a program
+/// embedding the library may.
+void declare_input_files(const std::vector<std::string>& paths);
 
 /// \brief Installs handlers of SIGINT, SIGTERM and SIGHUP that remove the
 /// temporary files being written (write_file_atomically(), temporary_path_for())

@@ -16,41 +16,63 @@ struct PairAtRest {
   std::string slave, master;
   int rows = 0, paired = 0, unpaired_near = 0;
   double overlap = 0.0;  ///< largest penetration of a paired slave node (length)
+  int dim = 2;
 };
+
+/// "curve" (2D) or "surface" (3D).
+std::string boundary_word(const PairAtRest& p) { return p.dim == 3 ? "surface" : "curve"; }
+
+/// Mean length of the master's segments (2D) or of its facets' edges (3D).
+double mean_master_length(const Mesh& mesh, const std::string& master) {
+  double sum = 0.0;
+  size_t n = 0;
+  if (mesh.dim == 3) {
+    const auto it = mesh.faces.find(master);
+    if (it == mesh.faces.end()) return 0.0;
+    for (const auto& facet : it->second) {
+      const int k = facet[3] < 0 ? 3 : 4;
+      for (int e = 0; e < k; ++e, ++n) sum += (mesh.nodes.col(facet[(e + 1) % k]) - mesh.nodes.col(facet[e])).norm();
+    }
+  } else {
+    for (const auto& seg : mesh.group_segments(master)) {
+      sum += (mesh.nodes.col(seg[1]) - mesh.nodes.col(seg[0])).norm();
+      ++n;
+    }
+  }
+  return sum / static_cast<double>(std::max<size_t>(n, 1));
+}
 
 std::vector<PairAtRest> pairs_at_rest(const Problem& problem) {
   std::vector<PairAtRest> out;
-  const auto* contact = dynamic_cast<const NodeToSegmentContact*>(&problem.contact());
+  const ContactModel& contact = problem.contact();
   const Mesh* mesh = problem.mesh();
-  if (!contact || !mesh) return out;
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(contact->surface_dofs().size()));
-  const Pairing pairing = contact->search(zero);
+  if (!contact.has_pairing() || !mesh) return out;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(contact.surface_dofs().size()));
+  const Pairing pairing = contact.search(zero);
   ConstraintMatrix c;
   Eigen::VectorXd g;
-  contact->assemble(pairing, c, g);
+  contact.assemble(pairing, c, g);
   const std::vector<ContactPairSpec>& specs = problem.definition().contact;
   out.resize(specs.size());
-  // "Near" a master curve: within its mean segment length (a node just beyond an
-  // end, as where two surfaces of different lengths meet), per pair.
+  // "Near" a master: within its mean segment (2D) or facet edge (3D) length (a node
+  // just beyond an edge, as where two surfaces of different sizes meet), per pair.
   std::vector<double> reach(specs.size(), 0.0);
   for (size_t q = 0; q < specs.size(); ++q) {
-    out[q].slave = specs[q].slave, out[q].master = specs[q].master;
-    const auto& segments = mesh->group_segments(specs[q].master);
-    for (const auto& seg : segments) reach[q] += (mesh->nodes.col(seg[1]) - mesh->nodes.col(seg[0])).norm();
-    reach[q] /= static_cast<double>(std::max<size_t>(segments.size(), 1));
+    out[q].slave = specs[q].slave, out[q].master = specs[q].master, out[q].dim = mesh->dim;
+    reach[q] = mean_master_length(*mesh, specs[q].master);
   }
-  for (int s = 0; s < contact->num_constraints(); ++s) {
-    const size_t q = static_cast<size_t>(contact->pair_of_row(s));
+  for (int s = 0; s < contact.num_constraints(); ++s) {
+    const size_t q = static_cast<size_t>(contact.pair_of_row(s));
     if (q >= out.size()) continue;
     PairAtRest& pair = out[q];
     ++pair.rows;
     if (pairing.segment[static_cast<size_t>(s)] >= 0) {
       ++pair.paired;
-      pair.overlap = std::max(pair.overlap, -g(s) / contact->weights()(s));
+      pair.overlap = std::max(pair.overlap, -g(s) / contact.weights()(s));
       continue;
     }
-    // Unpaired: near the master curve (one of its nodes within U)?
-    const Eigen::Vector2d x = contact->constraint_points().col(s);
+    // Unpaired: near the master (one of its nodes within reach)?
+    const Eigen::VectorXd x = contact.constraint_points().col(s);
     double nearest = HUGE_VAL;
     for (int node : mesh->group_nodes(pair.master)) nearest = std::min(nearest, (mesh->nodes.col(node) - x).norm());
     if (nearest <= reach[q]) ++pair.unpaired_near;
@@ -85,9 +107,10 @@ std::vector<std::string> reference_contact_warnings(const Problem& problem) {
                     "; expected surfaces that touch or are apart before loading");
     if (p.unpaired_near > 0)
       out.push_back(pair_name(q, p) + ": " + std::to_string(p.unpaired_near) + " of its " + std::to_string(p.rows) +
-                    " slave nodes lie just beyond the ends of the master curve (within one master segment of"
-                    " it) and are not paired, so no pressure acts there; expected a master curve that covers the"
-                    " slave curve");
+                    " slave nodes lie just beyond the " + (p.dim == 3 ? "edges of the master surface (within one"
+                    " facet edge" : "ends of the master curve (within one master segment") + " of it) and are not paired,"
+                    " so no pressure acts there; expected a master " + boundary_word(p) + " that covers the slave " +
+                    boundary_word(p));
   }
   return out;
 }
@@ -96,8 +119,9 @@ void check_contact_pairs_face(const Problem& problem) {
   const std::vector<PairAtRest> pairs = pairs_at_rest(problem);
   for (size_t q = 0; q < pairs.size(); ++q)
     if (pairs[q].rows > 0 && pairs[q].paired == 0)
-      throw InputError(pair_name(q, pairs[q]) + " has no slave node facing its master curve in the reference"
-                       " configuration, so none is ever paired; expected curves that face each other");
+      throw InputError(pair_name(q, pairs[q]) + " has no slave node facing its master " + boundary_word(pairs[q]) +
+                       " in the reference configuration, so none is ever paired; expected " + boundary_word(pairs[q]) +
+                       "s that face each other");
 }
 
 }  // namespace contactrom::fom

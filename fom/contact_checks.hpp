@@ -1,9 +1,10 @@
 #pragma once
 /// \file contact_checks.hpp
 /// \brief The contact pairs of a problem in its reference configuration (no
-/// load): pairs whose surfaces already overlap, slave nodes that lie beyond the
-/// ends of their master curve close to it (they are never paired: no pressure can
-/// act there), and pairs with no slave node facing the master at all.
+/// load), in 2D and 3D: pairs whose surfaces already overlap, slave nodes that lie
+/// beyond the ends of their master curve (the edges of their master surface) close
+/// to it (they are never paired: no pressure can act there), and pairs with no slave
+/// node facing the master at all.
 #include <string>
 #include <vector>
 
@@ -19,12 +20,12 @@ constexpr double kReferenceOverlapFraction = 0.1;
 /// \brief One-line warnings about the contact pairs of `problem` in the reference
 /// configuration: a pair whose paired slave nodes penetrate their master by more
 /// than kReferenceOverlapFraction·U (naming the largest overlap), and slave nodes
-/// that project beyond an end of their master curve while lying within its mean
-/// segment length of it (never paired). Empty for the rope and for problems without those.
+/// that project beyond an end of their master curve (an edge of their master
+/// surface) while lying within its mean segment (facet edge) length of it (never paired). Empty for the rope and for problems without those.
 std::vector<std::string> reference_contact_warnings(const Problem& problem);
 
 /// \brief Throws InputError naming the pair unless every contact pair has at least
-/// one slave node facing its master curve (paired) in the reference configuration:
+/// one slave node facing its master curve or surface (paired) in the reference configuration:
 /// a pair none of whose nodes is ever paired enforces nothing.
 void check_contact_pairs_face(const Problem& problem);
 

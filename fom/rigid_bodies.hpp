@@ -23,13 +23,17 @@ struct FreeRigidMotion {
   std::string motion;  ///< e.g. "translation in x", "rotation about (0.5, 1)"
 };
 
-/// \brief The free rigid motions of every connected piece of a plane mesh (nodes
-/// linked by its elements): with the piece's Dirichlet dofs as the rows of
-/// \f$ A \f$ (the x or y component of the plane rigid motions \f$ t_x, t_y \f$ and
-/// the rotation about the piece's centre, scaled by its size), a motion is free
-/// when it lies in the (numerical) null space of \f$ A^T A \f$: an eigenvalue below
-/// `relative_tolerance` times the largest. A piece with no Dirichlet dof at all is
-/// reported once, as "held by no Dirichlet condition". Empty for the 1D rope.
+/// \brief The free rigid motions of every connected piece of the mesh (nodes linked
+/// by its elements): with the piece's Dirichlet dofs as the rows of \f$ A \f$ (the
+/// component along the dof of each rigid motion: in 2D the translations \f$ t_x, t_y
+/// \f$ and the rotation about the piece's centre, in 3D the three translations and
+/// the three rotations about it, rotations scaled by the piece's size), a motion is
+/// free when it lies in the (numerical) null space of \f$ A^T A \f$: an eigenvalue
+/// below `relative_tolerance` times the largest. Free translations are reported
+/// first ("free to translate in x"), then rotations ("free to rotate about (x, y)";
+/// in 3D "about the axis parallel to z through (x, y, z)"). A piece with no
+/// Dirichlet dof at all is reported once, as "held by no Dirichlet condition".
+/// Empty for the 1D rope.
 std::vector<FreeRigidMotion> free_rigid_motions(const Problem& problem, double relative_tolerance = 1e-10);
 
 /// \brief Refuses a problem with a free rigid motion (the FOM solvers call it before

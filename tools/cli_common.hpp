@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <variant>
 
+#include <contactrom/core/atomic_file.hpp>
 #include <contactrom/core/parallel_for.hpp>
 #include <contactrom/fom/input_values.hpp>
 #include <contactrom/fom/kkt.hpp>
@@ -117,6 +118,14 @@ inline CLI::Validator non_empty_path() {
         return value.empty() ? std::string("'' is empty; expected a path") : std::string();
       },
       "PATH");
+}
+
+/// Declares the problem's file and mesh as inputs of the command (declare_input_files():
+/// no output may replace them), then checks `outputs` again against them.
+inline void declare_problem_inputs(const fom::Problem& problem, const std::vector<std::string>& outputs = {}) {
+  declare_input_files({problem.definition().path, problem.definition().mesh});
+  for (const std::string& out : outputs)
+    if (!out.empty()) check_output_path(out);
 }
 
 /// A parameter as a JSON number (one value) or array (several).

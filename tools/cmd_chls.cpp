@@ -54,9 +54,11 @@ struct ChlsArgs {
 };
 
 void run_chls(const ChlsArgs& a) {
-  if (!a.out.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.db});
+  declare_input_files({a.db});
+  if (!a.out.empty()) check_output_path(a.out);
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
+  declare_problem_inputs(*problem, {a.out});
   const rom::DatabaseChls chls = rom::chls_of_database(db);
   const std::vector<int>& used = chls.snapshots;
   const rom::ChlsResult& r = chls.result;
@@ -114,9 +116,11 @@ struct HullArgs {
 };
 
 void run_hull_report(const HullArgs& a) {
-  if (!a.out.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.db});
+  declare_input_files({a.db});
+  if (!a.out.empty()) check_output_path(a.out);
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
+  declare_problem_inputs(*problem, {a.out});
   rom::check_convex_hull_applicable(*problem);
   rom::ReducedModelOptions model_options;
   model_options.delta = a.delta;

@@ -29,6 +29,7 @@ void run_fom(const FomArgs& a) {
   fom::ProblemOptions popt;
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);
+  declare_problem_inputs(*problem);
   const fom::Param mu = parse_problem_param(*problem, a.param);
   const std::vector<std::string> warnings = fom::reference_contact_warnings(*problem);
   for (const std::string& w : warnings) std::cerr << "contactrom: warning: " << w << "\n";

@@ -20,8 +20,8 @@ struct MergeArgs {
 };
 
 void run_merge(const MergeArgs& a) {
+  declare_input_files(a.inputs);
   check_output_path(a.out);
-  check_output_not_input(a.out, a.inputs);
   std::vector<rom::SnapshotDatabase> dbs;
   // The primal snapshots stay on disk: the merged file is written one snapshot at a time.
   for (const auto& path : a.inputs) dbs.push_back(rom::read_database(path, false));

@@ -113,11 +113,12 @@ void write_on_root(const std::string& path, const std::function<const rom::Snaps
 std::unique_ptr<fom::Problem> open_run(const OfflineArgs& a, const Ranks& ranks) {
   if (a.out.empty() == a.append.empty()) throw InputError("offline needs one of --out DB.h5 and --append DB.h5");
   const std::string& out = a.append.empty() ? a.out : a.append;
+  if (a.append.empty()) declare_input_files({a.problem});
   check_output_path(out);  // before the snapshots are computed
-  if (a.append.empty()) check_output_not_input(out, {a.problem});
   fom::ProblemOptions popt;
   popt.refine = a.refine;
   auto problem = fom::make_problem(a.problem, popt);
+  declare_problem_inputs(*problem, {out});
   if (ranks.root())
     for (const std::string& w : fom::reference_contact_warnings(*problem)) std::cerr << "contactrom: warning: " << w << "\n";
   return problem;

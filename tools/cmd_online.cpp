@@ -143,7 +143,8 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
 }
 
 void run_online(const OnlineArgs& a) {
-  if (!a.out.empty() && a.param.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.db, a.params});
+  declare_input_files({a.db, a.params});
+  if (!a.out.empty() && a.param.empty()) check_output_path(a.out);
   if (!a.param.empty() && a.validation)
     throw InputError("--param and --validation exclude each other; give one");
   if (!a.param.empty() && !a.params.empty())
@@ -153,6 +154,7 @@ void run_online(const OnlineArgs& a) {
                      "expected a folder name (a CSV of results comes from --validation or contactrom query --out)");
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
+  declare_problem_inputs(*problem, {a.param.empty() ? a.out : std::string()});
   const rom::OnlineSolverOptions options = a.solver_options();
   // Validate the method name before the (more expensive) model construction.
   rom::check_online_method(a.method);

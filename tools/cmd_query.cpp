@@ -52,11 +52,13 @@ nlohmann::json result_json(const rom::OnlineModel& rom, const rom::OnlineResult&
 
 void run_query(const QueryArgs& a) {
   if (a.param.empty() == a.params.empty()) throw InputError("give exactly one of --param V and --params FILE.csv");
-  if (!a.out.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.rom, a.params});
+  declare_input_files({a.rom, a.params});
+  if (!a.out.empty()) check_output_path(a.out);
   const auto t0 = std::chrono::steady_clock::now();
   const rom::OnlineModel rom = rom::OnlineModel::load(a.rom);
   const double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const fom::Problem& problem = rom.problem();
+  declare_problem_inputs(problem, {a.out});
   const std::vector<fom::Param> params =
       a.param.empty() ? rom::read_parameter_csv(a.params, problem) : std::vector<fom::Param>{parse_problem_param(problem, a.param)};
   rom::FallbackOptions fallback_options;

@@ -31,8 +31,8 @@ struct ReduceArgs : MethodArgs {
 };
 
 void run_reduce(const ReduceArgs& a) {
+  declare_input_files({a.db});
   check_output_path(a.out);
-  check_output_not_input(a.out, {a.db});
   rom::check_online_method(a.method);
   const auto t0 = std::chrono::steady_clock::now();
   // The primal snapshots stay on disk: the POD reads them by blocks (rom/pod.hpp).

@@ -234,10 +234,12 @@ void print_text(const VerifyArgs& a, const rom::SnapshotDatabase& db, const rom:
 }
 
 void run_verify(const VerifyArgs& a) {
-  if (!a.out.empty()) check_output_path(a.out), check_output_not_input(a.out, {a.db});
+  declare_input_files({a.db});
+  if (!a.out.empty()) check_output_path(a.out);
   baselines::VerifyOptions options = verify_options(a);
   const rom::SnapshotDatabase db = rom::read_database(a.db);
   auto problem = rom::problem_from_database(db, a.db);
+  declare_problem_inputs(*problem, {a.out});
   rom::ReducedModelOptions model_options;
   model_options.delta = a.delta;
   const rom::ReducedModel model(*problem, db, model_options);

@@ -81,6 +81,32 @@ BOOST_FIXTURE_TEST_CASE(an_output_that_is_an_input_is_refused, Fixture) {
   BOOST_TEST(temporaries_in(dir) == 0);
 }
 
+BOOST_FIXTURE_TEST_CASE(an_output_over_a_problem_file_its_mesh_or_a_parameter_list_is_refused, Fixture) {
+  // A copy of hertz (problem file and mesh) in the test's folder.
+  fs::copy_file(fs::path(CONTACTROM_SOURCE_DIR) / "meshes/hertz.geo", file("hertz.geo"));
+  std::string toml = slurp(std::string(CONTACTROM_SOURCE_DIR) + "/problems/hertz.toml");
+  const size_t at = toml.find("mesh = ");
+  BOOST_REQUIRE(at != std::string::npos);
+  toml.replace(at, toml.find('\n', at) - at, "mesh = \"hertz.geo\"");
+  std::ofstream(file("hertz.toml")) << toml;
+  const std::string geo_bytes = slurp(file("hertz.geo"));
+  const std::string problem = " --problem " + file("hertz.toml");
+  check_refused("offline" + problem + " --train 2 --out " + file("hertz.geo"), "is the input file");
+  check_refused("offline" + problem + " --adaptive --tolerance 0.1 --out " + file("hertz.geo"), "is the input file");
+  BOOST_TEST(slurp(file("hertz.geo")) == geo_bytes);
+  // query --fields writes <problem>_<method>_surface.csv: a parameter list of that
+  // name in the field folder is an input and stays.
+  const std::string db = file("h.h5"), rom = file("h_rom.h5");
+  BOOST_REQUIRE(run_command(kExe + " offline" + problem + " --train 4 --out " + db).exit_code == 0);
+  BOOST_REQUIRE(run_command(kExe + " reduce --db " + db + " --method greedy --out " + rom).exit_code == 0);
+  fs::create_directories(file("fields"));
+  const std::string params = file("fields/hertz_greedy_surface.csv");
+  std::ofstream(params) << "0.1\n";
+  check_refused("query --rom " + rom + " --params " + params + " --fields " + file("fields"), "is the input file");
+  BOOST_TEST(slurp(params) == "0.1\n");
+  BOOST_TEST(temporaries_in(dir) == 0);
+}
+
 BOOST_FIXTURE_TEST_CASE(an_output_folder_without_write_access_is_refused_before_the_work, Fixture) {
   // /proc admits no new file, even for root: the refusal names the folder and comes
   // from the check before the snapshots (the message of that check).

@@ -226,6 +226,64 @@ bool any_contains(const std::vector<std::string>& lines, const std::string& text
 
 }  // namespace
 
+/// A block [0.3, 0.7]² x [z0, z0 + 0.3] on a slab [0, 1]² x [−0.4, 0] (3D, tetrahedra),
+/// the block's top moved by `top` and the slab's bottom clamped.
+std::string blocks3d_toml(const std::string& dir, double z0, const std::string& top) {
+  const std::string z = std::to_string(z0), z1 = std::to_string(z0 + 0.3);
+  const std::string geo = write_file(
+      dir, "b3.geo",
+      "SetFactory(\"OpenCASCADE\");\nBox(1) = {0, 0, -0.4, 1, 1, 0.4};\nBox(2) = {0.3, 0.3, " + z + ", 0.4, 0.4, 0.3};\n"
+      "e = 1e-6;\nPhysical Volume(\"slab\") = {1};\nPhysical Volume(\"block\") = {2};\n"
+      "bb() = Surface In BoundingBox{0.3-e, 0.3-e, " + z + "-e, 0.7+e, 0.7+e, " + z + "+e};\n"
+      "top() = Surface In BoundingBox{-e, -e, -e, 1+e, 1+e, e};\ntop() -= bb();\n"
+      "Physical Surface(\"slab_top\") = top();\n"
+      "Physical Surface(\"slab_bottom\") = Surface In BoundingBox{-e, -e, -0.4-e, 1+e, 1+e, -0.4+e};\n"
+      "Physical Surface(\"block_bottom\") = bb();\n"
+      "Physical Surface(\"block_top\") = Surface In BoundingBox{0.3-e, 0.3-e, " + z1 + "-e, 0.7+e, 0.7+e, " + z1 + "+e};\n"
+      "Mesh.CharacteristicLengthMax = 0.2;\n");
+  return write_file(dir, "b3.toml",
+                    "[problem]\nname = \"b3\"\nmesh = \"" + geo + "\"\nformulation = \"3d\"\ndisplacement_scale = 0.02\n"
+                    "[[parameters]]\nname = \"d\"\nrange = [0.0, 0.02]\nlower_open = true\n"
+                    "[[bodies]]\ngroup = \"slab\"\nyoung = 1.0\npoisson = 0.3\n"
+                    "[[bodies]]\ngroup = \"block\"\nyoung = 1.0\npoisson = 0.3\n"
+                    "[[dirichlet]]\ngroup = \"slab_bottom\"\ndisplacement = [0.0, 0.0, 0.0]\n"
+                    "[[dirichlet]]\ngroup = \"block_top\"\ndisplacement = " + top + "\n"
+                    "[[contact]]\nslave = \"block_bottom\"\nmaster = \"slab_top\"\n");
+}
+
+BOOST_AUTO_TEST_CASE(in_3d_free_rigid_motions_are_named_and_overlaps_warned_about) {
+  const std::string dir = contactrom::test::temp_dir();
+  // Held in every direction, resting on the slab: no refusal, no warning.
+  const auto held = fom::make_problem(blocks3d_toml(dir, 0.0, "[0.0, 0.0, \"-d\"]"));
+  BOOST_CHECK_NO_THROW(fom::check_rigid_motions_held(*held));
+  BOOST_TEST(fom::reference_contact_warnings(*held).empty());
+  // The top free in x: the block slides in x.
+  const std::string slide = contactrom::test::input_error_of([&] {
+    const auto problem = fom::make_problem(blocks3d_toml(dir, 0.0, "[\"free\", 0.0, \"-d\"]"));
+    fom::ActiveSetSolver solver(*problem);
+  });
+  BOOST_TEST(slide.find("body 'block' is free to translate in x (") != std::string::npos, slide);
+  // Free in x and y: both translations and the rotation about the vertical axis
+  // through the block's centre, which the top's z-components do not stop.
+  const std::string plane = contactrom::test::input_error_of([&] {
+    const auto problem = fom::make_problem(blocks3d_toml(dir, 0.0, "[\"free\", \"free\", \"-d\"]"));
+    baselines::IpoptQpSolver solver(*problem);
+  });
+  BOOST_TEST(plane.find("free to translate in x and free to translate in y and free to rotate about the axis parallel"
+                        " to z through (0.5, 0.5, 0.15)") != std::string::npos,
+             plane);
+  // The block sunk 0.05 (2.5 U) into the slab: warned about.
+  const auto sunk = fom::reference_contact_warnings(*fom::make_problem(blocks3d_toml(dir, -0.05, "[0.0, 0.0, \"-d\"]")));
+  BOOST_TEST(any_contains(sunk, "overlaps by 0.05"), (sunk.empty() ? "" : sunk[0]));
+  // Every shipped 3D problem holds its bodies and starts without overlap.
+  for (const char* name : {"hertz3d", "ironing3d"}) {
+    const auto problem = fom::make_problem(name);
+    BOOST_CHECK_NO_THROW(fom::check_rigid_motions_held(*problem));
+    BOOST_TEST(fom::reference_contact_warnings(*problem).empty());
+  }
+  fs::remove_all(dir);
+}
+
 BOOST_AUTO_TEST_CASE(overlaps_and_unpaired_slave_nodes_are_warned_about_and_a_pair_that_never_meets_refused) {
   const std::string dir = contactrom::test::temp_dir();
   const auto build = [&](double width, double x0, double y0) {
