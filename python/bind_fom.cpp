@@ -139,7 +139,10 @@ with u = u_lift(mu) + u0 on all dofs (Dirichlet dofs kept).)doc");
           py::arg("n"), "Training parameters of size or level n (the problem's [training] plan), shape (m, n_params).")
       .def(
           "validation_set",
-          [](const fom::Problem& p, int n) { return params_array(fom::validation_set(p, n), p.num_params()); },
+          [](const fom::Problem& p, int n) {
+            (void)fom::training_set(p, n);  // n checked as a training size or level
+            return params_array(fom::validation_set(p, n), p.num_params());
+          },
           py::arg("n"), "Validation parameters associated with training size or level n.")
       .def(
           "K", [](const fom::Problem& p, py::handle mu) { return p.stiffness(to_param(p, mu)); }, py::arg("mu"),
@@ -218,7 +221,7 @@ here when it does not depend on mu) or Ipopt (solver="ipopt").)doc")
              s->solver = baselines::make_fom_solver(*problem, solver);
              return s;
            }),
-           py::arg("problem"), py::arg("solver") = "active-set", R"doc(
+           py::arg("problem").none(false), py::arg("solver") = "active-set", R"doc(
 The FOM solver of `problem` (a contactrom.Problem): solver="active-set" (default:
 contactrom's dual active set, K factorised here once when no Young's modulus depends
 on mu) or "ipopt" (the interior-point reference). ValueError for another name.)doc")
@@ -260,12 +263,13 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
         {
           py::gil_scoped_release release;
           r = baselines::verify_solution(*problem, p, u, lam, reference ? &reference->solution : nullptr, degenerate_tol);
+          if (r.status == Status::InvalidInput) throw InputError(r.message);
           if (r.has_reference && r.status == Status::Success)
             errors = fom::reference_errors(*problem, u, lam, reference->solution.u, reference->solution.lambda);
         }
         return report_dict(r, r.has_reference && r.status == Status::Success ? &errors : nullptr);
       },
-      py::arg("problem"), py::arg("mu"), py::arg("u"), py::arg("lam"), py::arg("reference") = nullptr,
+      py::arg("problem").none(false), py::arg("mu"), py::arg("u"), py::arg("lam"), py::arg("reference") = nullptr,
       py::arg("degenerate_tol") = 1e-8, R"doc(
 KKT verification of a candidate (u, lam) at mu: {'status', 'message', 'kkt': {...},
 'errors': {'primal_error', 'dual_error', 'errors', 'active_set_differences'} or None}.

@@ -2,9 +2,11 @@
 // rom/focuss.hpp) on numpy arrays. Shapes and finiteness are checked here, so a
 // wrong input is a ValueError naming it rather than a zero vector with status
 // invalid_input.
+#include <cmath>
 #include <functional>
 
 #include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
 #include <contactrom/core/nnls.hpp>
 #include "python/bindings.hpp"
 #include <contactrom/rom/focuss.hpp>
@@ -30,6 +32,12 @@ void check_system(const char* kernel, const Eigen::MatrixXd& a, const Eigen::Vec
   if (!b.allFinite()) throw InputError(std::string(kernel) + ": " + b_name + " has a non-finite entry");
 }
 
+/// A tolerance must be a finite number >= 0 (as `contactrom sparse --tol`).
+void check_tolerance(const char* kernel, const char* name, double value) {
+  if (!(std::isfinite(value) && value >= 0.0))
+    throw InputError(std::string(kernel) + ": " + name + " = " + format_number(value) + "; expected a finite number >= 0");
+}
+
 /// Runs `solve` without the GIL and packs the solver's outcome.
 template <class Solver>
 SparseResult run(Solver& solver, const std::function<Eigen::VectorXd()>& solve) {
@@ -53,6 +61,11 @@ void bind_focuss(py::module_& m, const char* name, const char* doc) {
       [name](const Eigen::MatrixXd& d, const Eigen::VectorXd& x, int max_iterations, double tolerance,
              double prune_tolerance) {
         check_system(name, d, x, "D", "x");
+        check_tolerance(name, "tolerance", tolerance);
+        check_tolerance(name, "prune_tolerance", prune_tolerance);
+        if (max_iterations < 1)
+          throw InputError(std::string(name) + ": max_iterations = " + std::to_string(max_iterations) +
+                           "; expected an iteration cap >= 1");
         rom::FocussOptions o;
         o.max_iterations = max_iterations;
         o.tolerance = tolerance;
@@ -81,6 +94,7 @@ void bind_kernels(py::module_& m) {
       "nnls",
       [](const Eigen::MatrixXd& a, const Eigen::VectorXd& b, int max_iterations, double tolerance) {
         check_system("nnls", a, b, "A", "b");
+        check_tolerance("nnls", "tolerance", tolerance);
         NnlsOptions o;
         o.max_iterations = max_iterations;
         o.tolerance = tolerance;
@@ -93,6 +107,9 @@ void bind_kernels(py::module_& m) {
       "omp",
       [](const Eigen::MatrixXd& d, const Eigen::VectorXd& x, int max_atoms, double tolerance) {
         check_system("omp", d, x, "D", "x");
+        check_tolerance("omp", "tolerance", tolerance);
+        if (max_atoms < -1)
+          throw InputError("omp: max_atoms = " + std::to_string(max_atoms) + "; expected a number of atoms >= 0, or -1 (no limit)");
         rom::OmpOptions o;
         o.max_atoms = max_atoms;
         o.tolerance = tolerance;

@@ -103,7 +103,7 @@ py::dict fallback_answer(const rom::FallbackAnswer& a) {
   py::dict d;
   d["solution"] = a.result;
   d["source"] = a.from_fom ? "fom" : "rom";
-  d["reason"] = a.reason;
+  d["fallback_reason"] = a.reason;
   d["rom_status"] = std::string(to_string(a.rom_status));
   d["rom_primal_estimate"] = a.rom_primal_estimate;
   d["rom_dual_estimate"] = a.rom_dual_estimate;
@@ -177,7 +177,10 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
       .def_property_readonly("num_dofs", [](const Database& d) { return d.db->num_dofs(); })
       .def_property_readonly("num_constraints", [](const Database& d) { return d.db->num_constraints(); })
       .def_property_readonly("param_names", [](const Database& d) { return d.db->problem.param_names; })
-      .def_property_readonly("training_kind", [](const Database& d) { return d.db->training_kind; })
+      .def_property_readonly(
+          "training_kind", [](const Database& d) { return d.explicit_params ? std::string("explicit") : d.db->training_kind; },
+          "'train' or 'level' (a training set, `--train n` / `--level n`), 'list', 'adaptive', or 'explicit' (the "
+          "parameters given to offline()).")
       .def_property_readonly("training_size", [](const Database& d) { return d.db->training_size; })
       .def_property_readonly(
           "parameters", [](py::object self) { return columns_as_rows(self.cast<const Database&>().db->parameters, self); },
@@ -225,6 +228,10 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
           "save",
           [](const Database& d, py::handle path_like) {
             const std::string path = path_arg(path_like);
+            if (d.explicit_params)
+              throw InputError("cannot write " + quoted(path, 200) + ": the database holds snapshots at the parameters "
+                               "given to offline(), not a training set, and no reader accepts such a file; expected a "
+                               "database of offline(problem, n) or offline_adaptive()");
             py::gil_scoped_release release;
             rom::write_database(path, *d.db);
           },
@@ -255,8 +262,20 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
         options.threads = threads;
         Database d;
         d.problem = problem;
-        if (py::isinstance<py::int_>(params)) {
-          const int n = params.cast<int>();
+        // An int n (numpy's integers too): the training set of size or level n.
+        const bool is_int =
+            !py::isinstance<py::bool_>(params) && !py::isinstance<py::array>(params) && PyIndex_Check(params.ptr());
+        if (!is_int && (py::isinstance<py::float_>(params) || (py::hasattr(params, "dtype") && !py::isinstance<py::array>(params))))
+          throw InputError("params " + std::string(py::str(py::repr(params))) +
+                           " is a number but not an int; expected an int n (the training set of size or level n) or an"
+                           " array of parameters of shape (n, " + std::to_string(problem->num_params()) + ")");
+        if (is_int) {
+          const int n = py::int_(params.attr("__index__")()).cast<int>();
+          const fom::SamplingPlan& plan = problem->definition().training;
+          if (plan.selector() == "list" && n != static_cast<int>(plan.points.size()))
+            throw InputError("problem " + quoted(problem->name(), 200) + " trains on its " +
+                             std::to_string(plan.points.size()) + " listed points; expected params " +
+                             std::to_string(plan.points.size()) + " (or an array of parameters), not " + std::to_string(n));
           py::gil_scoped_release release;
           d.db = std::make_shared<rom::SnapshotDatabase>(rom::generate_snapshots(*problem, n, options));
         } else {
@@ -264,10 +283,11 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
           py::gil_scoped_release release;
           d.db = std::make_shared<rom::SnapshotDatabase>(
               rom::generate_snapshots(*problem, ps, "train", static_cast<int>(ps.size()), options));
+          d.explicit_params = true;
         }
         return d;
       },
-      py::arg("problem"), py::arg("params"), py::arg("threads") = 0, R"doc(
+      py::arg("problem").none(false), py::arg("params"), py::arg("threads") = 0, R"doc(
 FOM snapshots in parallel (GIL released). `params` is an int n (the training set
 of size or level n, as `contactrom offline --train n` / `--level n`) or an array
 of parameters (n, n_params); a database of other parameters than a training set
@@ -297,7 +317,7 @@ works in memory but is refused when read back from a file.)doc");
                                                                 : trainer.run());
         return d;
       },
-      py::arg("problem"), py::arg("tolerance") = py::none(), py::arg("threads") = 0, py::arg("resume") = py::none(),
+      py::arg("problem").none(false), py::arg("tolerance") = py::none(), py::arg("threads") = 0, py::arg("resume") = py::none(),
       py::arg("path") = py::none(), adaptive_doc().c_str());
 
   m.def(
@@ -358,7 +378,12 @@ works in memory but is refused when read back from a file.)doc");
             }
             return fallback_answer(a);
           },
-          py::arg("mu"), "One query: the ROM's answer if kept, else the FOM's (a dict; see ReducedModel.with_fallback).");
+          py::arg("mu"), "One query: the ROM's answer if kept, else the FOM's (a dict; see ReducedModel.with_fallback).")
+      .def("__repr__", [](const Fallback& f) {
+        return "<contactrom.FallbackModel " + f.rom->method() + ", primal tolerance " +
+               format_number(f.solver->options().primal_tolerance) + ", dual tolerance " +
+               format_number(f.solver->options().dual_tolerance) + ">";
+      });
 
   py::class_<ReducedModel>(m, "ReducedModel", R"doc(
 POD basis, dual dictionary, reduced operators and an online method, built from a
@@ -439,7 +464,7 @@ not succeed. ValueError names the argument for a bad value.)doc")
           py::arg("dual_tolerance") = rom::FallbackOptions().dual_tolerance, R"doc(
 The model with the FOM behind it (as `contactrom query --fallback fom`): its solve(mu)
 returns a dict with 'solution' (a RomSolution: the ROM's answer, or the FOM's u, lam
-and status), 'source' ('rom' or 'fom'), 'reason', 'rom_status',
+and status), 'source' ('rom' or 'fom'), 'fallback_reason', 'rom_status',
 'rom_primal_estimate', 'rom_dual_estimate', 'rom_time_s' and 'fom_time_s'. An answer
 is kept from the ROM when its status is success and 3 x its estimates are within the
 tolerances.)doc")

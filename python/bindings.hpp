@@ -38,6 +38,9 @@ using ProblemPtr = std::shared_ptr<const fom::Problem>;
 struct Database {
   std::shared_ptr<const rom::SnapshotDatabase> db;
   ProblemPtr problem;
+  /// Snapshots at parameters the caller gave (not a training set): usable in memory,
+  /// never written (no reader accepts such a file).
+  bool explicit_params = false;
 };
 
 /// \brief A FOM solution with its KKT residuals (computed once, after the solve).

@@ -110,6 +110,14 @@ py::dict kkt_dict(const fom::KktResiduals& k) {
 
 std::string option_text(py::handle value) {
   if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
+  // numpy scalars (np.int64(3), np.float32(1e-6), np.bool_(True)): by their kind.
+  if (!py::isinstance<py::str>(value) && py::hasattr(value, "dtype") && py::hasattr(value.attr("dtype"), "kind") &&
+      py::len(py::getattr(value, "shape", py::tuple())) == 0) {
+    const std::string kind = py::str(value.attr("dtype").attr("kind"));
+    if (kind == "b") return value.attr("item")().cast<bool>() ? "true" : "false";
+    if (kind == "i" || kind == "u") return py::str(value.attr("item")());
+    if (kind == "f") return format_number(value.attr("item")().cast<double>());
+  }
   if (py::isinstance<py::int_>(value)) return py::str(value);
   if (py::isinstance<py::float_>(value)) return format_number(value.cast<double>());
   if (py::isinstance<py::str>(value)) return value.cast<std::string>();

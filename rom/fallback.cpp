@@ -51,6 +51,7 @@ FallbackAnswer FallbackSolver::solve(const fom::Param& mu) const {
   r.message = sol.message;
   r.converged = sol.status == Status::Success;
   r.iterations = sol.iterations;
+  r.u_hat.resize(0);
   r.selected.clear();
   r.coefficients.resize(0);
   r.primal_estimate = r.dual_estimate = 0.0;

@@ -36,8 +36,9 @@ struct FallbackOptions {
 /// \brief Where an answer came from, and why.
 struct FallbackAnswer {
   /// The answer: the ROM's, or (from_fom) the FOM's displacement, pressure, status and
-  /// contact residuals, with time_s the ROM's and the FOM's time together and the
-  /// estimates 0 (it is the reference).
+  /// contact residuals, with time_s the ROM's and the FOM's time together, the
+  /// estimates 0 (it is the reference) and no reduced coordinates (u_hat empty: the
+  /// FOM's u is not in the basis).
   OnlineResult result;
   bool from_fom = false;   ///< the FOM answered
   std::string reason;      ///< why the ROM's answer was not kept (empty when it was)
@@ -62,6 +63,8 @@ class FallbackSolver {
   FallbackAnswer solve(const fom::Param& mu) const;
   /// Time spent building the FOM (factorisation), 0 until a query needed it.
   double fom_setup_time() const;
+  /// The tolerances it was made with.
+  const FallbackOptions& options() const { return m_options; }
 
  private:
   const fom::ActiveSetSolver& fom_solver() const;

@@ -120,7 +120,7 @@ def test_paths_may_be_path_like(tmp_path):
     import pathlib
     source = pathlib.Path(__file__).resolve().parents[2]  # the source tree
     problem = contactrom.problem("rope")
-    db = contactrom.offline(problem, 3)
+    db = contactrom.offline(problem, 9)
     path = tmp_path / "rope.h5"
     db.save(path)
     assert contactrom.load_database(path).problem.name == "rope"
@@ -150,3 +150,50 @@ def test_threads_take_the_clis_values(tmp_path):
                 call()
             assert message_of(e) == f"threads = {bad} invalid; expected an integer in [0, 1024] (0: all cores)"
     assert not (tmp_path / "bad.h5").exists()
+
+
+def test_none_for_a_problem_is_a_type_error_not_a_crash():
+    for call in (lambda: contactrom.FullOrderSolver(None), lambda: contactrom.offline(None, 3),
+                 lambda: contactrom.offline_adaptive(None, tolerance=0.1),
+                 lambda: contactrom.verify(None, 0.1, [0.0], [0.0])):
+        with pytest.raises(TypeError):
+            call()
+
+
+def test_offline_counts_and_explicit_parameters(tmp_path):
+    hertz = contactrom.problem("hertz")
+    # numpy's integers are counts; a float is refused, naming it.
+    assert contactrom.offline(hertz, np.int64(3)).training_size == 3
+    with pytest.raises(ValueError, match=r"params 3.0 is a number but not an int"):
+        contactrom.offline(hertz, 3.0)
+    # A problem trained on a list takes no other count (the CLI refuses --train).
+    with pytest.raises(ValueError, match="trains on its 9 listed points"):
+        contactrom.offline(contactrom.problem("rope"), 5)
+    # Snapshots at given parameters say so and are not written as a training set.
+    explicit = contactrom.offline(hertz, [[0.1], [0.2]])
+    assert explicit.training_kind == "explicit"
+    with pytest.raises(ValueError, match="not a training set"):
+        explicit.save(tmp_path / "never_written.h5")
+    assert not (tmp_path / "never_written.h5").exists()
+    with pytest.raises(ValueError, match="training size 0 is invalid"):
+        hertz.validation_set(0)
+
+
+def test_numpy_scalars_are_option_values_and_kernel_settings_are_checked():
+    db = contactrom.offline(contactrom.problem("hertz"), 4)
+    rom = contactrom.ReducedModel(db, options={"max_iterations": np.int64(3), "tau": np.float32(1e-6)})
+    assert rom.solve(0.1).iterations <= 3
+    with pytest.raises(ValueError, match="tolerance = nan; expected a finite number >= 0"):
+        contactrom.omp(np.eye(2), np.ones(2), tolerance=float("nan"))
+    with pytest.raises(ValueError, match="tolerance = -1"):
+        contactrom.nnls(np.eye(2), np.ones(2), tolerance=-1)
+    with pytest.raises(ValueError, match="max_iterations = 0"):
+        contactrom.focuss(np.eye(2), np.ones(2), max_iterations=0)
+
+
+def test_verify_refuses_a_reference_of_another_parameter():
+    hertz = contactrom.problem("hertz")
+    fom = contactrom.FullOrderSolver(hertz)
+    a, b = fom.solve(0.1), fom.solve(0.2)
+    with pytest.raises(ValueError, match="another parameter"):
+        contactrom.verify(hertz, 0.1, a.u, a.lam, reference=b)
