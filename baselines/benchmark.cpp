@@ -5,6 +5,7 @@
 #include <memory>
 
 #include <contactrom/baselines/ipopt_qp.hpp>
+#include <contactrom/core/format.hpp>
 #include <contactrom/baselines/online_methods.hpp>
 #include <contactrom/fom/active_set_solver.hpp>
 
@@ -134,6 +135,11 @@ BenchReport benchmark(const rom::ReducedModel& model, const std::vector<fom::Par
     rom::OnlineSolverOptions o = rom::options_from_map(v.method, v.options);
     // The reduced answer is timed alone (the error estimate is a separate variant).
     if (!v.options.count("estimate")) o.estimate = false;
+    if (o.estimate && !problem.stiffness_is_constant()) {
+      r.not_applicable[v.key] = "no error estimate: the stiffness of problem " + quoted(problem.name(), 200) +
+                                " depends on its parameters";
+      continue;
+    }
     try {
       owned.push_back(rom::make_online_solver(v.method, model, o));
     } catch (const InputError& e) {

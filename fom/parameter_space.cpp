@@ -158,7 +158,7 @@ class AffineReader {
   void check_no_product() {
     skip_space();
     if (!at_end() && (peek() == '*' || peek() == '/'))
-      fail("multiplies or divides a parameter; expected an affine expression (terms number, name or number*name)");
+      fail("multiplies or divides a parameter (an affine expression has terms number, name or number*name)");
   }
   void add_name(double factor, AffineExpression& e) {
     const size_t start = m_pos;

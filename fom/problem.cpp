@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <set>
 #include <sstream>
@@ -156,9 +157,9 @@ class Builder {
     std::set<int> contact_nodes;
     for (const ContactPairSpec& c : m_def.contact)
       for (const std::string* name : {&c.slave, &c.master}) {
-        group_nodes(*name, c.where, "physical surface");
+        group_nodes(*name, c.where_of(*name), "physical surface");
         if (m_mesh.faces.count(*name) == 0)
-          throw InputError(m_def.where(c.where) + ": '" + *name + "' is not a physical surface with facets");
+          throw InputError(m_def.where(c.where_of(*name)) + ": '" + *name + "' is not a physical surface with facets");
         for (const auto& f : m_mesh.faces.at(*name))
           for (int v : f)
             if (v >= 0) contact_nodes.insert(v);
@@ -192,7 +193,7 @@ class Builder {
       for (const std::string* name : {&c.slave, &c.master})
         for (const auto& f : m_mesh.faces.at(*name))
           if (face_count[key(f)] != 1)
-            throw InputError(m_def.where(c.where) + ": the surface '" + *name + "' has the facet at " +
+            throw InputError(m_def.where(c.where_of(*name)) + ": the surface '" + *name + "' has the facet at " +
                              point_text(m_mesh, f[0]) +
                              " inside a body; expected a contact surface on the boundary of its body");
       pairs.push_back(std::move(facets));
@@ -217,13 +218,13 @@ class Builder {
     for (const ContactPairSpec& c : m_def.contact) {
       ContactPairChains chains;
       chains.slave = group_nodes(c.slave, c.where, "physical curve");
-      chains.master = group_nodes(c.master, c.where, "physical curve");
+      chains.master = group_nodes(c.master, c.where_master, "physical curve");
       for (const std::string* name : {&c.slave, &c.master}) {
         if (m_mesh.segments.count(*name) == 0 || m_mesh.segments.at(*name).empty())
-          throw InputError(m_def.where(c.where) + ": '" + *name + "' is not a physical curve with segments");
+          throw InputError(m_def.where(c.where_of(*name)) + ": '" + *name + "' is not a physical curve with segments");
         for (const auto& seg : m_mesh.segments.at(*name))
           if (edge_count[{std::min(seg[0], seg[1]), std::max(seg[0], seg[1])}] != 1)
-            throw InputError(m_def.where(c.where) + ": the curve '" + *name + "' has the segment " +
+            throw InputError(m_def.where(c.where_of(*name)) + ": the curve '" + *name + "' has the segment " +
                              point_text(m_mesh, seg[0]) + "-" + point_text(m_mesh, seg[1]) +
                              " inside a body; expected a contact curve on the boundary of its body");
       }
@@ -434,6 +435,10 @@ std::unique_ptr<Problem> make_problem(const std::string& name_or_path, const Pro
   mesh_options.refine = def.refine;
   mesh_options.max_nodes = def.max_mesh_nodes;
   mesh_options.time_limit_s = def.mesh_time_limit;
+  std::error_code ec;
+  if (!std::filesystem::exists(def.mesh, ec))
+    throw InputError(def.where(def.mesh_where) + ": mesh file " + quoted(def.mesh, 200) +
+                     " not found; expected a gmsh .geo or .msh file (a relative path is taken from the problem file's folder)");
   Mesh mesh = load_mesh(def.mesh, mesh_options);
   return build_problem(std::move(def), std::move(mesh));
 }

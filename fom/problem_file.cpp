@@ -176,6 +176,7 @@ class Reader {
     const std::string mesh = string(*t, p, "mesh", true);
     const fs::path base = m_def.path.empty() ? fs::path(".") : fs::path(m_def.path).parent_path();
     m_def.mesh = fs::path(mesh).is_absolute() ? mesh : (base / mesh).lexically_normal().string();
+    m_def.mesh_where = at(t->get("mesh"), p + "mesh");
     const std::string formulation = string(*t, p, "formulation", false, "plane_strain");
     if (formulation != "plane_strain" && formulation != "plane_stress" && formulation != "3d")
       fail(t->get("formulation"), p + "formulation",
@@ -216,8 +217,9 @@ class Reader {
       if (!std::isfinite(hi - lo))
         fail(r, p + "range", "[" + format_number(lo) + ", " + format_number(hi) +
                                  "] has a width hi - lo that overflows; expected a finite width");
+      const bool lower_open = boolean(t, p, "lower_open", false);
       try {
-        m_def.parameters.add(name, lo, hi, boolean(t, p, "lower_open", false));
+        m_def.parameters.add(name, lo, hi, lower_open);
       } catch (const InputError& e) {
         fail(t.get("name"), p + "name", e.what());
       }
@@ -289,8 +291,11 @@ class Reader {
       ContactPairSpec c;
       c.slave = string(t, p, "slave", true);
       c.master = string(t, p, "master", true);
-      c.where = at(&t, p + "slave");
-      if (c.slave == c.master) fail(&t, p + "master", "is the slave curve " + quoted(c.slave, 200) + " itself; expected another curve");
+      c.where = at(t.get("slave"), p + "slave");
+      c.where_master = at(t.get("master"), p + "master");
+      const std::string group = m_def.dimension == 3 ? "surface" : "curve";
+      if (c.slave == c.master)
+        fail(t.get("master"), p + "master", "is the slave " + group + " " + quoted(c.slave, 200) + " itself; expected another " + group);
       m_def.contact.push_back(std::move(c));
     }
   }
@@ -313,8 +318,9 @@ class Reader {
       fail(t->get("sampling"), p + "sampling", e.what());
     }
     plan.seed = static_cast<unsigned>(integer(*t, p, "seed", 0, 0, 4294967295L));
-    if (validation) plan.of = static_cast<int>(integer(*t, p, "of", 0, 0, SamplingPlan::kMaxPoints));
-    else plan.default_size = static_cast<int>(integer(*t, p, "default_size", 0, 0, SamplingPlan::kMaxPoints));
+    // Present, a size or level is at least 1 (0 would read as "not given").
+    if (validation) plan.of = static_cast<int>(integer(*t, p, "of", 0, 1, SamplingPlan::kMaxPoints));
+    else plan.default_size = static_cast<int>(integer(*t, p, "default_size", 0, 1, SamplingPlan::kMaxPoints));
     const toml::node* pts = t->get("points");
     if (plan.kind == SamplingPlan::Kind::List) {
       if (!pts || !pts->is_array() || pts->as_array()->empty())

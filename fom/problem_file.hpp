@@ -52,7 +52,10 @@ struct TractionSpec {
 /// curve; in 3D slave and master physical surfaces.
 struct ContactPairSpec {
   std::string slave, master;
-  SourceLocation where;
+  SourceLocation where;         ///< of its `slave` key
+  SourceLocation where_master;  ///< of its `master` key
+  /// Where the group `name` (its slave or its master) was given.
+  const SourceLocation& where_of(const std::string& name) const { return &name == &master ? where_master : where; }
 };
 
 /// \brief Settings of the reduced models that depend on the problem (`[rom]`).
@@ -77,6 +80,7 @@ struct ProblemDefinition {
   std::string path;                      ///< the file it was read from ("" if from text)
   std::string text;                      ///< the file's text (stored in databases)
   std::string mesh;                      ///< mesh path, resolved against the file's folder
+  SourceLocation mesh_where;             ///< where `mesh` was given
   bool plane_stress = false;             ///< `formulation = "plane_stress"` (unit thickness)
   int dimension = 2;                     ///< 3 for `formulation = "3d"` (a mesh of physical volumes), else 2
   SourceLocation formulation_where;      ///< where `formulation` is (or the [problem] table), for messages

@@ -96,6 +96,10 @@ AdaptiveOptions adaptive_options_of(const SnapshotDatabase& db) {
 AdaptiveTrainer::AdaptiveTrainer(const fom::Problem& problem, AdaptiveOptions options)
     : m_problem(problem), m_options(std::move(options)) {
   check_adaptive_options(m_options);
+  if (!problem.stiffness_is_constant())
+    throw InputError("adaptive training ranks its candidates by the error estimate of the reduced answers, which "
+                     "problem " + quoted(problem.name(), 200) + " has none of: its stiffness depends on its parameters; "
+                     "expected a problem whose elastic moduli do not depend on the parameters, or a grid (--train, --level)");
   if (!m_options.generate) m_options.generate = [](const fom::Problem& p, const std::vector<fom::Param>& params,
                                                    const std::string& kind, int n, const OfflineOptions& o) {
     return generate_snapshots(p, params, kind, n, o);

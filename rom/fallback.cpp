@@ -1,5 +1,7 @@
 #include <contactrom/rom/fallback.hpp>
 
+#include <cmath>
+
 #include <contactrom/core/format.hpp>
 #include <contactrom/fom/contact_residuals.hpp>
 #include <contactrom/fom/kkt.hpp>
@@ -22,6 +24,11 @@ bool FallbackSolver::keeps(const OnlineResult& res, std::string& reason) const {
   const double f = m_options.safety_factor;
   if (res.status != Status::Success)
     reason = std::string("reduced status ") + to_string(res.status);
+  else if (std::isnan(res.primal_estimate) || std::isnan(res.dual_estimate))
+    reason = m_rom.model().problem().stiffness_is_constant()
+                 ? "no error estimate to judge the answer by (the estimate is off)"
+                 : "no error estimate to judge the answer by (the stiffness of problem " +
+                       quoted(m_rom.model().problem().name(), 200) + " depends on its parameters)";
   else if (!(f * res.primal_estimate <= m_options.primal_tolerance))  // NaN: no estimate, not kept
     reason = "primal estimate " + format_number(res.primal_estimate) + " x " + format_number(f) + " above " +
              format_number(m_options.primal_tolerance);

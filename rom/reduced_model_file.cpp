@@ -3,8 +3,10 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -25,7 +27,7 @@ namespace {
 using hdf5::Handle;
 
 /// Value of attribute `kind`: tells a reduced model from a database.
-constexpr const char* kKind = "contactrom reduced model";
+constexpr const char* kKind = kReducedModelKind;
 
 /// The column-major rows × cols matrix as a dataset of cols rows (one column of
 /// `m` per dataset row, as h5py users index them).
@@ -304,7 +306,29 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
       start = end + 1;
       continue;
     }
-    if (compact == header) all[start] = '#';
+    if (compact == header) {
+      all[start] = '#';
+      break;
+    }
+    // A line of names that are not the parameters in order: a wrong header, not a
+    // number that failed to parse.
+    bool names = false;
+    for (size_t a = 0; a <= compact.size() && !names;) {
+      size_t b = compact.find(',', a);
+      if (b == std::string::npos) b = compact.size();
+      const std::string token = compact.substr(a, b - a);
+      char* rest = nullptr;
+      (void)std::strtod(token.c_str(), &rest);
+      names = !token.empty() && (rest == token.c_str() || *rest != '\0') &&
+              (std::isalpha(static_cast<unsigned char>(token[0])) || token[0] == '_');
+      a = b + 1;
+    }
+    if (names) {
+      const size_t line_number = static_cast<size_t>(std::count(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(start), '\n')) + 1;
+      throw InputError("parameter file " + quoted(path, 200) + " line " + std::to_string(line_number) + ": header " +
+                       quoted(compact, 200) + " does not name the parameters of " + quoted(problem.name(), 200) +
+                       " in order; expected " + quoted(header, 200) + " or no header");
+    }
     break;
   }
   std::istringstream lines(all);

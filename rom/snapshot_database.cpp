@@ -479,6 +479,9 @@ SnapshotDatabase read_database(const std::string& path, bool load_primal) {
   SnapshotDatabase db;
   try {
     const hid_t f = file.id();
+    if (has_attribute(f, "kind") && read_string_attribute(f, "kind") == kReducedModelKind)
+      throw InputError("database " + quoted(path, 200) + " is a reduced-model file (contactrom reduce), not a snapshot "
+                       "database; a reduced model is read with --rom (contactrom query), a database with --db");
     if (!has_attribute(f, "format_version"))
       throw InputError("database " + quoted(path, 200) + " has no format_version attribute; not a contactrom database");
     const int version = hdf5::read_int_attribute(f, "format_version");
@@ -602,6 +605,11 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
                      std::to_string(a.initial_snapshots) + " initial ones, and it holds " +
                      std::to_string(db.num_snapshots()) + " from " + std::to_string(expected.size()));
   } else if (static_cast<int>(expected.size()) != db.num_snapshots()) {
+    if (db.num_snapshots() < static_cast<int>(expected.size()))  // a part (offline --part k/K), or an interrupted append
+      throw InputError("database " + quoted(path, 200) + " claims " + option + std::to_string(db.training_size) + " of " +
+                       problem.name() + ", but it holds " + std::to_string(db.num_snapshots()) + " of its " +
+                       std::to_string(expected.size()) + " snapshots (a part of it); expected the whole set: complete "
+                       "it with contactrom offline --append, or join the parts with contactrom merge");
     throw mismatch("it holds " + std::to_string(db.num_snapshots()) + " snapshots instead of " +
                    std::to_string(expected.size()));
   }

@@ -38,6 +38,9 @@ namespace contactrom::rom {
 
 /// \brief Version of the file layout written by write_database (attribute `format_version`).
 inline constexpr int kDatabaseFormatVersion = 2;
+/// The `kind` attribute of a reduced-model file (rom/reduced_model_file.hpp), which
+/// read_database() names when it is given one.
+inline constexpr const char* kReducedModelKind = "contactrom reduced model";
 
 /// \brief How an adaptive offline run (rom/adaptive_training.hpp) built a database
 /// (training_kind "adaptive"): the settings of its latest run and one entry per round.

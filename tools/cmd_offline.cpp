@@ -376,7 +376,7 @@ void print_offline_summary(const OfflineArgs& a, const fom::Problem& problem, co
     return;
   }
   std::cout << "offline " << problem.name() << ": " << db.num_snapshots() << " snapshots (" << db.training_kind << " "
-            << plan.n << "), " << failed << " failed, " << db.threads << " threads"
+            << plan.n << "), " << failed << " failed, " << db.threads << (db.threads == 1 ? " thread" : " threads")
             << (ranks.size > 1 ? " on " + std::to_string(ranks.size) + " MPI ranks" : std::string()) << "\n"
             << std::setprecision(3) << "wall time " << db.wall_time_s << " s (factorisation " << db.setup_time_s
             << " s, mean FOM query " << 1e3 * mean_fom << " ms)\n";

@@ -122,6 +122,39 @@ BOOST_FIXTURE_TEST_CASE(options_and_parameters, Fixture) {
   for (const Case& c : cases) check_case(c);
 }
 
+BOOST_FIXTURE_TEST_CASE(messages_name_the_right_key_and_file, Fixture) {
+  const std::string hertz = hertz_problem_next_to(dir);
+  fs::copy_file(std::string(CONTACTROM_SOURCE_DIR) + "/meshes/hertz.geo", file("hertz.geo"));
+  const std::string text = contactrom::test::slurp(hertz);
+  const auto variant = [&](const std::string& name, const std::string& from, const std::string& to) {
+    std::string t = text;
+    const size_t at = t.find(from);
+    BOOST_REQUIRE_MESSAGE(at != std::string::npos, from);
+    t.replace(at, from.size(), to);
+    std::ofstream(file(name)) << t;
+    return file(name);
+  };
+  // An unknown master names the master key and its line.
+  const std::string master = variant("master.toml", "master = \"", "master = \"nothing_");
+  check_case({"fom --problem " + master + " --param 0.1", "key 'contact[0].master': the mesh has no physical curve", "", ""});
+  // A wrong type of lower_open is named once, at its own key.
+  const std::string open = variant("open.toml", "lower_open = true", "lower_open = \"true\"");
+  check_case({"fom --problem " + open + " --param 0.1", "key 'parameters[0].lower_open': expected true or false", "", ""});
+  // A missing mesh names the problem file's key.
+  const std::string mesh = variant("mesh.toml", "mesh = \"hertz.geo\"", "mesh = \"nothere.geo\"");
+  check_case({"fom --problem " + mesh + " --param 0.1", "key 'problem.mesh': mesh file", "", ""});
+  // A size or level of 0 would read as "not given".
+  const std::string of = variant("of.toml", "of = 120", "of = 0");
+  check_case({"fom --problem " + of + " --param 0.1", "key 'validation.of': is 0; expected 1..", "", ""});
+  // A reduced-model file given as a database, and a parameter header out of order.
+  const std::string db = file("r.h5"), rom = file("r_rom.h5");
+  BOOST_REQUIRE(run_command(kExe + " offline --problem rope --out " + db).exit_code == 0);
+  BOOST_REQUIRE(run_command(kExe + " reduce --db " + db + " --method greedy --out " + rom).exit_code == 0);
+  check_case({"online --db " + rom, "is a reduced-model file (contactrom reduce), not a snapshot database", "", ""});
+  std::ofstream(file("p.csv")) << "g\n20\n";
+  check_case({"query --rom " + rom + " --params " + file("p.csv"), "header 'g' does not name the parameters of 'rope' in order; expected 'gamma'", "", ""});
+}
+
 BOOST_FIXTURE_TEST_CASE(subnormal_parameter_is_a_number, Fixture) {
   const auto r = run_command(kExe + " fom --problem hertz --param 5e-324 --json");
   BOOST_TEST(r.exit_code == 0, r.err);
@@ -150,7 +183,10 @@ BOOST_FIXTURE_TEST_CASE(corrupted_databases, Fixture) {
                                       .c_str());
   // h5py and numpy are installed by tools/setup.sh: without them the case fails.
   BOOST_REQUIRE_MESSAGE(patched == 0, "the relabelled-database case needs /usr/bin/python3 with h5py and numpy");
-  check_case({"online --db " + file("h2.h5"), "claims training size 7 of hertz, but it holds 2 snapshots", "", ""});
+  check_case({"online --db " + file("h2.h5"), "claims training size 7 of hertz, but it holds 2 of its 7 snapshots", "", ""});
+  // A part of a training set says how to complete it.
+  BOOST_REQUIRE(run_command(kExe + " offline --problem hertz --train 4 --part 1/2 --out " + file("part.h5")).exit_code == 0);
+  check_case({"online --db " + file("part.h5"), "complete it with contactrom offline --append, or join the parts with contactrom merge", "", ""});
 }
 
 BOOST_FIXTURE_TEST_CASE(output_targets, Fixture) {
