@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <csignal>
@@ -53,39 +54,71 @@ void check_not_declared_input(const std::string& path, const struct stat& st) {
 
 // --- temporaries removed on signals ------------------------------------------
 //
-// A fixed table of paths, so that the signal handler only reads memory that is
-// never freed and calls unlink() (async-signal-safe). A slot is claimed (0 → 2),
-// filled, then published (→ 1); the handler removes the published ones.
-constexpr int kSlots = 64;
+// A list of nodes that is only ever prepended to, so that the signal handler only
+// reads memory that is never freed and calls unlink() (async-signal-safe), whatever
+// the number of files being written at once (a field folder may take thousands). A
+// node is claimed (0 → 2), filled, then published (→ 1); a free node (0) is reused
+// by a path that fits. The handler removes the published ones.
+struct Node {
+  std::atomic<int> state{0};
+  size_t capacity = 0;
+  char* path = nullptr;
+  Node* next = nullptr;
+};
+std::atomic<Node*> g_temporaries{nullptr};
+
+void register_temporary(const std::string& tmp) {
+  for (Node* n = g_temporaries.load(); n; n = n->next) {
+    int expected = 0;
+    if (n->capacity <= tmp.size() || !n->state.compare_exchange_strong(expected, 2)) continue;
+    std::memcpy(n->path, tmp.c_str(), tmp.size() + 1);
+    n->state.store(1);
+    return;
+  }
+  Node* n = new Node;
+  n->capacity = std::max<size_t>(tmp.size() + 1, 256);
+  n->path = new char[n->capacity];
+  std::memcpy(n->path, tmp.c_str(), tmp.size() + 1);
+  n->state.store(1);
+  n->next = g_temporaries.load();
+  while (!g_temporaries.compare_exchange_weak(n->next, n)) {
+  }
+}
+
+void unregister_temporary(const std::string& tmp) {
+  for (Node* n = g_temporaries.load(); n; n = n->next)
+    if (n->state.load() == 1 && tmp == n->path) {
+      n->state.store(0);
+      return;
+    }
+}
+
+// A fixed table for the few folders an output created (removed if still empty).
 constexpr size_t kPathBytes = 4096;
 struct Slot {
   std::atomic<int> state{0};
   char path[kPathBytes];
 };
-Slot g_slots[kSlots];
 
-void register_temporary(const std::string& tmp) {
-  if (tmp.size() >= kPathBytes) return;
-  for (Slot& s : g_slots) {
-    int expected = 0;
-    if (!s.state.compare_exchange_strong(expected, 2)) continue;
-    std::memcpy(s.path, tmp.c_str(), tmp.size() + 1);
-    s.state.store(1);
-    return;
-  }
-}
+// Folders an output created, removed on signals if still empty (after the files).
+constexpr int kFolderSlots = 8;
+Slot g_folders[kFolderSlots];
 
-void unregister_temporary(const std::string& tmp) {
-  for (Slot& s : g_slots)
-    if (s.state.load() == 1 && tmp == s.path) {
-      s.state.store(0);
-      return;
-    }
-}
+// While a set of files is being published (SignalsHeld): a signal handled by another
+// thread (one this thread's mask does not cover) is only noted, and acted on when the
+// set is out.
+std::atomic<int> g_publishing{0};
+std::atomic<int> g_pending_signal{0};
 
 extern "C" void remove_temporaries_and_end(int sig) {
-  for (Slot& s : g_slots)
-    if (s.state.load() == 1) ::unlink(s.path);
+  if (g_publishing.load() > 0) {
+    g_pending_signal.store(sig);
+    return;
+  }
+  for (Node* n = g_temporaries.load(); n; n = n->next)
+    if (n->state.load() == 1) ::unlink(n->path);
+  for (Slot& s : g_folders)
+    if (s.state.load() == 1) ::rmdir(s.path);  // fails, harmlessly, unless empty
   std::signal(sig, SIG_DFL);
   ::raise(sig);
 }
@@ -94,8 +127,9 @@ void remove_all(const std::vector<std::string>& tmps) {
   for (const std::string& t : tmps) discard_temporary(t);
 }
 
-/// Blocks SIGINT, SIGTERM and SIGHUP while alive (the renames that publish a set
-/// of files complete before a signal is handled).
+/// Holds SIGINT, SIGTERM and SIGHUP while alive (the renames that publish a set of
+/// files complete before a signal is handled): blocked in this thread, and only
+/// noted by the handler when another thread of the process receives one.
 class SignalsHeld {
  public:
   SignalsHeld() {
@@ -103,8 +137,15 @@ class SignalsHeld {
     sigemptyset(&set);
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set, sig);
     pthread_sigmask(SIG_BLOCK, &set, &m_old);
+    g_publishing.fetch_add(1);
   }
-  ~SignalsHeld() { pthread_sigmask(SIG_SETMASK, &m_old, nullptr); }
+  ~SignalsHeld() {
+    if (g_publishing.fetch_sub(1) == 1) {
+      const int sig = g_pending_signal.exchange(0);
+      if (sig) remove_temporaries_and_end(sig);
+    }
+    pthread_sigmask(SIG_SETMASK, &m_old, nullptr);
+  }
 
  private:
   sigset_t m_old;
@@ -150,6 +191,25 @@ void check_output_path(const std::string& path) {
   }
   ::close(fd);
   discard_temporary(probe);
+}
+
+void register_created_folder(const std::string& dir) {
+  if (dir.size() >= kPathBytes) return;
+  for (Slot& s : g_folders) {
+    int expected = 0;
+    if (!s.state.compare_exchange_strong(expected, 2)) continue;
+    std::memcpy(s.path, dir.c_str(), dir.size() + 1);
+    s.state.store(1);
+    return;
+  }
+}
+
+void forget_created_folder(const std::string& dir) {
+  for (Slot& s : g_folders)
+    if (s.state.load() == 1 && dir == s.path) {
+      s.state.store(0);
+      return;
+    }
 }
 
 void declare_input_files(const std::vector<std::string>& paths) {

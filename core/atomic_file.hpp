@@ -54,6 +54,13 @@ void check_output_path(const std::string& path);
 /// embedding the library may.
 void declare_input_files(const std::vector<std::string>& paths);
 
+/// \brief Registers a folder just created to hold outputs: the signal handlers of
+/// remove_temporaries_on_signals() remove it if it is still empty, until
+/// forget_created_folder().
+void register_created_folder(const std::string& dir);
+/// \brief Ends register_created_folder(dir) (the outputs in it are published).
+void forget_created_folder(const std::string& dir);
+
 /// \brief Installs handlers of SIGINT, SIGTERM and SIGHUP that remove the
 /// temporary files being written (write_file_atomically(), temporary_path_for())
 /// and then end the process by the same signal (its default action). Called by the

@@ -154,6 +154,7 @@ void write_field_sets(const std::string& dir, const Problem& problem, const std:
     fs::create_directories(dir, ec);
     if (ec) throw InputError("cannot create output folder " + quoted(dir, 200) + ": " + ec.message());
     created = true;
+    register_created_folder(dir);
   }
   std::vector<std::pair<std::string, FileWriter>> files = extra;
   for (const FieldSet& set : sets) {
@@ -164,9 +165,10 @@ void write_field_sets(const std::string& dir, const Problem& problem, const std:
   try {
     write_files_atomically(files);
   } catch (...) {
-    if (created) fs::remove(dir, ec);  // only if still empty
+    if (created) fs::remove(dir, ec), forget_created_folder(dir);  // only if still empty
     throw;
   }
+  if (created) forget_created_folder(dir);
 }
 
 }  // namespace contactrom::fom

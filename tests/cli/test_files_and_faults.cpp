@@ -277,6 +277,43 @@ BOOST_FIXTURE_TEST_CASE(signals_during_writes_leave_the_old_or_the_complete_new_
   }
 }
 
+BOOST_FIXTURE_TEST_CASE(a_signal_during_a_large_set_of_field_files_leaves_no_file_and_no_folder, Fixture) {
+  // 300 queries: 600 field files and the CSV, many more than are written at once
+  // elsewhere; each interrupted run leaves no temporary file and no field folder, or
+  // the whole set.
+  const std::string db = file("db.h5"), rom = file("rom.h5"), params = file("p.csv");
+  BOOST_REQUIRE(run_command(kExe + " offline --problem rope --out " + db).exit_code == 0);
+  BOOST_REQUIRE(run_command(kExe + " reduce --db " + db + " --method greedy --out " + rom).exit_code == 0);
+  {
+    std::ofstream p(params);
+    for (int i = 0; i < 300; ++i) p << 10.0 + 40.0 * (i + 0.5) / 300 << "\n";
+  }
+  const std::string fields = file("fields"), csv = file("answers.csv");
+  const std::vector<std::string> args = {"query", "--rom", rom, "--params", params, "--out", csv, "--fields", fields};
+  const long span = run_time_us(args);
+  fs::remove_all(fields), fs::remove(csv);
+  std::mt19937 rng(7);
+  int none = 0, whole = 0;
+  for (int trial = 0; trial < 16; ++trial) {
+    const long delay = std::uniform_int_distribution<long>(span / 4, span)(rng);
+    run_and_signal(args, trial % 2 ? SIGTERM : SIGINT, std::chrono::microseconds(delay));
+    BOOST_TEST_CONTEXT("signal after " << delay << " us of " << span) {
+      BOOST_TEST(temporaries_in(dir) == 0);
+      if (!fs::exists(fields)) {
+        BOOST_TEST(!fs::exists(csv));
+        ++none;
+      } else {
+        BOOST_TEST(std::distance(fs::directory_iterator(fields), fs::directory_iterator()) == 600);
+        BOOST_TEST(fs::exists(csv));
+        ++whole;
+      }
+    }
+    fs::remove_all(fields), fs::remove(csv);
+  }
+  BOOST_TEST_MESSAGE(none << " runs left nothing, " << whole << " the whole set");
+  BOOST_TEST(none > 0);
+}
+
 BOOST_FIXTURE_TEST_CASE(gmsh_ends_with_its_parent, Fixture) {
   // A .geo that loops for days, meshed by the gmsh child of `contactrom fom`: killed
   // by PID (SIGKILL: no handler runs), the parent leaves no gmsh behind.
