@@ -66,7 +66,14 @@ void parallel_for(int n, int threads, const std::function<void(int)>& task, cons
       reported = done;
       if (progress && !failed) {
         lock.unlock();
-        progress(reported, n);
+        try {
+          progress(reported, n);
+        } catch (...) {  // the caller stops the run (e.g. an interrupt): no new task starts
+          lock.lock();
+          if (!error) error = std::current_exception();
+          failed = true;
+          break;
+        }
         lock.lock();
       }
     }

@@ -14,8 +14,9 @@ using ProgressCallback = std::function<void(int done, int total)>;
 
 /// \brief Runs `task(i)` for i = 0..n-1 on `threads` worker threads (≤ 0: the
 /// hardware concurrency; never more threads than tasks). Tasks are handed out in
-/// increasing order from a shared counter. The first exception thrown by a task is
-/// rethrown after all workers have stopped (the remaining tasks are skipped).
+/// increasing order from a shared counter. The first exception thrown by a task, or
+/// by `progress` (a way to stop the run), is rethrown after all workers have
+/// stopped (the remaining tasks are skipped; the running ones finish).
 void parallel_for(int n, int threads, const std::function<void(int)>& task, const ProgressCallback& progress = {});
 
 /// \brief Number of worker threads `requested` resolves to (≤ 0: hardware concurrency, at least 1).

@@ -246,7 +246,7 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
             std::vector<FomResult> out(ps.size());
             py::gil_scoped_release release;
             parallel_for(static_cast<int>(ps.size()), threads,
-                              [&](int i) { out[i] = finish(*s.problem, s.solve(ps[i])); });
+                              [&](int i) { out[i] = finish(*s.problem, s.solve(ps[i])); }, interrupt_check());
             return out;
           },
           py::arg("params"), py::arg("threads") = 0,

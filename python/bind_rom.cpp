@@ -260,6 +260,7 @@ are read-only views with one snapshot per row, as in the HDF5 file.)doc")
         check_threads(threads, "threads");
         rom::OfflineOptions options;
         options.threads = threads;
+        options.progress = interrupt_check();  // Ctrl-C stops it
         Database d;
         d.problem = problem;
         // An int n (numpy's integers too): the training set of size or level n.
@@ -305,6 +306,7 @@ works in memory but is refused when read back from a file.)doc");
         if (!tolerance.is_none()) settings["tolerance"] = tolerance;
         read_adaptive_settings(settings, o);
         o.offline.threads = threads;
+        o.offline.progress = interrupt_check();  // Ctrl-C stops it
         const std::string path = path_like.is_none() ? std::string() : path_arg(path_like);
         if (!path.empty()) o.on_round = [path](const rom::AdaptiveRound&, const rom::SnapshotDatabase& db) {
           rom::write_database(path, db);
@@ -475,7 +477,11 @@ tolerances.)doc")
             std::vector<rom::OnlineResult> out;
             out.reserve(ps.size());
             py::gil_scoped_release release;
-            for (const fom::Param& p : ps) out.push_back(r.rom->solver().solve(p));
+            const ProgressCallback check = interrupt_check();
+            for (const fom::Param& p : ps) {
+              out.push_back(r.rom->solver().solve(p));
+              if (out.size() % 64 == 0) check(static_cast<int>(out.size()), static_cast<int>(ps.size()));
+            }
             return out;
           },
           py::arg("params"), "Online queries at every row of params, in order (GIL released).")
@@ -493,7 +499,7 @@ tolerances.)doc")
             {
               py::gil_scoped_release release;
               const fom::ActiveSetSolver fom_solver(problem);
-              const std::vector<fom::FomSolution> refs = rom::compute_references(fom_solver, ps, threads);
+              const std::vector<fom::FomSolution> refs = rom::compute_references(fom_solver, ps, threads, interrupt_check());
               rom::EvaluationOptions options;
               options.kkt = kkt;
               s = rom::evaluate_online(r.rom->solver(), ps, refs, options);

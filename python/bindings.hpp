@@ -13,12 +13,14 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <exception>
 #include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <contactrom/baselines/ipopt_qp.hpp>
+#include <contactrom/core/parallel_for.hpp>
 #include <contactrom/fom/active_set_solver.hpp>
 #include <contactrom/fom/kkt.hpp>
 #include <contactrom/fom/problem.hpp>
@@ -35,6 +37,17 @@ using ProblemPtr = std::shared_ptr<const fom::Problem>;
 
 /// \brief A snapshot database and the problem it was computed for (built by
 /// `offline`, or rebuilt from the file by `load_database`).
+/// \brief Thrown by interrupt_check() when Python has an exception pending (Ctrl-C:
+/// KeyboardInterrupt); the module's translator leaves that exception to Python.
+struct PythonErrorPending : std::exception {
+  const char* what() const noexcept override { return "a Python exception is pending (interrupted)"; }
+};
+
+/// \brief A progress callback for the long calls that release the GIL: takes the GIL,
+/// runs Python's signal handlers (Ctrl-C), and stops the run by throwing
+/// PythonErrorPending if one raised. Call only from the thread that released the GIL.
+ProgressCallback interrupt_check();
+
 struct Database {
   std::shared_ptr<const rom::SnapshotDatabase> db;
   ProblemPtr problem;

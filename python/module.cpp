@@ -108,6 +108,13 @@ py::dict kkt_dict(const fom::KktResiduals& k) {
   return d;
 }
 
+ProgressCallback interrupt_check() {
+  return [](int, int) {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw PythonErrorPending();
+  };
+}
+
 std::string option_text(py::handle value) {
   if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
   // numpy scalars (np.int64(3), np.float32(1e-6), np.bool_(True)): by their kind.
@@ -143,6 +150,8 @@ PYBIND11_MODULE(_contactrom, m) {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const python::PythonErrorPending&) {
+      if (!PyErr_Occurred()) PyErr_SetString(PyExc_KeyboardInterrupt, "interrupted");  // the pending one, else this
     }
   });
 

@@ -197,3 +197,27 @@ def test_verify_refuses_a_reference_of_another_parameter():
     a, b = fom.solve(0.1), fom.solve(0.2)
     with pytest.raises(ValueError, match="another parameter"):
         contactrom.verify(hertz, 0.1, a.u, a.lam, reference=b)
+
+
+def test_ctrl_c_stops_long_calls():
+    # SIGINT (what Ctrl-C sends) during offline and adaptive training raises
+    # KeyboardInterrupt within a snapshot or a candidate, not at the end of the run.
+    import os
+    import signal
+    import threading
+    import time
+    hertz = contactrom.problem("hertz")
+    start = time.time()
+    contactrom.offline(hertz, 40, threads=1)
+    per_snapshot = (time.time() - start) / 40
+    for run in (lambda: contactrom.offline(hertz, 5000, threads=1),
+                lambda: contactrom.offline_adaptive(hertz, tolerance=1e-12, max_snapshots=5000, threads=1)):
+        timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+        timer.start()
+        start = time.time()
+        with pytest.raises(KeyboardInterrupt):
+            run()
+        timer.join()
+        # 5000 snapshots would take 5000 * per_snapshot; the interrupt comes at 0.3 s.
+        assert time.time() - start < 0.3 + 0.5 * 5000 * per_snapshot
+    assert contactrom.offline(hertz, 3).training_size == 3  # the module still works
