@@ -6,6 +6,7 @@
 #include <functional>
 
 #include <contactrom/core/errors.hpp>
+#include <contactrom/core/exact_scaling.hpp>
 #include <contactrom/core/format.hpp>
 #include <contactrom/core/nnls.hpp>
 #include "python/bindings.hpp"
@@ -38,13 +39,19 @@ void check_tolerance(const char* kernel, const char* name, double value) {
     throw InputError(std::string(kernel) + ": " + name + " = " + format_number(value) + "; expected a finite number >= 0");
 }
 
-/// Runs `solve` without the GIL and packs the solver's outcome.
+/// Runs `solve` on D and x scaled by exact_scaling() without the GIL, and packs the
+/// solver's outcome (coefficients of the given D and x).
 template <class Solver>
-SparseResult run(Solver& solver, const std::function<Eigen::VectorXd()>& solve) {
+SparseResult run(Solver& solver, const Eigen::MatrixXd& d, const Eigen::VectorXd& x,
+                 const std::function<Eigen::VectorXd(const Eigen::MatrixXd&, const Eigen::VectorXd&)>& solve) {
   SparseResult r;
   {
     py::gil_scoped_release release;
-    r.x = solve();
+    const ExactScaling s = exact_scaling(d, x);
+    if (s.dictionary == 1.0 && s.signal == 1.0)
+      r.x = solve(d, x);
+    else
+      r.x = solve(d * s.dictionary, x * s.signal) * s.coefficients();
   }
   r.status = solver.info();
   r.iterations = solver.iterations();
@@ -71,7 +78,7 @@ void bind_focuss(py::module_& m, const char* name, const char* doc) {
         o.tolerance = tolerance;
         o.prune_tolerance = prune_tolerance;
         Solver solver(o);
-        return run(solver, [&] { return solver.compute(d).solve(x); });
+        return run(solver, d, x, [&](const Eigen::MatrixXd& ds, const Eigen::VectorXd& xs) { return solver.compute(ds).solve(xs); });
       },
       py::arg("D"), py::arg("x"), py::arg("max_iterations") = 100, py::arg("tolerance") = 1e-10,
       py::arg("prune_tolerance") = 1e-8, doc);
@@ -99,7 +106,7 @@ void bind_kernels(py::module_& m) {
         o.max_iterations = max_iterations;
         o.tolerance = tolerance;
         Nnls solver(o);
-        return run(solver, [&] { return solver.compute(a).solve(b); });
+        return run(solver, a, b, [&](const Eigen::MatrixXd& as, const Eigen::VectorXd& bs) { return solver.compute(as).solve(bs); });
       },
       py::arg("A"), py::arg("b"), py::arg("max_iterations") = 0, py::arg("tolerance") = 1e-12,
       "min ||A x - b|| s.t. x >= 0 (Lawson-Hanson); max_iterations <= 0: 3n.");
@@ -114,7 +121,7 @@ void bind_kernels(py::module_& m) {
         o.max_atoms = max_atoms;
         o.tolerance = tolerance;
         rom::Omp solver(o);
-        return run(solver, [&] { return solver.compute(d).solve(x); });
+        return run(solver, d, x, [&](const Eigen::MatrixXd& ds, const Eigen::VectorXd& xs) { return solver.compute(ds).solve(xs); });
       },
       py::arg("D"), py::arg("x"), py::arg("max_atoms") = -1, py::arg("tolerance") = 1e-8,
       "Orthogonal matching pursuit: sparse alpha with D alpha ~ x (||x - D alpha|| <= tolerance ||x||).");

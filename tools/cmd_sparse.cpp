@@ -25,6 +25,7 @@
 
 #include <contactrom/core/format.hpp>
 #include <contactrom/core/errors.hpp>
+#include <contactrom/core/exact_scaling.hpp>
 #include <contactrom/core/nnls.hpp>
 #include <contactrom/rom/dense_csv.hpp>
 #include <contactrom/rom/focuss.hpp>
@@ -152,9 +153,15 @@ void run_sparse(const SparseArgs& args, bool has_tol, bool has_max_iter, bool ha
   }
 
   check_gram_fits(args, d);
-  const SparseRun run = run_method(args, has_tol, has_max_iter, has_atoms, d, x);
-  const double residual = (d * run.coefficients - x).norm();
-  const double x_norm = x.norm();
+  // Data of extreme magnitude is scaled by powers of two (exact) for the kernel.
+  const contactrom::ExactScaling scaling = contactrom::exact_scaling(d, x);
+  const bool scaled = scaling.dictionary != 1.0 || scaling.signal != 1.0;
+  SparseRun run = scaled ? run_method(args, has_tol, has_max_iter, has_atoms, d * scaling.dictionary, x * scaling.signal)
+                         : run_method(args, has_tol, has_max_iter, has_atoms, d, x);
+  if (scaled) run.coefficients *= scaling.coefficients();
+  // Norms that do not underflow or overflow with such data.
+  const double residual = (d * run.coefficients - x).stableNorm();
+  const double x_norm = x.stableNorm();
   const double relative = x_norm > 0.0 ? residual / x_norm : residual;
   std::vector<Eigen::Index> nonzeros;
   for (Eigen::Index j = 0; j < run.coefficients.size(); ++j) {

@@ -57,3 +57,28 @@ def test_nnls_agrees_with_scipy():
     w = A.T @ (b - A @ r.x)  # KKT: w <= 0 where x = 0, w = 0 where x > 0
     assert np.all(w[r.x == 0.0] <= 1e-10)
     assert np.allclose(w[r.x > 0.0], 0.0, atol=1e-10)
+
+
+@pytest.mark.parametrize("scale", [2.0 ** -1000, 2.0 ** 1000])
+def test_extreme_magnitudes_give_the_same_answer(planted, scale, tmp_path):
+    # Scaled by a power of two, a problem has the same solution (D scaled alone:
+    # coefficients divided by the scale); Gram matrices of such data would under- or
+    # overflow, and the kernels answered 0 with status success.
+    D, alpha, x = planted
+    Dn = np.abs(D)
+    for kernel, (A, b) in {"nnls": (Dn, Dn @ np.abs(alpha)), "omp": (D, x), "nnfocuss": (Dn, Dn @ np.abs(alpha))}.items():
+        plain = getattr(contactrom, kernel)(A, b)
+        both = getattr(contactrom, kernel)(A * scale, b * scale)
+        alone = getattr(contactrom, kernel)(A * scale, b)
+        assert both.status == plain.status == "success"
+        assert np.array_equal(both.x, plain.x), kernel
+        # (a coefficient near zero may fall into the subnormal range: absolute tolerance)
+        assert np.allclose(alone.x * scale, plain.x, rtol=1e-12, atol=1e-12 * np.abs(plain.x).max()), kernel
+    # The CLI: the same coefficients, and a residual that does not underflow.
+    from conftest import run_cli_json
+    np.savetxt(tmp_path / "D.csv", np.eye(2) * scale, delimiter=",")
+    np.savetxt(tmp_path / "x.csv", np.array([scale, 2 * scale]))
+    out = run_cli_json("sparse", "--method", "nnls", "--dictionary", str(tmp_path / "D.csv"), "--signal",
+                       str(tmp_path / "x.csv"))
+    assert out["status"] == "success" and out["coefficients"] == [1.0, 2.0]
+    assert out["relative_residual"] == 0.0
