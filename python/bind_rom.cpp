@@ -16,11 +16,13 @@
 namespace contactrom::python {
 namespace {
 
-/// The offset kind named by `offset`, or by its older spelling `lifting` when given.
-rom::OffsetKind offset_kind(const std::string& offset, const py::object& lifting) {
+/// The offset kind named by `offset` (None: harmonic), or by its older spelling
+/// `lifting` when given; both given must agree.
+rom::OffsetKind offset_kind(const py::object& offset_arg, const py::object& lifting) {
   const bool alias = !lifting.is_none();
+  const std::string offset = offset_arg.is_none() ? std::string("harmonic") : py::str(offset_arg).cast<std::string>();
   const std::string text = alias ? py::str(lifting).cast<std::string>() : offset;
-  if (alias && offset != "harmonic" && offset != text)
+  if (alias && !offset_arg.is_none() && offset != text)
     throw InputError("offset " + quoted(offset, 200) + " and lifting " + quoted(text, 200) +
                      " disagree; expected only offset (lifting is its older name)");
   if (text == "harmonic") return rom::OffsetKind::Harmonic;
@@ -30,7 +32,7 @@ rom::OffsetKind offset_kind(const std::string& offset, const py::object& lifting
 }
 
 std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, double delta, const std::string& method,
-                                                  const py::dict& options, const std::string& offset,
+                                                  const py::dict& options, const py::object& offset,
                                                   bool include_failed, const py::object& lifting) {
   if (!(delta >= 0.0 && delta <= 1.0))
     throw InputError("delta = " + format_number(delta) + " is outside [0, 1]; expected a POD tolerance such as 1e-8");
@@ -299,6 +301,9 @@ works in memory but is refused when read back from a file.)doc");
       [](std::shared_ptr<fom::Problem> problem, py::object tolerance, int threads, py::object resume,
          py::object path_like, py::kwargs settings) {
         check_threads(threads, "threads");
+        if (!resume.is_none() && !py::isinstance<Database>(resume))
+          throw py::type_error("resume is a SnapshotDatabase (contactrom.load_database(path)), not " +
+                               std::string(py::str(py::repr(resume))));
         const Database* previous = resume.is_none() ? nullptr : &resume.cast<const Database&>();
         rom::AdaptiveOptions o = previous ? rom::adaptive_options_of(*previous->db) : rom::AdaptiveOptions{};
         if (tolerance.is_none() && !previous)
@@ -392,7 +397,7 @@ POD basis, dual dictionary, reduced operators and an online method, built from a
 snapshot database or loaded from a reduced-model file (`contactrom reduce`). The
 object owns the problem (and the database) it needs.)doc")
       .def(py::init(&build_reduced_model), py::arg("db"), py::arg("delta") = 1e-8, py::arg("method") = "greedy",
-           py::arg("options") = py::dict(), py::arg("offset") = "harmonic",
+           py::arg("options") = py::dict(), py::arg("offset") = py::none(),
            py::arg("include_failed_snapshots") = false, py::arg("lifting") = py::none(), R"doc(
 Builds the reduced model of a SnapshotDatabase: the POD of its primal snapshots
 truncated at `delta` (energy share dropped), the dual dictionary of its pressures,

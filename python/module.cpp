@@ -28,8 +28,21 @@ fom::Param to_param(const fom::Problem& problem, py::handle value) {
                       std::to_string(problem.num_params()) + " numbers (" + problem.range_text() + "), not " +
                       quoted(py::str(py::repr(value)).cast<std::string>(), 80));
   };
-  // None and text are not numbers (numpy would turn them into nan, or read the text).
-  if (value.is_none() || py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value)) throw refuse();
+  // None, bools and text are not numbers (numpy would turn them into nan or 1, or
+  // read the text), alone or in a sequence.
+  if (value.is_none() || py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value) ||
+      py::isinstance<py::bytes>(value))
+    throw refuse();
+  if (!py::isinstance<py::float_>(value) && !py::isinstance<py::int_>(value)) {
+    py::object kind;
+    try {
+      kind = py::module_::import("numpy").attr("asarray")(value).attr("dtype").attr("kind");
+    } catch (const py::error_already_set&) {
+      throw refuse();
+    }
+    const std::string k = py::str(kind);
+    if (k != "i" && k != "u" && k != "f") throw refuse();
+  }
   if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
     const double v = PyFloat_AsDouble(value.ptr());  // an int beyond the doubles: OverflowError
     if (v == -1.0 && PyErr_Occurred()) {

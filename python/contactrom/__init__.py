@@ -7,6 +7,7 @@ RuntimeError; numerical non-convergence is a ``status`` of the result.
 """
 from ._contactrom import __version__  # the C++ library's version
 from ._contactrom import (
+    FallbackModel,
     FomSolution,
     FullOrderSolver,
     Problem,
@@ -28,6 +29,7 @@ from ._contactrom import (
 )
 
 __all__ = [
+    "FallbackModel",
     "FomSolution",
     "FullOrderSolver",
     "Problem",

@@ -221,3 +221,18 @@ def test_ctrl_c_stops_long_calls():
         # 5000 snapshots would take 5000 * per_snapshot; the interrupt comes at 0.3 s.
         assert time.time() - start < 0.3 + 0.5 * 5000 * per_snapshot
     assert contactrom.offline(hertz, 3).training_size == 3  # the module still works
+
+
+def test_parameters_are_numbers_and_settings_agree():
+    hertz = contactrom.problem("hertz")
+    fom = contactrom.FullOrderSolver(hertz)
+    for value in (True, ["0.2"], [b"0.1"], np.array(["0.1"]), [None], [True]):
+        with pytest.raises(ValueError, match="is a number or a sequence of 1 numbers"):
+            fom.solve(value)
+    db = contactrom.offline(hertz, 4)
+    with pytest.raises(ValueError, match="disagree"):
+        contactrom.ReducedModel(db, lifting="dirichlet", offset="harmonic")
+    assert contactrom.ReducedModel(db, lifting="dirichlet").solve(0.1).status == "success"
+    with pytest.raises(TypeError, match="resume is a SnapshotDatabase"):
+        contactrom.offline_adaptive(hertz, tolerance=0.1, resume="x.h5")
+    assert "FallbackModel" in contactrom.__all__
