@@ -201,7 +201,7 @@ class Builder {
     try {
       return std::make_unique<NodeToFaceContact>(m_mesh.nodes, pairs);
     } catch (const InputError& e) {
-      throw InputError(m_def.where({0, "contact"}) + ": " + e.what());
+      throw InputError(pair_error<NodeToFaceContact>(pairs, e));
     }
   }
 
@@ -233,11 +233,25 @@ class Builder {
     try {
       return std::make_unique<NodeToSegmentContact>(m_mesh.nodes, pairs);
     } catch (const InputError& e) {
-      throw InputError(m_def.where({0, "contact"}) + ": " + e.what());
+      throw InputError(pair_error<NodeToSegmentContact>(pairs, e));
     }
   }
 
  private:
+  /// The message of a contact model that refused `pairs`: located at the first pair
+  /// that the model refuses on its own, else at the `contact` tables together.
+  template <class Model, class Pairs>
+  std::string pair_error(const Pairs& pairs, const InputError& e) const {
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      try {
+        Model single(m_mesh.nodes, Pairs{pairs[i]});
+      } catch (const InputError& one) {
+        return m_def.where({m_def.contact[i].where.line, "contact[" + std::to_string(i) + "]"}) + ": " + one.what();
+      }
+    }
+    return m_def.where({0, "contact"}) + ": " + e.what();
+  }
+
   int body_index(const std::string& name) const {
     for (size_t b = 0; b < m_mesh.body_names.size(); ++b)
       if (m_mesh.body_names[b] == name) return static_cast<int>(b);

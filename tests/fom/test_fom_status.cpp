@@ -275,6 +275,15 @@ BOOST_AUTO_TEST_CASE(in_3d_free_rigid_motions_are_named_and_overlaps_warned_abou
   // The block sunk 0.05 (2.5 U) into the slab: warned about.
   const auto sunk = fom::reference_contact_warnings(*fom::make_problem(blocks3d_toml(dir, -0.05, "[0.0, 0.0, \"-d\"]")));
   BOOST_TEST(any_contains(sunk, "overlaps by 0.05"), (sunk.empty() ? "" : sunk[0]));
+  // A master surface that takes in its slave surface: the error names the pair.
+  const std::string toml = blocks3d_toml(dir, 0.0, "[0.0, 0.0, \"-d\"]");
+  std::string geo = contactrom::test::slurp(dir + "/b3.geo");
+  geo.replace(geo.find("top() -= bb();"), 14, "");
+  write_file(dir, "b3.geo", geo);
+  const std::string pair = contactrom::test::input_error_of([&] { fom::make_problem(toml); });
+  BOOST_TEST(pair.find("key 'contact[0]': a contact pair's master surface contains its own slave node") !=
+                 std::string::npos,
+             pair);
   // Every shipped 3D problem holds its bodies and starts without overlap.
   for (const char* name : {"hertz3d", "ironing3d"}) {
     const auto problem = fom::make_problem(name);
