@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include <contactrom/core/format.hpp>
 #include <contactrom/fom/kkt.hpp>
 #include <contactrom/rom/error_indicator.hpp>
 
@@ -113,6 +114,17 @@ const AnswerSearch* check_contact(const ReducedModel& model, const fom::ContactT
   if (res.status == Status::Success && !res.contact.within(tolerances)) {
     res.status = Status::Inaccurate;
     res.message = "full-order contact residuals above tolerance: " + res.contact.describe(tolerances);
+  } else if (res.status == Status::Success && res.contact.penetration > 0.0 && !(res.lambda.array() > 0.0).any()) {
+    // No pressure anywhere: the answer must not penetrate, on the scale of its own
+    // displacement (U's tolerance cannot see a load far below U). Below 1e-6 U the
+    // load counts as zero, as in the errors against the FOM.
+    const double own = (u_s.size() ? u_s.cwiseAbs().maxCoeff() : 0.0) / problem.displacement_scale();
+    if (own >= fom::kNearZeroReference && res.contact.penetration > tolerances.penetration * own) {
+      res.status = Status::Inaccurate;
+      res.message = "no contact pressure anywhere, yet the answer penetrates by " + format_number(res.contact.penetration) +
+                    " U, more than " + format_number(tolerances.penetration) + " of its own largest surface displacement (" +
+                    format_number(own) + " U)";
+    }
   }
   return &search;
 }

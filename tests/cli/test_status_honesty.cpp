@@ -52,6 +52,21 @@ BOOST_AUTO_TEST_CASE(convex_hull_outside_the_training_range_is_not_a_success) {
       BOOST_TEST((r["status"].get<std::string>() != "success" || worst <= 1e-6),
                  method << " at d = " << d << ": success with residuals " << k.dump());
     }
+  // Far below the training range (d = 0.0005 against 0.01, …) the four methods answer
+  // with no pressure at all while penetrating by the whole indentation, which U's
+  // tolerance cannot see: judged on the answer's own displacement, not a success.
+  for (const char* method : {"greedy", "greedy-nested", "cpg", "full-dictionary"}) {
+    const auto r = nlohmann::json::parse(
+        run_command(kExe + " online --db " + db + " --method " + method + " --param 0.0005 --json").out);
+    BOOST_TEST_CONTEXT(method << " at d = 0.0005: " << r.dump()) {
+      if (r["contact_force"].get<double>() == 0.0) {
+        BOOST_TEST(r["status"].get<std::string>() == "inaccurate");
+        BOOST_TEST(r["message"].get<std::string>().find("no contact pressure anywhere") != std::string::npos);
+      }
+      // Either way, a success has pressure (a dual error below 1).
+      if (r["status"].get<std::string>() == "success") BOOST_TEST(r["dual_error"].get<double>() < 1.0);
+    }
+  }
   // Inside the range the same method still succeeds, with relative errors.
   const auto inside = nlohmann::json::parse(
       run_command(kExe + " online --db " + db + " --method convex-hull --param 0.15 --json").out);
