@@ -52,57 +52,61 @@ void check_not_declared_input(const std::string& path, const struct stat& st) {
                        ", which would be replaced; expected another output file");
 }
 
-// --- temporaries removed on signals ------------------------------------------
+// --- paths removed on signals ------------------------------------------------
 //
 // A list of nodes that is only ever prepended to, so that the signal handler only
-// reads memory that is never freed and calls unlink() (async-signal-safe), whatever
-// the number of files being written at once (a field folder may take thousands). A
-// node is claimed (0 → 2), filled, then published (→ 1); a free node (0) is reused
-// by a path that fits. The handler removes the published ones.
-struct Node {
-  std::atomic<int> state{0};
-  size_t capacity = 0;
-  char* path = nullptr;
-  Node* next = nullptr;
-};
-std::atomic<Node*> g_temporaries{nullptr};
-
-void register_temporary(const std::string& tmp) {
-  for (Node* n = g_temporaries.load(); n; n = n->next) {
-    int expected = 0;
-    if (n->capacity <= tmp.size() || !n->state.compare_exchange_strong(expected, 2)) continue;
-    std::memcpy(n->path, tmp.c_str(), tmp.size() + 1);
-    n->state.store(1);
-    return;
-  }
-  Node* n = new Node;
-  n->capacity = std::max<size_t>(tmp.size() + 1, 256);
-  n->path = new char[n->capacity];
-  std::memcpy(n->path, tmp.c_str(), tmp.size() + 1);
-  n->state.store(1);
-  n->next = g_temporaries.load();
-  while (!g_temporaries.compare_exchange_weak(n->next, n)) {
-  }
-}
-
-void unregister_temporary(const std::string& tmp) {
-  for (Node* n = g_temporaries.load(); n; n = n->next)
-    if (n->state.load() == 1 && tmp == n->path) {
-      n->state.store(0);
+// reads memory that is never freed and calls unlink() or rmdir() (async-signal-safe),
+// whatever the number of paths registered at once (a field folder may take
+// thousands of files). A node is claimed (0 → 2), filled, then published (→ 1); a
+// free node (0) is reused by a path that fits. The handler removes the published ones.
+class SignalSafePaths {
+ public:
+  void add(const std::string& path) {
+    for (Node* n = m_head.load(); n; n = n->next) {
+      int expected = 0;
+      if (n->capacity <= path.size() || !n->state.compare_exchange_strong(expected, 2)) continue;
+      std::memcpy(n->path, path.c_str(), path.size() + 1);
+      n->state.store(1);
       return;
     }
-}
+    Node* n = new Node;
+    n->capacity = std::max<size_t>(path.size() + 1, 256);
+    n->path = new char[n->capacity];
+    std::memcpy(n->path, path.c_str(), path.size() + 1);
+    n->state.store(1);
+    n->next = m_head.load();
+    while (!m_head.compare_exchange_weak(n->next, n)) {
+    }
+  }
+  void remove(const std::string& path) {
+    for (Node* n = m_head.load(); n; n = n->next)
+      if (n->state.load() == 1 && path == n->path) {
+        n->state.store(0);
+        return;
+      }
+  }
+  /// Calls `action(path)` on every published path (from a signal handler too).
+  template <class Action>
+  void for_each(Action action) const {
+    for (Node* n = m_head.load(); n; n = n->next)
+      if (n->state.load() == 1) action(n->path);
+  }
 
-// A fixed table for the few folders an output created (removed if still empty).
-constexpr size_t kPathBytes = 4096;
-struct Slot {
-  std::atomic<int> state{0};
-  char path[kPathBytes];
+ private:
+  struct Node {
+    std::atomic<int> state{0};
+    size_t capacity = 0;
+    char* path = nullptr;
+    Node* next = nullptr;
+  };
+  std::atomic<Node*> m_head{nullptr};
 };
 
-// Folders an output created, removed on signals if still empty (after the files).
-constexpr int kFolderSlots = 8;
-Slot g_folders[kFolderSlots];
+SignalSafePaths g_temporaries;  // files being written
+SignalSafePaths g_folders;      // folders an output created, removed if still empty
+
+void register_temporary(const std::string& tmp) { g_temporaries.add(tmp); }
+void unregister_temporary(const std::string& tmp) { g_temporaries.remove(tmp); }
 
 // While a set of files is being published (SignalsHeld): a signal handled by another
 // thread (one this thread's mask does not cover) is only noted, and acted on when the
@@ -115,10 +119,8 @@ extern "C" void remove_temporaries_and_end(int sig) {
     g_pending_signal.store(sig);
     return;
   }
-  for (Node* n = g_temporaries.load(); n; n = n->next)
-    if (n->state.load() == 1) ::unlink(n->path);
-  for (Slot& s : g_folders)
-    if (s.state.load() == 1) ::rmdir(s.path);  // fails, harmlessly, unless empty
+  g_temporaries.for_each([](const char* path) { ::unlink(path); });
+  g_folders.for_each([](const char* path) { ::rmdir(path); });  // fails, harmlessly, unless empty
   std::signal(sig, SIG_DFL);
   ::raise(sig);
 }
@@ -193,24 +195,9 @@ void check_output_path(const std::string& path) {
   discard_temporary(probe);
 }
 
-void register_created_folder(const std::string& dir) {
-  if (dir.size() >= kPathBytes) return;
-  for (Slot& s : g_folders) {
-    int expected = 0;
-    if (!s.state.compare_exchange_strong(expected, 2)) continue;
-    std::memcpy(s.path, dir.c_str(), dir.size() + 1);
-    s.state.store(1);
-    return;
-  }
-}
+void register_created_folder(const std::string& dir) { g_folders.add(dir); }
 
-void forget_created_folder(const std::string& dir) {
-  for (Slot& s : g_folders)
-    if (s.state.load() == 1 && dir == s.path) {
-      s.state.store(0);
-      return;
-    }
-}
+void forget_created_folder(const std::string& dir) { g_folders.remove(dir); }
 
 void declare_input_files(const std::vector<std::string>& paths) {
   const std::lock_guard<std::mutex> lock(g_inputs_mutex);

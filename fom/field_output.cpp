@@ -165,7 +165,10 @@ void write_field_sets(const std::string& dir, const Problem& problem, const std:
   try {
     write_files_atomically(files);
   } catch (...) {
-    if (created) fs::remove(dir, ec), forget_created_folder(dir);  // only if still empty
+    if (created) {
+      fs::remove(dir, ec);  // only if still empty
+      forget_created_folder(dir);
+    }
     throw;
   }
   if (created) forget_created_folder(dir);
