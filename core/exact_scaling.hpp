@@ -31,4 +31,17 @@ inline ExactScaling exact_scaling(const Eigen::MatrixXd& d, const Eigen::VectorX
   return {factor(d.size() ? d.cwiseAbs().maxCoeff() : 0.0), factor(x.size() ? x.cwiseAbs().maxCoeff() : 0.0)};
 }
 
+/// \brief `solve(D', x')` on D and x scaled by exact_scaling() (D and x themselves,
+/// not copied, when they are in range), with the coefficients of its result —
+/// `coefficients(result)`, a reference into it — scaled back to those of D and x.
+template <class Solve, class Coefficients>
+auto solve_exactly_scaled(const Eigen::MatrixXd& d, const Eigen::VectorXd& x, Solve&& solve,
+                          Coefficients&& coefficients) {
+  const ExactScaling s = exact_scaling(d, x);
+  if (s.dictionary == 1.0 && s.signal == 1.0) return solve(d, x);
+  auto result = solve(Eigen::MatrixXd(d * s.dictionary), Eigen::VectorXd(x * s.signal));
+  coefficients(result) *= s.coefficients();
+  return result;
+}
+
 }  // namespace contactrom

@@ -47,11 +47,7 @@ SparseResult run(Solver& solver, const Eigen::MatrixXd& d, const Eigen::VectorXd
   SparseResult r;
   {
     py::gil_scoped_release release;
-    const ExactScaling s = exact_scaling(d, x);
-    if (s.dictionary == 1.0 && s.signal == 1.0)
-      r.x = solve(d, x);
-    else
-      r.x = solve(d * s.dictionary, x * s.signal) * s.coefficients();
+    r.x = solve_exactly_scaled(d, x, solve, [](Eigen::VectorXd& c) -> Eigen::VectorXd& { return c; });
   }
   r.status = solver.info();
   r.iterations = solver.iterations();

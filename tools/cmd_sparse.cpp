@@ -154,11 +154,9 @@ void run_sparse(const SparseArgs& args, bool has_tol, bool has_max_iter, bool ha
 
   check_gram_fits(args, d);
   // Data of extreme magnitude is scaled by powers of two (exact) for the kernel.
-  const contactrom::ExactScaling scaling = contactrom::exact_scaling(d, x);
-  const bool scaled = scaling.dictionary != 1.0 || scaling.signal != 1.0;
-  SparseRun run = scaled ? run_method(args, has_tol, has_max_iter, has_atoms, d * scaling.dictionary, x * scaling.signal)
-                         : run_method(args, has_tol, has_max_iter, has_atoms, d, x);
-  if (scaled) run.coefficients *= scaling.coefficients();
+  const SparseRun run = contactrom::solve_exactly_scaled(
+      d, x, [&](const MatrixXd& ds, const VectorXd& xs) { return run_method(args, has_tol, has_max_iter, has_atoms, ds, xs); },
+      [](SparseRun& r) -> VectorXd& { return r.coefficients; });
   // Norms that do not underflow or overflow with such data.
   const double residual = (d * run.coefficients - x).stableNorm();
   const double x_norm = x.stableNorm();
