@@ -5,9 +5,9 @@
 #include <memory>
 
 #include <contactrom/baselines/ipopt_qp.hpp>
-#include <contactrom/core/format.hpp>
 #include <contactrom/baselines/online_methods.hpp>
 #include <contactrom/fom/active_set_solver.hpp>
+#include <contactrom/rom/error_indicator.hpp>
 
 namespace contactrom::baselines {
 namespace {
@@ -135,9 +135,8 @@ BenchReport benchmark(const rom::ReducedModel& model, const std::vector<fom::Par
     rom::OnlineSolverOptions o = rom::options_from_map(v.method, v.options);
     // The reduced answer is timed alone (the error estimate is a separate variant).
     if (!v.options.count("estimate")) o.estimate = false;
-    if (o.estimate && !problem.stiffness_is_constant()) {
-      r.not_applicable[v.key] = "no error estimate: the stiffness of problem " + quoted(problem.name(), 200) +
-                                " depends on its parameters";
+    if (const std::string why = rom::no_error_estimate_reason(problem); o.estimate && !why.empty()) {
+      r.not_applicable[v.key] = "no error estimate: " + why;
       continue;
     }
     try {

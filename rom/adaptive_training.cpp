@@ -7,6 +7,7 @@
 #include <contactrom/core/format.hpp>
 #include <contactrom/fom/sampling.hpp>
 #include <contactrom/rom/database_merge.hpp>
+#include <contactrom/rom/error_indicator.hpp>
 #include <contactrom/rom/online_methods.hpp>
 
 namespace contactrom::rom {
@@ -96,10 +97,10 @@ AdaptiveOptions adaptive_options_of(const SnapshotDatabase& db) {
 AdaptiveTrainer::AdaptiveTrainer(const fom::Problem& problem, AdaptiveOptions options)
     : m_problem(problem), m_options(std::move(options)) {
   check_adaptive_options(m_options);
-  if (!problem.stiffness_is_constant())
+  if (const std::string why = no_error_estimate_reason(problem); !why.empty())
     throw InputError("adaptive training ranks its candidates by the error estimate of the reduced answers, which "
-                     "problem " + quoted(problem.name(), 200) + " has none of: its stiffness depends on its parameters; "
-                     "expected a problem whose elastic moduli do not depend on the parameters, or a grid (--train, --level)");
+                     "there is none of: " + why + "; expected a problem whose elastic moduli do not depend on the "
+                     "parameters, or a grid (--train, --level)");
   if (!m_options.generate) m_options.generate = [](const fom::Problem& p, const std::vector<fom::Param>& params,
                                                    const std::string& kind, int n, const OfflineOptions& o) {
     return generate_snapshots(p, params, kind, n, o);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <contactrom/core/stopwatch.hpp>
+#include <contactrom/core/format.hpp>
 #include <contactrom/fom/kkt.hpp>
 #include <contactrom/rom/reduced_model.hpp>
 
@@ -31,10 +32,15 @@ Eigen::MatrixXd solve_free(const fom::SparseCholesky& factor, const Eigen::Matri
 
 }  // namespace
 
+std::string no_error_estimate_reason(const fom::Problem& problem) {
+  if (problem.stiffness_is_constant()) return {};
+  return "the stiffness of problem " + quoted(problem.name(), 200) + " depends on its parameters";
+}
+
 ErrorIndicator::ErrorIndicator(const ReducedModel& model, ErrorIndicatorOptions options)
     : m_problem(model.problem()), m_rank(model.primal_rank()), m_options(std::move(options)) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (m_problem.stiffness_is_constant()) build(model);
+  if (no_error_estimate_reason(m_problem).empty()) build(model);
   m_setup_time = seconds_since(t0);
 }
 

@@ -88,6 +88,10 @@ struct ErrorEstimate {
   double time_s = 0.0;    ///< wall time of the estimate
 };
 
+/// \brief Why the answers of a reduced model of `problem` can have no error estimate
+/// ("the stiffness of problem 'X' depends on its parameters"); empty when they can.
+std::string no_error_estimate_reason(const fom::Problem& problem);
+
 /// \brief The error estimate of a reduced model's answers; see the file comment.
 /// Immutable after construction; estimate() is const and thread-safe.
 class ErrorIndicator {

@@ -5,6 +5,7 @@
 #include <contactrom/core/format.hpp>
 #include <contactrom/fom/contact_residuals.hpp>
 #include <contactrom/fom/kkt.hpp>
+#include <contactrom/rom/error_indicator.hpp>
 
 namespace contactrom::rom {
 
@@ -24,12 +25,10 @@ bool FallbackSolver::keeps(const OnlineResult& res, std::string& reason) const {
   const double f = m_options.safety_factor;
   if (res.status != Status::Success)
     reason = std::string("reduced status ") + to_string(res.status);
-  else if (std::isnan(res.primal_estimate) || std::isnan(res.dual_estimate))
-    reason = m_rom.model().problem().stiffness_is_constant()
-                 ? "no error estimate to judge the answer by (the estimate is off)"
-                 : "no error estimate to judge the answer by (the stiffness of problem " +
-                       quoted(m_rom.model().problem().name(), 200) + " depends on its parameters)";
-  else if (!(f * res.primal_estimate <= m_options.primal_tolerance))  // NaN: no estimate, not kept
+  else if (std::isnan(res.primal_estimate) || std::isnan(res.dual_estimate)) {
+    const std::string why = no_error_estimate_reason(m_rom.model().problem());
+    reason = "no error estimate to judge the answer by (" + (why.empty() ? std::string("the estimate is off") : why) + ")";
+  } else if (!(f * res.primal_estimate <= m_options.primal_tolerance))
     reason = "primal estimate " + format_number(res.primal_estimate) + " x " + format_number(f) + " above " +
              format_number(m_options.primal_tolerance);
   else if (!(f * res.dual_estimate <= m_options.dual_tolerance))
