@@ -60,10 +60,6 @@ std::string describe_motion(const Eigen::Vector3d& v, const Eigen::Vector2d& cen
          short_number(std::abs(py) < scale ? 0.0 : py) + ")";
 }
 
-}  // namespace
-
-namespace {
-
 /// Plain words for a free motion of a 3D piece, (t, ω) with the rotation ω per unit
 /// of `size` about `centre`: a translation, or a rotation about an axis (the points
 /// where the velocity t + ω × (x − c) is parallel to ω; a pitch along it is dropped).

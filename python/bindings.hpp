@@ -35,8 +35,6 @@ namespace py = pybind11;
 
 using ProblemPtr = std::shared_ptr<const fom::Problem>;
 
-/// \brief A snapshot database and the problem it was computed for (built by
-/// `offline`, or rebuilt from the file by `load_database`).
 /// \brief Thrown by interrupt_check() when Python has an exception pending (Ctrl-C:
 /// KeyboardInterrupt); the module's translator leaves that exception to Python.
 struct PythonErrorPending : std::exception {
@@ -48,6 +46,8 @@ struct PythonErrorPending : std::exception {
 /// PythonErrorPending if one raised. Call only from the thread that released the GIL.
 ProgressCallback interrupt_check();
 
+/// \brief A snapshot database and the problem it was computed for (built by
+/// `offline`, or rebuilt from the file by `load_database`).
 struct Database {
   std::shared_ptr<const rom::SnapshotDatabase> db;
   ProblemPtr problem;

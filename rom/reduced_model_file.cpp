@@ -26,9 +26,6 @@ namespace {
 
 using hdf5::Handle;
 
-/// Value of attribute `kind`: tells a reduced model from a database.
-constexpr const char* kKind = kReducedModelKind;
-
 /// The column-major rows × cols matrix as a dataset of cols rows (one column of
 /// `m` per dataset row, as h5py users index them).
 void write_columns(hid_t f, hid_t dcpl, const char* name, const Eigen::MatrixXd& m) {
@@ -71,7 +68,7 @@ OffsetKind read_offset_kind(hid_t f) {
 void write_model(hid_t f, hid_t dcpl, const OnlineModel& rom) {
   const ReducedModelData d = rom.model().data();
   const int version = kReducedModelFormatVersion;
-  hdf5::write_string_attribute(f, "kind", kKind);
+  hdf5::write_string_attribute(f, "kind", kReducedModelKind);
   hdf5::write_scalar_attribute(f, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &version);
   hdf5::write_string_attribute(f, "created_by", "contactrom " + contactrom::version());
   hdf5::write_string_attribute(f, "method", rom.method());
@@ -124,8 +121,8 @@ struct StoredModel {
 
 /// The attributes: format version, method, δ, offset kind, failed snapshots, options.
 void read_settings(hid_t f, const std::string& label, StoredModel& s) {
-  if (!hdf5::has_attribute(f, "kind") || hdf5::read_string_attribute(f, "kind") != kKind)
-    throw InputError(label + " is not a contactrom reduced model (attribute kind is not '" + kKind +
+  if (!hdf5::has_attribute(f, "kind") || hdf5::read_string_attribute(f, "kind") != kReducedModelKind)
+    throw InputError(label + " is not a contactrom reduced model (attribute kind is not '" + kReducedModelKind +
                      "'; a snapshot database is read with --db, not --rom)");
   s.version = hdf5::read_int_attribute(f, "format_version");
   if (s.version < 1 || s.version > kReducedModelFormatVersion)

@@ -587,9 +587,9 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
   } catch (const InputError& e) {
     throw InputError("database " + quoted(path, 200) + " attribute training_size: " + e.what());
   }
-  const auto mismatch = [&](const std::string& why) {
+  const auto mismatch = [&](const std::string& why, const std::string& expected = "the snapshots of that training set") {
     return InputError("database " + quoted(path, 200) + " claims " + option + std::to_string(db.training_size) + " of " +
-                      problem.name() + ", but " + why + "; expected the snapshots of that training set");
+                      problem.name() + ", but " + why + "; expected " + expected);
   };
   if (adaptive) {
     const AdaptiveRecord& a = db.adaptive;
@@ -606,10 +606,9 @@ void check_training_set(const SnapshotDatabase& db, const fom::Problem& problem,
                      std::to_string(db.num_snapshots()) + " from " + std::to_string(expected.size()));
   } else if (static_cast<int>(expected.size()) != db.num_snapshots()) {
     if (db.num_snapshots() < static_cast<int>(expected.size()))  // a part (offline --part k/K), or an interrupted append
-      throw InputError("database " + quoted(path, 200) + " claims " + option + std::to_string(db.training_size) + " of " +
-                       problem.name() + ", but it holds " + std::to_string(db.num_snapshots()) + " of its " +
-                       std::to_string(expected.size()) + " snapshots (a part of it); expected the whole set: complete "
-                       "it with contactrom offline --append, or join the parts with contactrom merge");
+      throw mismatch("it holds " + std::to_string(db.num_snapshots()) + " of its " + std::to_string(expected.size()) +
+                         " snapshots (a part of it)",
+                     "the whole set: complete it with contactrom offline --append, or join the parts with contactrom merge");
     throw mismatch("it holds " + std::to_string(db.num_snapshots()) + " snapshots instead of " +
                    std::to_string(expected.size()));
   }
