@@ -1,10 +1,12 @@
 #include <contactrom/fom/contact_residuals.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include <contactrom/core/format.hpp>
 #include <contactrom/fom/contact_model.hpp>
+#include <contactrom/fom/kkt.hpp>
 
 namespace contactrom::fom {
 
@@ -29,6 +31,17 @@ std::string ContactResiduals::describe(const ContactTolerances& tol) const {
   item("separation under pressure", complementarity, tol.complementarity, complementarity_row, " U");
   item("negative pressure", negative_pressure, tol.negative_pressure, negative_pressure_row, " of the largest");
   return out.str();
+}
+
+ScaledContactTolerances tolerances_on_own_scale(const ContactTolerances& tol, const Eigen::VectorXd& u_surface,
+                                                double displacement_scale) {
+  ScaledContactTolerances out{tol, 1.0};
+  const double own = (u_surface.size() ? u_surface.lpNorm<Eigen::Infinity>() : 0.0) / displacement_scale;
+  if (!(own < 1.0)) return out;  // NaN: U's tolerances, which a NaN residual fails anyway
+  out.scale = std::max(own, kNearZeroReference);
+  out.tolerances.penetration *= out.scale;
+  out.tolerances.complementarity *= out.scale;
+  return out;
 }
 
 ContactResiduals contact_residuals(const Problem& problem, const Eigen::VectorXd& u_surface,

@@ -36,6 +36,20 @@ struct ContactTolerances {
   double negative_pressure = 1e-2;
 };
 
+/// \brief The tolerances a candidate's gaps are judged by, on its own scale: those
+/// of `tol` when the candidate's largest surface displacement \f$ \|u_s\|_\infty \f$
+/// is at least U, else its penetration and separation tolerances times
+/// `scale` = \f$ \max(\|u_s\|_\infty / U,\ 10^{-6}) \f$ (the residuals stay in units
+/// of U). Far below the loads U describes, U's tolerance would pass a gap as large
+/// as the whole answer; below 1e-6 U the load counts as zero (kNearZeroReference of
+/// fom/kkt.hpp). The negative-pressure tolerance is relative to ‖λ‖∞ already.
+struct ScaledContactTolerances {
+  ContactTolerances tolerances;  ///< the scaled tolerances
+  double scale = 1.0;            ///< the factor applied (1: U's own)
+};
+ScaledContactTolerances tolerances_on_own_scale(const ContactTolerances& tol, const Eigen::VectorXd& u_surface,
+                                                double displacement_scale);
+
 /// \brief The row-by-row contact residuals of a candidate; see the file comment.
 struct ContactResiduals {
   double penetration = 0.0;        ///< max_s d_s^+ / U
