@@ -275,11 +275,13 @@ BOOST_AUTO_TEST_CASE(hertz_basis_and_online_solver) {
     BOOST_TEST(cpg.dual_basis().col(i) == model.dictionary().col(basis.columns[i]));
   }
   // Online: converged, λ̂ ≥ 0, reduced constraint Wᵀ(Cu − g) ≤ τ at the returned u.
+  // validation[0], d = 0.00375, lies far below the smallest training load (0.01):
+  // its answer (a pressure error of 0.5) converges and is flagged inaccurate.
   const std::vector<fom::Param> validation = fom::validation_set(*problem, 30);
   for (size_t i = 0; i < validation.size(); i += 12) {
     const rom::OnlineResult res = cpg.solve(validation[i]);
     BOOST_TEST(res.converged);
-    BOOST_TEST(res.status == Status::Success);
+    BOOST_TEST(res.status == (i == 0 ? Status::Inaccurate : Status::Success), "d = " << validation[i](0));
     BOOST_TEST(!res.selected.empty());
     BOOST_TEST(res.coefficients.minCoeff() > 0.0);
     BOOST_TEST(res.lambda.minCoeff() >= 0.0);

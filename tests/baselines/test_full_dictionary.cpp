@@ -39,6 +39,7 @@ struct Hertz {
     db = rom::generate_snapshots(*problem, 12, offline);
     model = std::make_unique<rom::ReducedModel>(*problem, db);
     const std::vector<fom::Param> validation = fom::validation_set(*problem, 12);
+    // From d = 0.01125 (below the smallest training load, 0.025) to 0.29375.
     for (size_t i = 3; i < validation.size(); i += 16) params.push_back(validation[i]);
   }
 };
@@ -91,7 +92,9 @@ BOOST_AUTO_TEST_CASE(converged_solution_solves_the_reduced_qp) {
     const rom::OnlineResult res = full.solve(mu);
     BOOST_TEST_MESSAGE("d = " << mu(0) << ": " << res.iterations << " iterations, |I| = " << res.selected.size());
     BOOST_TEST(res.converged);
-    BOOST_TEST(res.status == Status::Success);
+    // Below the training loads an answer may be flagged (d = 0.01125: a pressure
+    // error of 0.47); inside them every one succeeds.
+    BOOST_TEST((res.status == Status::Success || (res.status == Status::Inaccurate && mu(0) < 0.025)));
     BOOST_TEST(res.iterations <= 50);
     // Dual feasibility and the reduced constraint at the returned u (own pairing).
     BOOST_TEST(res.coefficients.size() == static_cast<Eigen::Index>(res.selected.size()));
@@ -153,7 +156,7 @@ BOOST_AUTO_TEST_CASE(iteration_cap_and_textbook_pdas) {
   const rom::OnlineResult res = baselines::FullDictionaryActiveSet(*h.model, textbook).solve(h.params.front());
   BOOST_TEST(res.u.allFinite());
   BOOST_TEST(res.lambda.allFinite());
-  BOOST_TEST(res.converged == (res.status == Status::Success));
+  BOOST_TEST(res.converged == (res.status == Status::Success || res.status == Status::Inaccurate));
 }
 
 BOOST_AUTO_TEST_CASE(bad_columns_and_options_are_input_errors) {

@@ -52,7 +52,7 @@ json run_json(const std::string& args) {
   return json::parse(r.out);  // exactly one JSON object
 }
 
-void check_report(const json& j, const std::string& problem, int n) {
+void check_report(const json& j, const std::string& problem, int n, int inaccurate) {
   BOOST_TEST(j["problem"] == problem);
   BOOST_TEST(j["validation_size"] == n);
   const json& ref = j["reference"];
@@ -72,7 +72,7 @@ void check_report(const json& j, const std::string& problem, int n) {
       BOOST_TEST(r["nonconverged"] == 0);
       BOOST_TEST(r["reduced_constraint"] == true);
       BOOST_TEST(r["tau"].get<double>() == 1e-8);
-      BOOST_TEST(r["inaccurate"] == 0);
+      BOOST_TEST(r["inaccurate"] == inaccurate);
       // Reduced level: max_p W_pᵀ(Cu − g) ≤ τ + 1e-10 for the primal–dual active sets.
       // The greedy's fixed point is stopped by the physical test at its own pairing
       // instead (row by row, in units of U: docs/rom.md, "Fixed-point schedule").
@@ -98,13 +98,15 @@ void check_report(const json& j, const std::string& problem, int n) {
 
 BOOST_AUTO_TEST_CASE(hertz_greedy_cpg_full_dictionary_against_ipopt) {
   const json j = run_json("verify --db " + dbs().hertz + " --method greedy,cpg,full-dictionary --limit 5 --threads 2");
-  check_report(j, "hertz", 5);
+  // The first of the five, d = 0.00375, lies far below the smallest training load
+  // (0.025): every method answers it with a pressure error of 0.78 and says so.
+  check_report(j, "hertz", 5, 1);
   BOOST_TEST(j["train"] == 12);
 }
 
 BOOST_AUTO_TEST_CASE(ironing_greedy_cpg_full_dictionary_against_ipopt) {
   const json j = run_json("verify --db " + dbs().ironing + " --method greedy,cpg,full-dictionary --limit 5 --threads 2");
-  check_report(j, "ironing", 5);
+  check_report(j, "ironing", 5, 0);
   BOOST_TEST(j["level"] == 4);
   // The pressure moves with the iron, so no level-4 snapshot lies in the cone of the
   // others at the default tolerance 5e-2: CPG keeps every one of them.
