@@ -34,6 +34,17 @@ std::string base_of(const std::string& path) {
 
 std::string cannot_write(const std::string& path) { return "cannot write " + quoted(path, 200) + ": "; }
 
+/// A file that cannot be created or renamed: a fault of the machine (no space or
+/// inodes left, quota, I/O error, no descriptors or memory) is a WriteFailure (exit
+/// 1), anything else (permissions, a read-only file system, a bad name) bad input.
+[[noreturn]] void throw_cannot_create(const std::string& message, int err) {
+  const std::string text = message + std::strerror(err);
+  switch (err) {
+    case ENOSPC: case EDQUOT: case EIO: case EMFILE: case ENFILE: case ENOMEM: throw WriteFailure(text);
+    default: throw InputError(text);
+  }
+}
+
 // --- declared inputs -----------------------------------------------------------
 struct DeclaredInput {
   std::string path;
@@ -129,7 +140,12 @@ void remove_all(const std::vector<std::string>& tmps) {
   for (const std::string& t : tmps) discard_temporary(t);
 }
 
-/// Holds SIGINT, SIGTERM and SIGHUP while alive (the renames that publish a set of
+/// The signals whose default action ends the process and that a handler can catch:
+/// each removes the temporaries first (SIGKILL cannot be caught).
+constexpr int kEndingSignals[] = {SIGINT,  SIGTERM, SIGHUP,  SIGQUIT,   SIGPIPE, SIGXCPU,
+                                  SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF};
+
+/// Holds the ending signals while alive (the renames that publish a set of
 /// files complete before a signal is handled): blocked in this thread, and only
 /// noted by the handler when another thread of the process receives one.
 class SignalsHeld {
@@ -137,7 +153,7 @@ class SignalsHeld {
   SignalsHeld() {
     sigset_t set;
     sigemptyset(&set);
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set, sig);
+    for (int sig : kEndingSignals) sigaddset(&set, sig);
     pthread_sigmask(SIG_BLOCK, &set, &m_old);
     g_publishing.fetch_add(1);
   }
@@ -159,7 +175,10 @@ void remove_temporaries_on_signals() {
   struct sigaction sa {};
   sa.sa_handler = remove_temporaries_and_end;
   sigemptyset(&sa.sa_mask);
-  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
+  for (int sig : kEndingSignals) sigaction(sig, &sa, nullptr);
+  // Past a file-size limit (ulimit -f) a write fails with EFBIG instead of ending
+  // the process: reported like a full disk, temporaries removed.
+  std::signal(SIGXFSZ, SIG_IGN);
 }
 
 void check_output_path(const std::string& path) {
@@ -188,12 +207,14 @@ void check_output_path(const std::string& path) {
   if (fd < 0) {
     const int err = errno;
     unregister_temporary(probe);
-    throw InputError(cannot_write(path) + "cannot create a file in folder " + quoted(folder, 200) + ": " +
-                     std::strerror(err));
+    throw_cannot_create(cannot_write(path) + "cannot create a file in folder " + quoted(folder, 200) + ": ", err);
   }
   ::close(fd);
   discard_temporary(probe);
 }
+
+void register_scratch_file(const std::string& path) { g_temporaries.add(path); }
+void forget_scratch_file(const std::string& path) { g_temporaries.remove(path); }
 
 void register_created_folder(const std::string& dir) { g_folders.add(dir); }
 
@@ -258,7 +279,7 @@ void commit_temporary(const std::string& tmp, const std::string& path) {
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     const int err = errno;
     discard_temporary(tmp);
-    throw InputError(cannot_write(path) + "renaming the completed temporary file failed: " + std::strerror(err));
+    throw_cannot_create(cannot_write(path) + "renaming the completed temporary file failed: ", err);
   }
   unregister_temporary(tmp);
 }
@@ -273,7 +294,7 @@ void write_files_atomically(const std::vector<std::pair<std::string, FileWriter>
     if (!out) {
       const int err = errno;
       remove_all(tmps);
-      throw InputError(cannot_write(path) + std::strerror(err));
+      throw_cannot_create(cannot_write(path), err);
     }
     try {
       writer(out);

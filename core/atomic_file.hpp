@@ -15,8 +15,10 @@
 ///
 /// Failures of the machine while writing (disk full, I/O error) throw WriteFailure,
 /// not InputError: the CLI reports them with exit code 1. The temporary files being
-/// written are removed when the process is ended by SIGINT, SIGTERM or SIGHUP
-/// (remove_temporaries_on_signals()), and a set of files is published only after
+/// written are removed when the process is ended by a signal it can catch (SIGINT,
+/// SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXCPU, SIGUSR1/2, SIGALRM, SIGVTALRM, SIGPROF;
+/// remove_temporaries_on_signals(), which also makes a file-size limit a write
+/// failure rather than SIGXFSZ), and a set of files is published only after
 /// all of it was written.
 #include <functional>
 #include <stdexcept>
@@ -61,11 +63,22 @@ void register_created_folder(const std::string& dir);
 /// \brief Ends register_created_folder(dir) (the outputs in it are published).
 void forget_created_folder(const std::string& dir);
 
-/// \brief Installs handlers of SIGINT, SIGTERM and SIGHUP that remove the
-/// temporary files being written (write_file_atomically(), temporary_path_for())
-/// and then end the process by the same signal (its default action). Called by the
-/// command-line tool; a program embedding the library may call it (it replaces
-/// the program's handlers of those signals).
+/// \brief Registers a published file that is scratch (e.g. in a temporary folder of
+/// register_created_folder()): the signal handlers of remove_temporaries_on_signals()
+/// remove it, until forget_scratch_file().
+void register_scratch_file(const std::string& path);
+/// \brief Ends register_scratch_file(path).
+void forget_scratch_file(const std::string& path);
+
+/// \brief Installs handlers of the catchable signals that end a process (SIGINT,
+/// SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXCPU, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM,
+/// SIGPROF) that remove the temporary files being written (write_file_atomically(),
+/// temporary_path_for()) and then end the process by the same signal (its default
+/// action), and ignores SIGXFSZ (a write past `ulimit -f` then fails with EFBIG and
+/// is reported like a full disk). A process ended by SIGKILL (or the kernel's
+/// out-of-memory killer) leaves its temporaries, named `.NAME.tmp.PID.K` beside the
+/// output. Called by the command-line tool; a program embedding the library may
+/// call it (it replaces the program's handlers of those signals).
 void remove_temporaries_on_signals();
 
 /// \brief An exclusive lock on an existing file that is updated by read, modify

@@ -31,7 +31,9 @@ std::string read_input_file(const std::string& path, const std::string& label, s
   if (!in) throw InputError(label + " " + quoted(path, 200) + " cannot be read: " + std::strerror(errno));
   std::ostringstream text;
   text << in.rdbuf();
-  return text.str();
+  std::string content = text.str();
+  if (content.compare(0, 3, "\xEF\xBB\xBF") == 0) content.erase(0, 3);
+  return content;
 }
 
 }  // namespace contactrom

@@ -13,7 +13,8 @@ namespace contactrom {
 /// `path` is a readable regular file of at most `max_bytes` bytes.
 void check_input_file(const std::string& path, const std::string& label, std::uintmax_t max_bytes);
 
-/// \brief The content of `path` after check_input_file().
+/// \brief The content of `path` after check_input_file(), without a leading UTF-8
+/// byte-order mark (which some editors write, and which no one can see in a message).
 std::string read_input_file(const std::string& path, const std::string& label, std::uintmax_t max_bytes);
 
 }  // namespace contactrom

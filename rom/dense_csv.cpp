@@ -53,6 +53,7 @@ Eigen::MatrixXd read_dense_csv(std::istream& in, const std::string& name) {
   std::size_t line_number = 0;
   while (std::getline(in, line)) {
     ++line_number;
+    if (line_number == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // a UTF-8 byte-order mark
     const std::string content = trim(line);
     if (content.empty() || content[0] == '#') continue;
     std::size_t count = 0;

@@ -1,14 +1,16 @@
 #include <contactrom/rom/hdf5_io.hpp>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <limits>
 
 #include <contactrom/core/format.hpp>
 #include <contactrom/core/atomic_file.hpp>
 #include <contactrom/core/errors.hpp>
+#include <contactrom/core/input_file.hpp>
 
 namespace contactrom::rom::hdf5 {
 namespace {
@@ -432,10 +434,11 @@ int superblock_version(const std::string& path) {
 }  // namespace
 
 hid_t open_file(const std::string& path, const std::string& label, const std::string& expected_writer) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(label + " " + quoted(path, 200) + " not found");
-  if (fs::is_directory(path, ec)) throw InputError(label + " " + quoted(path, 200) + " is a directory, expected an HDF5 file");
+  // A regular file that can be read: a pipe or a device would block the signature
+  // search below (or never end it), and an unreadable file is not "not HDF5".
+  check_input_file(path, label, std::numeric_limits<std::uintmax_t>::max());
+  if (std::ifstream probe(path, std::ios::binary); !probe)
+    throw InputError(label + " " + quoted(path, 200) + " cannot be read: " + std::strerror(errno));
   silence();
   const int version = superblock_version(path);
   if (version < 0)

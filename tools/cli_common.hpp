@@ -129,6 +129,12 @@ inline void declare_problem_inputs(const fom::Problem& problem, const std::vecto
 }
 
 /// A parameter as a JSON number (one value) or array (several).
+/// The text of a JSON report: file names are bytes, not always UTF-8, so an invalid
+/// sequence is printed as U+FFFD instead of failing after the work is done.
+inline std::string json_text(const nlohmann::json& j) {
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 inline nlohmann::json param_json(const fom::Param& mu) {
   if (mu.size() == 1) return mu(0);
   return std::vector<double>(mu.data(), mu.data() + mu.size());

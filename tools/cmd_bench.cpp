@@ -123,7 +123,7 @@ void run_bench(const BenchArgs& a) {
   j["ratios"] = r.ratios;
   const nlohmann::json& ratios = j["ratios"];
   if (a.json) {
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << "contactrom bench: " << problem->name() << ", training " << n << ", delta " << a.delta << ", "

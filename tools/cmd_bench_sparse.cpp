@@ -173,7 +173,7 @@ void run_bench(const BenchArgs& args) {
     out["noise"] = args.noise;
     out["seed"] = base_seed;
     out["results"] = results;
-    std::cout << out.dump() << "\n";
+    std::cout << contactrom::cli::json_text(out) << "\n";
   }
 }
 

@@ -76,7 +76,7 @@ void run_chls(const ChlsArgs& a) {
   j["params"] = params;
   append_summary_json(j, rom::summary_values(chls));
   if (a.json) {
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << "CHLS (leave-one-out convex hull least squares) of " << used.size() << " " << db.problem.name
@@ -160,7 +160,7 @@ void run_hull_report(const HullArgs& a) {
   j["dictionary_size"] = solver.dictionary().size();
   append_summary_json(j, rom::summary_values(r));
   if (a.json) {
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << "convex-hull on " << problem->name() << " (" << db.training_kind << " " << db.training_size << "), "

@@ -13,12 +13,15 @@
 //                      contactrom online --db hertz30.h5 --method greedy --option init=empty --delta 1e-8 --validation
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 
+#include <contactrom/core/atomic_file.hpp>
 #include <contactrom/core/format.hpp>
 #include <contactrom/core/errors.hpp>
 #include <contactrom/core/stopwatch.hpp>
@@ -105,22 +108,30 @@ void run_demo(const DemoArgs& a) {
   std::string dir = a.dir;
   const bool temporary = dir.empty();
   if (temporary) {
-    char name[] = "/tmp/contactrom-demo-XXXXXX";
-    if (!::mkdtemp(name)) throw InputError("cannot create a temporary folder under /tmp");
+    std::error_code ec;
+    const fs::path base = fs::temp_directory_path(ec);  // $TMPDIR, else /tmp
+    std::string name = ((ec ? fs::path("/tmp") : base) / "contactrom-demo-XXXXXX").string();
+    if (!::mkdtemp(name.data()))
+      throw InputError("cannot create a temporary folder under " + quoted(fs::path(name).parent_path().string(), 200) +
+                       ": " + std::strerror(errno) + "; expected a writable TMPDIR, or give --dir");
     dir = name;
+    register_created_folder(dir);  // removed, with the database, if a signal ends the run
   } else {
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec || !fs::is_directory(dir)) throw InputError("cannot create folder " + quoted(dir, 200));
   }
   struct Remove {
-    std::string dir;
+    std::string dir, file;
     bool active;
     ~Remove() {
+      if (!active) return;
+      if (!file.empty()) forget_scratch_file(file);
+      forget_created_folder(dir);
       std::error_code ec;
-      if (active) fs::remove_all(dir, ec);
+      fs::remove_all(dir, ec);
     }
-  } remove{dir, temporary};
+  } remove{dir, {}, temporary};
 
   auto problem = fom::make_problem("hertz");
   const fom::ActiveSetSolver solver(*problem);
@@ -136,6 +147,7 @@ void run_demo(const DemoArgs& a) {
   offline.progress = [&bar](int done, int total) { bar.update(done, total); };
   const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, a.train, offline);
   bar.finish();
+  if (temporary) remove.file = db_path, register_scratch_file(db_path);
   rom::write_database(db_path, db);
   int failed = 0;
   for (Status s : db.status) failed += s != Status::Success;

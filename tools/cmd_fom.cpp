@@ -71,7 +71,7 @@ void run_fom(const FomArgs& a) {
   j["kkt"] = kkt_json(kkt);
   j["warnings"] = warnings;
   if (a.json) {
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << "problem " << problem->name() << "  " << problem->range_text() << "\n"

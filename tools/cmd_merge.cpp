@@ -9,6 +9,7 @@
 #include <contactrom/rom/database_merge.hpp>
 #include <contactrom/rom/snapshot_database.hpp>
 #include "tools/cli.hpp"
+#include "tools/cli_common.hpp"
 
 namespace contactrom::cli {
 namespace {
@@ -33,7 +34,7 @@ void run_merge(const MergeArgs& a) {
     j["inputs"] = a.inputs.size();
     j["snapshots"] = merged.num_snapshots();
     j["out"] = a.out;
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << "merged " << a.inputs.size() << " databases of " << merged.problem.name << ": "

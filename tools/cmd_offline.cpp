@@ -238,7 +238,7 @@ void print_adaptive_summary(const OfflineArgs& a, const fom::Problem& problem, c
     j["ranks"] = ranks.size;
     j["wall_time_s"] = db.wall_time_s;
     j["out"] = out;
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << std::setprecision(3) << "offline " << problem.name() << " adaptive: " << db.num_snapshots()
@@ -323,7 +323,7 @@ void finish_without_snapshots(const OfflineArgs& a, const fom::Problem& problem,
   nlohmann::json j{{"problem", problem.name()}, {"snapshots", 0},
                    {"total_snapshots", plan.existing.num_snapshots()}, {"out", plan.out}};
   if (reorder) j["reordered"] = true;
-  std::cout << (a.json ? j.dump()
+  std::cout << (a.json ? json_text(j)
                        : a.append + (reorder ? " holds these snapshots; rewritten in training order"
                                              : " already holds these snapshots; nothing to compute"))
             << std::endl;
@@ -372,7 +372,7 @@ void print_offline_summary(const OfflineArgs& a, const fom::Problem& problem, co
     j["setup_time_s"] = db.setup_time_s;
     j["mean_fom_time_s"] = mean_fom;
     j["out"] = plan.out;
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << "offline " << problem.name() << ": " << db.num_snapshots() << " snapshots (" << db.training_kind << " "

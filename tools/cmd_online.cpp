@@ -83,7 +83,7 @@ void run_single(const OnlineArgs& a, const fom::Problem& problem, const rom::Red
   j["fom_time_s"] = ref.time_s;
   j["kkt"] = kkt_json(kkt);
   if (a.json) {
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << "online " << solver.name() << " on " << problem.name() << " at " << j["param"].dump() << ": "
@@ -114,7 +114,7 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
   nlohmann::json j;
   append_summary_json(j, rom::summary_values(s));
   if (a.json) {
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << "online " << s.method << " on " << problem.name() << " (" << db.training_kind << " "

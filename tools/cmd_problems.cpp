@@ -7,6 +7,7 @@
 #include <contactrom/fom/problem.hpp>
 #include <contactrom/fom/rope.hpp>
 #include "tools/cli.hpp"
+#include "tools/cli_common.hpp"
 
 namespace contactrom::cli {
 namespace {
@@ -37,7 +38,7 @@ void run_problems(const ProblemsArgs& a) {
     list.push_back(p);
   }
   if (a.json) {
-    std::cout << nlohmann::json{{"problems", list}}.dump() << std::endl;
+    std::cout << json_text(nlohmann::json{{"problems", list}}) << std::endl;
     return;
   }
   std::cout << "shipped problems (" << fom::problem_directory() << "):\n";

@@ -129,7 +129,7 @@ void run_query(const QueryArgs& a) {
     j["queries"].push_back(q);
   }
   if (a.json) {
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << "reduced model of " << problem.name() << " (" << rom.method() << ", primal rank "

@@ -74,7 +74,7 @@ void run_reduce(const ReduceArgs& a) {
   j["time_s"] = seconds;
   j["pod_time_s"] = rom.model().pod_time();
   if (a.json) {
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
     return;
   }
   std::cout << "reduced model of " << problem->name() << " (" << rom.method() << "): primal rank "

@@ -178,7 +178,7 @@ void run_sparse(const SparseArgs& args, bool has_tol, bool has_max_iter, bool ha
     out["cols"] = d.cols();
     out["coefficients"] = std::vector<double>(run.coefficients.data(), run.coefficients.data() + run.coefficients.size());
     for (const auto& item : run.extra.items()) out[item.key()] = item.value();
-    std::cout << out.dump() << "\n";  // doubles are written with round-trip precision
+    std::cout << contactrom::cli::json_text(out) << "\n";  // doubles are written with round-trip precision
     return;
   }
 

@@ -196,7 +196,7 @@ void print_json(const VerifyArgs& a, const rom::SnapshotDatabase& db, const rom:
   j["methods"] = nlohmann::json::object();
   for (const auto& r : report.methods) j["methods"][r.name] = method_json(r, model, a.bench, report.fom_median_time_s);
   if (a.bench) j["fom_median_time_s"] = report.fom_median_time_s;
-  std::cout << j.dump() << std::endl;
+  std::cout << json_text(j) << std::endl;
 }
 
 void print_text(const VerifyArgs& a, const rom::SnapshotDatabase& db, const rom::ReducedModel& model,

@@ -8,6 +8,9 @@
 // Bad input ends with one line on stderr ("contactrom: error: ...") and exit code 2;
 // numerical non-convergence is reported in the output with a status instead.
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <memory>
 #include <new>
@@ -29,6 +32,33 @@ std::vector<CommandEntry>& command_table() {
   return table;
 }
 }  // namespace contactrom::cli
+
+namespace {
+
+/// A message as one line: control characters (a newline or an escape sequence in a
+/// name read from a file) are written as \n, \t or \xHH.
+std::string one_line(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '\n') out += "\\n";
+    else if (c == '\t') out += "\\t";
+    else if (c < 0x20 || c == 0x7f) {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    } else out += ch;
+  }
+  return out;
+}
+
+int fail(const std::string& message, int code) {
+  std::cerr << "contactrom: error: " << one_line(message) << "\n";
+  return code;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace contactrom;
@@ -57,30 +87,29 @@ int main(int argc, char** argv) {
     if (!known) {
       std::string names;
       for (const auto& e : table) names += (names.empty() ? "" : ", ") + e.name;
-      std::cerr << "contactrom: error: unknown command " << quoted(name) << "; expected one of: " << names << "\n";
-      return 2;
+      return fail("unknown command " + quoted(name) + "; expected one of: " + names, 2);
     }
   }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << "contactrom: error: " << e.what() << "\n";
-    return 2;
+    return fail(e.what(), 2);
   } catch (const InputError& e) {
-    std::cerr << "contactrom: error: " << e.what() << "\n";
-    return 2;
+    return fail(e.what(), 2);
   } catch (const std::bad_alloc&) {
-    std::cerr << "contactrom: error: out of memory: a size given in the input (mesh, database, dictionary or option)"
-                 " is too large for this machine\n";
-    return 1;
+    return fail("out of memory: a size given in the input (mesh, database, dictionary or option) is too large for this"
+                " machine", 1);
   } catch (const std::length_error&) {
-    std::cerr << "contactrom: error: a size given in the input (mesh, database, dictionary or option) is too large to"
-                 " allocate\n";
-    return 1;
+    return fail("a size given in the input (mesh, database, dictionary or option) is too large to allocate", 1);
   } catch (const std::exception& e) {
-    std::cerr << "contactrom: error: " << e.what() << "\n";
-    return 1;
+    return fail(e.what(), 1);
   }
+  // The report went to stdout: a full disk or a closed pipe there is a failure too.
+  errno = 0;
+  std::cout.flush();
+  if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout))
+    return fail(std::string("cannot write the report to standard output: ") +
+                    (errno ? std::strerror(errno) : "write error"), 1);
   return 0;
 }

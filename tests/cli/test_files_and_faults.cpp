@@ -7,16 +7,20 @@
 #define BOOST_TEST_MODULE cli_files_and_faults
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <boost/test/unit_test.hpp>
+#include <algorithm>
+#include <cstdlib>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "common/run_command.hpp"
 
@@ -254,8 +258,9 @@ BOOST_FIXTURE_TEST_CASE(signals_during_writes_leave_the_old_or_the_complete_new_
     std::ofstream(t.path, std::ios::binary) << t.before;
     const long span = run_time_us(t.args);
     int kept_old = 0, complete_new = 0;
-    for (int sig : {SIGINT, SIGTERM}) {
-      for (int trial = 0; trial < 20; ++trial) {
+    // Every signal that ends a process and can be caught, not only Ctrl-C's.
+    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGUSR1, SIGUSR2, SIGALRM, SIGXCPU}) {
+      for (int trial = 0; trial < 5; ++trial) {
         std::ofstream(t.path, std::ios::binary | std::ios::trunc) << t.before;
         const long delay = std::uniform_int_distribution<long>(0, span)(rng);
         run_and_signal(t.args, sig, std::chrono::microseconds(delay));
@@ -361,6 +366,75 @@ BOOST_FIXTURE_TEST_CASE(user_strings_are_quoted_on_one_line, Fixture) {
       BOOST_TEST(r.exit_code == 2);
       BOOST_TEST(std::count(r.err.begin(), r.err.end(), '\n') == 1, r.err);
       BOOST_TEST(r.err.find('\x1b') == std::string::npos, r.err);
+    }
+  }
+}
+
+BOOST_FIXTURE_TEST_CASE(pipes_devices_and_write_errors_are_reported_not_waited_on, Fixture) {
+  const std::string db = file("db.h5"), fifo = file("fifo.h5");
+  BOOST_REQUIRE(run_command(kExe + " offline --problem rope --out " + db).exit_code == 0);
+  // An HDF5 input that is a pipe or a device: refused at once (the signature search
+  // would block on the pipe and read /dev/zero for ever). `timeout` turns a hang into 124.
+  BOOST_REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  const std::vector<std::string> readers = {"online --db " + fifo + " --param 20", "query --rom /dev/zero --param 20",
+                                            "reduce --db " + fifo + " --out " + file("r.h5"),
+                                            "merge " + fifo + " " + db + " --out " + file("m.h5")};
+  for (const std::string& args : readers) {
+    BOOST_TEST_CONTEXT(args) {
+      const auto r = run_command("timeout 60 " + kExe + " " + args);
+      BOOST_TEST(r.exit_code == 2);
+      BOOST_TEST(r.err.find("is not a regular file") != std::string::npos, r.err);
+    }
+  }
+  // The report on a full disk or a closed stdout: exit 1, one line on stderr.
+  for (const char* redirect : {">/dev/full", ">&-"}) {
+    const auto r = run_command("sh -c '" + kExe + " problems --json " + redirect + "'");
+    BOOST_TEST(r.exit_code == 1, redirect);
+    BOOST_TEST(r.err.find("cannot write the report to standard output") != std::string::npos, r.err);
+    BOOST_TEST(std::count(r.err.begin(), r.err.end(), '\n') == 1, r.err);
+  }
+  // A file name that is not UTF-8 is printed in the JSON report, not a failure
+  // after the file was written.
+  const std::string latin1 = file("caf\xe9.h5");
+  const auto named = run_command(kExe + " offline --problem rope --json --out '" + latin1 + "'");
+  BOOST_TEST(named.exit_code == 0, named.err);
+  BOOST_TEST(fs::exists(latin1));
+  BOOST_TEST(named.out.find("\"out\":") != std::string::npos);
+  // A parameter list with a UTF-8 byte-order mark reads as without it.
+  std::ofstream(file("bom.csv")) << "\xEF\xBB\xBF" << "20\n30\n";
+  const auto bom = run_command(kExe + " online --db " + db + " --validation --params " + file("bom.csv") + " --json");
+  BOOST_TEST(bom.exit_code == 0, bom.err);
+  BOOST_TEST(bom.out.find("\"validation_size\":2") != std::string::npos, bom.out);
+  BOOST_TEST(temporaries_in(dir) == 0);
+}
+
+BOOST_FIXTURE_TEST_CASE(an_interrupted_demo_leaves_no_temporary_folder, Fixture) {
+  // The demo's database lives in a temporary folder under $TMPDIR: removed at the
+  // end and when a signal ends the run while the database is there.
+  const std::string tmp = file("tmpdir");
+  fs::create_directory(tmp);
+  for (int trial = 0; trial < 4; ++trial) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      ::setenv("TMPDIR", tmp.c_str(), 1);
+      const int null = ::open("/dev/null", O_WRONLY);
+      ::dup2(null, STDOUT_FILENO), ::dup2(null, STDERR_FILENO);
+      ::execl(kExe.c_str(), kExe.c_str(), "demo", "--train", "600", "--threads", "1", static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    // Wait for the database to appear, then interrupt.
+    bool seen = false;
+    for (int i = 0; i < 3000 && !seen; ++i) {
+      for (const auto& e : fs::recursive_directory_iterator(tmp))
+        if (e.path().extension() == ".h5") seen = true;
+      if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ::kill(pid, trial % 2 ? SIGTERM : SIGINT);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    BOOST_TEST_CONTEXT("trial " << trial) {
+      BOOST_TEST(seen);
+      BOOST_TEST(fs::is_empty(tmp));
     }
   }
 }
