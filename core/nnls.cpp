@@ -221,7 +221,7 @@ VectorXd Nnls::solve(const VectorXd& b) { return run(b, nullptr); }
 VectorXd Nnls::solve(const VectorXd& b, const VectorXd& x0) { return run(b, &x0); }
 
 VectorXd Nnls::run(const VectorXd& b, const VectorXd* x0) {
-  if (!m_computed || b.size() != m_a.rows() || !b.allFinite()) {
+  if (!m_computed || b.size() != m_a.rows() || !b.allFinite() || (x0 && x0->size() != m_a.cols())) {
     m_info = Status::InvalidInput;
     return VectorXd::Zero(m_a.cols());
   }

@@ -428,7 +428,12 @@ std::string find_problem_file(const std::string& name_or_path) {
   if (name_or_path.empty() || !fs::exists(path, ec)) {
     std::string list;
     for (const auto& n : shipped_problem_names()) list += (list.empty() ? "" : ", ") + n;
-    throw InputError("unknown problem " + quoted(name_or_path, 200) + "; expected a problem file path or one of: " + list);
+    std::string where = "; the shipped problems are looked for in " + quoted(problem_directory(), 200);
+    if (!fs::is_directory(problem_directory(), ec))
+      where += ", which does not exist: set CONTACTROM_PROBLEM_DIR to the folder that holds them "
+               "(PREFIX/share/contactrom/problems of an install)";
+    throw InputError("unknown problem " + quoted(name_or_path, 200) + "; expected a problem file path or one of: " + list +
+                     where);
   }
   return path;
 }

@@ -459,10 +459,7 @@ not succeed. ValueError names the argument for a bad value.)doc")
       .def(
           "with_fallback",
           [](const ReducedModel& r, double primal_tolerance, double dual_tolerance) {
-            if (!(primal_tolerance > 0.0) || !(dual_tolerance > 0.0))
-              throw InputError("with_fallback: tolerances must be positive numbers, got " +
-                               format_number(primal_tolerance) + " and " + format_number(dual_tolerance));
-            rom::FallbackOptions o;
+            rom::FallbackOptions o;  // checked by FallbackSolver
             o.primal_tolerance = primal_tolerance;
             o.dual_tolerance = dual_tolerance;
             return Fallback{r.rom, std::make_shared<rom::FallbackSolver>(r.rom->solver(), o)};

@@ -149,6 +149,10 @@ std::vector<double> AdaptiveTrainer::evaluate(const SnapshotDatabase& db, const 
 SnapshotDatabase AdaptiveTrainer::run() const {
   const int n = initial_size();
   const std::vector<fom::Param> initial = fom::training_set(m_problem, n);
+  if (static_cast<int>(initial.size()) > m_options.max_snapshots)
+    throw InputError("max_snapshots = " + std::to_string(m_options.max_snapshots) + " is below the " +
+                     std::to_string(initial.size()) + " snapshots of the initial training set; expected at least " +
+                     std::to_string(initial.size()));
   SnapshotDatabase db = m_options.generate(m_problem, initial, "adaptive", n, m_options.offline);
   db.training_kind = "adaptive";
   db.adaptive = AdaptiveRecord{};

@@ -1,7 +1,9 @@
 #include <contactrom/rom/fallback.hpp>
 
 #include <cmath>
+#include <string>
 
+#include <contactrom/core/errors.hpp>
 #include <contactrom/core/format.hpp>
 #include <contactrom/fom/contact_residuals.hpp>
 #include <contactrom/fom/kkt.hpp>
@@ -10,7 +12,16 @@
 namespace contactrom::rom {
 
 FallbackSolver::FallbackSolver(const OnlineSolver& rom, FallbackOptions options)
-    : m_rom(rom), m_options(std::move(options)) {}
+    : m_rom(rom), m_options(std::move(options)) {
+  // Written so that NaN is refused too.
+  const auto positive = [](const char* name, double value) {
+    if (!(value > 0.0) || !std::isfinite(value))
+      throw InputError(std::string("fallback ") + name + " = " + format_number(value) + "; expected a finite number > 0");
+  };
+  positive("primal_tolerance", m_options.primal_tolerance);
+  positive("dual_tolerance", m_options.dual_tolerance);
+  positive("safety_factor", m_options.safety_factor);
+}
 
 FallbackSolver::~FallbackSolver() = default;
 

@@ -76,7 +76,8 @@ BOOST_AUTO_TEST_CASE(bad_settings_exit_2_with_one_line) {
         std::string(" --adaptive --tolerance 0.1 --candidates 100001"),
         std::string(" --adaptive --tolerance 0.1 --indicator both"), std::string(" --adaptive --tolerance 0.1 --method nope"),
         std::string(" --adaptive --tolerance 0.1 --delta 2"), std::string(" --tolerance 0.1"), std::string(" --adaptive"),
-        std::string(" --adaptive --tolerance 0.1 --part 1/2")}) {
+        std::string(" --adaptive --tolerance 0.1 --part 1/2"),
+        std::string(" --adaptive --tolerance 0.1 --train 4 --max-snapshots 3")}) {
     const auto r = run_command(base + args);
     BOOST_TEST(r.exit_code == 2, args << ": exit " << r.exit_code);
     BOOST_TEST(count_lines(r.err, "\n") == 1, args << ": " << r.err);
