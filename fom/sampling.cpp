@@ -115,7 +115,8 @@ int resolve_training_size(const SamplingPlan& plan, const std::string& problem_n
   const int n = by_level ? level : train;
   if (n != 0) return n;
   if (allow_default && plan.default_size > 0) return plan.default_size;
-  throw InputError(intro + "needs " + (by_level ? "--level n" : "--train N"));
+  throw InputError(intro + "needs " + (by_level ? "--level n" : "--train N") +
+                   (allow_default ? " (its file's [training] sets no default_size)" : ""));
 }
 
 std::string SamplingPlan::kind_name() const {

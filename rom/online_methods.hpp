@@ -57,6 +57,10 @@ void check_online_method(const std::string& name);
 /// name, or naming the method, option, value and what was expected.
 std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const ReducedModel& model,
                                                  const OnlineSolverOptions& options = {});
+/// A solver keeps a reference to its model: a temporary model would be gone before
+/// the first solve.
+std::unique_ptr<OnlineSolver> make_online_solver(const std::string& name, const ReducedModel&& model,
+                                                 const OnlineSolverOptions& options = {}) = delete;
 
 /// \brief An online method: what the registry knows about it.
 struct OnlineMethod {

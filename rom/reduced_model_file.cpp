@@ -232,6 +232,8 @@ void measure_primal_from_lifting(const fom::Problem& problem, ReducedModelData& 
 OnlineModel::OnlineModel(std::shared_ptr<const fom::Problem> problem, std::unique_ptr<ReducedModel> model,
                          const std::string& method, const OnlineSolverOptions& options)
     : m_problem(std::move(problem)), m_model(std::move(model)), m_method(method), m_options(options) {
+  if (!m_problem) throw InputError("OnlineModel: the problem is null; expected a problem");
+  if (!m_model) throw InputError("OnlineModel: the reduced model is null; expected a model");
   m_solver = make_online_solver(m_method, *m_model, m_options);
 }
 
@@ -239,6 +241,7 @@ OnlineModel::OnlineModel(std::shared_ptr<const fom::Problem> problem, const Snap
                          const ReducedModelOptions& model_options, const std::string& method,
                          const OnlineSolverOptions& options)
     : m_problem(std::move(problem)), m_method(method), m_options(options) {
+  if (!m_problem) throw InputError("OnlineModel: the problem is null; expected a problem");
   // The method name first: building the model costs a POD.
   check_online_method(method);
   ReducedModelOptions kept = model_options;
