@@ -292,6 +292,9 @@ OnlineModel OnlineModel::load(const std::string& path) {
 std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::Problem& problem) {
   // A regular file of at most 256 MiB (millions of queries): never /dev/zero.
   std::string all = read_input_file(path, "parameter file", std::uintmax_t{1} << 28), header;
+  // Line ends of every system: CRLF, LF, and a lone CR (old Mac spreadsheets).
+  for (size_t i = 0; i < all.size(); ++i)
+    if (all[i] == '\r' && (i + 1 == all.size() || all[i + 1] != '\n')) all[i] = '\n';
   // An optional header naming the components becomes a comment (line numbers kept).
   for (const std::string& name : problem.param_names()) header += (header.empty() ? "" : ",") + name;
   size_t start = 0;

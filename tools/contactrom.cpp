@@ -35,8 +35,9 @@ std::vector<CommandEntry>& command_table() {
 
 namespace {
 
-/// A message as one line: control characters (a newline or an escape sequence in a
-/// name read from a file) are written as \n, \t or \xHH.
+/// A message as one line of at most about 1.5 kB: control characters (a newline or
+/// an escape sequence in a name read from a file) are written as \n, \t or \xHH,
+/// and the middle of a longer message is cut.
 std::string one_line(const std::string& text) {
   std::string out;
   out.reserve(text.size());
@@ -50,6 +51,11 @@ std::string one_line(const std::string& text) {
       out += hex;
     } else out += ch;
   }
+  // A name of thousands of characters (read from a file) would bury the message.
+  constexpr size_t kHead = 1000, kTail = 400;
+  if (out.size() > kHead + kTail + 100)
+    out = out.substr(0, kHead) + "[... " + std::to_string(out.size() - kHead - kTail) + " characters cut ...]" +
+          out.substr(out.size() - kTail);
   return out;
 }
 

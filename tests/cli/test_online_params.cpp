@@ -55,6 +55,21 @@ BOOST_AUTO_TEST_CASE(parameter_list_rows_equal_single_queries) {
     BOOST_TEST(std::stod(rows[i + 1][1]) == s["primal_error"].get<double>(), boost::test_tools::tolerance(1e-9));
     BOOST_TEST(std::stod(rows[i + 1][2]) == s["dual_error"].get<double>(), boost::test_tools::tolerance(1e-9));
   }
+  // The same list with other line ends (CRLF, a lone CR) and a UTF-8 byte-order mark.
+  for (const std::string& end : {std::string("\r\n"), std::string("\r")}) {
+    const std::string other = dir + "/points_other.csv", other_out = dir + "/rows_other.csv";
+    {
+      std::ofstream f(other, std::ios::binary);
+      f << "\xEF\xBB\xBF" << "d" << end;
+      for (const std::string& p : points) f << p << end;
+    }
+    const auto o = run_command(kExe + " online --db " + db + " --method greedy --validation --params " + other +
+                               " --out " + other_out);
+    BOOST_REQUIRE_MESSAGE(o.exit_code == 0, o.err);
+    const auto other_rows = csv_rows(other_out);
+    BOOST_REQUIRE(other_rows.size() == rows.size());
+    for (size_t i = 1; i < rows.size(); ++i) BOOST_TEST(other_rows[i][0] == rows[i][0]);
+  }
 }
 
 BOOST_AUTO_TEST_CASE(offset_and_its_other_name_lifting_build_the_same_model) {
