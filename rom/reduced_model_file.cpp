@@ -173,8 +173,15 @@ void read_columns_data(hid_t f, const StoredModel& s, hsize_t n, ReducedModelDat
   hsize_t rows = 0, cols = 0;
   hdf5::read_int_dataset(f, "dictionary_snapshots", d.dictionary_snapshots, rows, cols);
   if (rows != m || cols != 1) throw hdf5::Refused("dataset /dictionary_snapshots does not hold one index per column");
-  for (int j : d.dictionary_snapshots)
+  for (size_t c = 0; c < d.dictionary_snapshots.size(); ++c) {
+    const int j = d.dictionary_snapshots[c];
     if (j < 0) throw hdf5::Refused("dataset /dictionary_snapshots holds the negative index " + std::to_string(j));
+    // The columns are the kept snapshots in database order.
+    if (c > 0 && j <= d.dictionary_snapshots[c - 1])
+      throw hdf5::Refused("dataset /dictionary_snapshots is not increasing (" +
+                          std::to_string(d.dictionary_snapshots[c - 1]) + " then " + std::to_string(j) +
+                          "), expected the database order of the columns");
+  }
   const auto [mp, np] = shape2(f, "dictionary_parameters");
   const Eigen::MatrixXd params = read_columns(f, "dictionary_parameters", np, m);
   for (hsize_t c = 0; c < m; ++c) d.dictionary_parameters.push_back(params.col(static_cast<Eigen::Index>(c)));

@@ -416,6 +416,17 @@ BOOST_AUTO_TEST_CASE(every_stored_list_and_number_is_checked) {
   BOOST_REQUIRE_MESSAGE(py.exit_code == 0, "needs /usr/bin/python3 with h5py: " << py.err);
   const std::string e = one_line_error([&] { OnlineModel::load(emptied); });
   BOOST_TEST(e.find("fingerprint") != std::string::npos, e);
+  // A column's snapshot index edited (its checksum with it) out of database order.
+  const std::string reordered = work_dir() + "/reordered.h5";
+  fs::copy_file(good, reordered, fs::copy_options::overwrite_existing);
+  const auto edit = run_command(
+      "/usr/bin/python3 -c \"import h5py, numpy; f = h5py.File('" + reordered + "', 'a'); k = 'dictionary_snapshots'; "
+      "data = f[k][()]; data[0] = 1000000; dtype = f[k].dtype; del f[k]; f.create_dataset(k, data=data.astype(dtype)); "
+      "import sys; sys.path.insert(0, '" + std::string(CONTACTROM_SOURCE_DIR) + "/fuzz'); "
+      "from hdf5_checksum import lookup3; f[k].attrs.create('checksum_lookup3', lookup3(f[k][()].tobytes()), dtype='<u4')\"");
+  BOOST_REQUIRE_MESSAGE(edit.exit_code == 0, edit.err);
+  const std::string order = one_line_error([&] { OnlineModel::load(reordered); });
+  BOOST_TEST(order.find("/dictionary_snapshots is not increasing") != std::string::npos, order);
   // A number changed without its checksum: the file is damaged.
   const std::string flipped = work_dir() + "/flipped.h5";
   fs::copy_file(good, flipped, fs::copy_options::overwrite_existing);
