@@ -61,7 +61,9 @@ double parse_number(const std::string& text, const std::string& what) {
   char* end = nullptr;
   const double value = std::strtod(t.c_str(), &end);
   const int err = errno;
-  if (end == t.c_str() || end != t.c_str() + t.size())
+  // strtod also reads C's hexadecimal floats (0x1p-3), which Python, TOML and CSV
+  // readers elsewhere do not: decimal numbers only, the same everywhere.
+  if (end == t.c_str() || end != t.c_str() + t.size() || t.find_first_of("xX") != std::string::npos)
     throw InputError(what + " " + quoted(text) + " is not a number");
   if (!std::isfinite(value)) {
     if (err == ERANGE) throw InputError(what + " " + quoted(text) + " is too large for a double");

@@ -89,6 +89,7 @@ BOOST_FIXTURE_TEST_CASE(options_and_parameters, Fixture) {
       {"fom --problem hertz --param 0.30000000001", "'0.30000000001'", "", ""},
       {"fom --problem hertz --param 1e-400", "'1e-400'", "", ""},
       {"fom --problem hertz --param 0x", "'0x'", "", ""},
+      {"fom --problem hertz --param 0x1p-3", "'0x1p-3' is not a number", "", ""},
       {"fom --problem ironing2 --param 1", "takes 2 parameter", "", ""},
       {"fom --problem hertz --param 0.5 --out " + file("fields"), "'0.5'", file("fields"), ""},
       {"offline --problem hertz --train 2.5 --out " + out, "'2.5'", out, ""},
