@@ -240,6 +240,7 @@ class ConvexHullSolver final : public OnlineSolver {
  private:
   void solve_reduced(const fom::Param& mu, OnlineResult& res) const override;
   Eigen::VectorXd reconstruct_primal(const OnlineResult& res) const override;
+  bool answer_combines_snapshots() const override { return true; }
   /// The step of solve_detailed(): the answer `on` and the statistics `res`.
   void solve_hull(const fom::Param& mu, ConvexHullResult& res, OnlineResult& on) const;
   MonolithicDictionary m_dictionary;

@@ -82,6 +82,16 @@ void ErrorIndicator::build(const ReducedModel& model) {
     m_shs.middleCols(first, count) = surface_rows(solve_free(*m_cond.factor, h * x, free), surf, free_index);
   }
   m_shs = (0.5 * (m_shs + m_shs.transpose())).eval();
+  if (model.has_primal_snapshots()) {  // m + T more solves, for combinations of snapshots
+    const Eigen::MatrixXd& p = model.primal_snapshots();
+    const Eigen::Index m = p.cols();
+    Eigen::MatrixXd w(n, m + nt);
+    w.leftCols(m) = p;
+    for (int k = 0; k < nt; ++k) w.col(m + k) = problem.lifting_terms()[static_cast<size_t>(k)] - z.col(k);
+    const Eigen::MatrixXd hw = h * w;
+    m_whw = w.transpose() * hw;
+    m_whs = surface_rows(solve_free(*m_cond.factor, hw, free), surf, free_index).transpose();
+  }
   m_z_s = Eigen::MatrixXd(ns, nt);
   for (int j = 0; j < ns; ++j) m_z_s.row(j) = z.row(surf[j]);
   m_cond.factor.reset();  // every query needs S only
@@ -93,7 +103,8 @@ void ErrorIndicator::build(const ReducedModel& model) {
 
 ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& lambda,
                                        const fom::Pairing& pairing, const Eigen::VectorXd& u_surface,
-                                       int pairings, const fom::SearchMemory* memory) const {
+                                       int pairings, const fom::SearchMemory* memory,
+                                       const SnapshotCombination* combination) const {
   const auto t0 = std::chrono::steady_clock::now();
   ErrorEstimate e;
   const fom::Problem& problem = m_problem;
@@ -134,8 +145,19 @@ ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::Vector
   // 2. Norms of u_r − u_c = V a + K⁻¹ E_s y and of u_c = Z φ − K⁻¹ E_s y, y = Cᵀ λ_c,
   // from the offline products, on the support of y only.
   const Eigen::VectorXd y = c.transpose() * sol.lambda;
-  Eigen::VectorXd a(m_vhv.rows());
-  a << u_hat, phi;
+  // The answer is V a + z(μ), a = (û, φ); or, a combination of snapshots, W a + z(μ),
+  // a = (α, φ) with α over all the dictionary's columns.
+  const bool combined = combination && m_whw.size() > 0;
+  const Eigen::MatrixXd& vhv = combined ? m_whw : m_vhv;
+  const Eigen::MatrixXd& vhs = combined ? m_whs : m_vhs;
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(vhv.rows());
+  if (combined) {
+    for (size_t i = 0; i < combination->columns.size(); ++i)
+      a(combination->columns[i]) += combination->coefficients(static_cast<Eigen::Index>(i));
+    a.tail(phi.size()) = phi;
+  } else {
+    a << u_hat, phi;
+  }
   Eigen::VectorXd vy = Eigen::VectorXd::Zero(a.size()), zy = Eigen::VectorXd::Zero(phi.size());
   double yqy = 0.0;
   thread_local std::vector<int> support;
@@ -144,14 +166,14 @@ ErrorEstimate ErrorIndicator::estimate(const fom::Param& mu, const Eigen::Vector
     if (y(j) != 0.0) support.push_back(static_cast<int>(j));
   for (size_t b = 0; b < support.size(); ++b) {  // yᵀ Q y over the lower triangle (Q symmetric)
     const int j = support[b];
-    vy.noalias() += y(j) * m_vhs.col(j);
+    vy.noalias() += y(j) * vhs.col(j);
     zy.noalias() += y(j) * m_zhs.col(j);
     const double* q_j = m_shs.data() + static_cast<Eigen::Index>(j) * m_shs.rows();
     double row = 0.0;
     for (size_t a = 0; a < b; ++a) row += q_j[support[a]] * y(support[a]);
     yqy += y(j) * (2.0 * row + q_j[j] * y(j));
   }
-  const double error2 = a.dot(m_vhv * a) + 2.0 * a.dot(vy) + yqy;
+  const double error2 = a.dot(vhv * a) + 2.0 * a.dot(vy) + yqy;
   const double norm2 = phi.dot(m_zhz * phi) - 2.0 * phi.dot(zy) + yqy;
   const double norm = std::sqrt(std::max(norm2, 0.0));
   e.absolute = norm < m_near_zero;

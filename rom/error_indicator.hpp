@@ -35,6 +35,7 @@
 /// every query); otherwise available() is false and the estimates are NaN.
 #include <Eigen/Dense>
 #include <limits>
+#include <vector>
 #include <memory>
 #include <string>
 
@@ -72,6 +73,12 @@ struct ErrorIndicatorOptions {
     o.newton_retry = 0.0;
     return o;
   }();
+};
+
+/// \brief An answer made of the model's primal snapshots (ErrorIndicator::estimate()).
+struct SnapshotCombination {
+  const std::vector<int>& columns;        ///< dictionary columns
+  const Eigen::VectorXd& coefficients;    ///< one per column
 };
 
 /// \brief The estimate of one answer.
@@ -114,9 +121,14 @@ class ErrorIndicator {
   /// \param pairings cap on the correction's pairings (≤ 0: ErrorIndicatorOptions::pairing_iterations)
   /// \param memory memory of the search that found `pairing` (its re-pairings start
   ///   from it: the same estimate, less searching), or nullptr
+  /// \param combination for an answer that is a combination of the model's primal
+  ///   snapshots, u = u_lift(μ) + Σ_i coefficients_i P[:, columns_i] (the convex hull),
+  ///   rather than Φû + u_off(μ): its primal estimate is then that answer's own (when
+  ///   the model keeps its primal snapshots; else that of Φû); nullptr: Φû + u_off(μ).
   ErrorEstimate estimate(const fom::Param& mu, const Eigen::VectorXd& u_hat, const Eigen::VectorXd& lambda,
                          const fom::Pairing& pairing, const Eigen::VectorXd& u_surface, int pairings = 0,
-                         const fom::SearchMemory* memory = nullptr) const;
+                         const fom::SearchMemory* memory = nullptr,
+                         const SnapshotCombination* combination = nullptr) const;
 
  private:
   void build(const ReducedModel& model);
@@ -133,6 +145,10 @@ class ErrorIndicator {
   Eigen::MatrixXd m_zhz;      // Zᵀ H Z, T × T
   Eigen::MatrixXd m_zhs;      // Zᵀ H K⁻¹ E_s, T × n_s
   Eigen::MatrixXd m_shs;      // E_sᵀ K⁻¹ H K⁻¹ E_s, n_s × n_s
+  // With the model's primal snapshots P (m columns): W = [P, L − Z], the answer of a
+  // combination being W (α, φ) + z(μ) (L: the lifting terms).
+  Eigen::MatrixXd m_whw;      // Wᵀ H W, (m+T)², empty without the snapshots
+  Eigen::MatrixXd m_whs;      // Wᵀ H K⁻¹ E_s, (m+T) × n_s
   double m_near_zero = 0.0;   // ‖u_c‖_H below which the estimates are absolute
 };
 

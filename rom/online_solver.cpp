@@ -74,17 +74,19 @@ void OnlineSolver::finish_query(std::chrono::steady_clock::time_point t0, Online
   res.u = reconstruct_primal(res);
   res.reconstruction_time_s = std::chrono::duration<double>(clock::now() - t1).count();
   const AnswerSearch* search = check_contact(model(), contact_tolerances(), res);
-  if (m_indicator && search) estimate_errors(*m_indicator, *search, res, m_estimate_pairings);
+  if (m_indicator && search) estimate_errors(*m_indicator, *search, res, m_estimate_pairings, answer_combines_snapshots());
 }
 
 Eigen::VectorXd OnlineSolver::reconstruct_primal(const OnlineResult& res) const {
   return model().reconstruct_primal(res.u_hat, res.mu);
 }
 
-void estimate_errors(const ErrorIndicator& indicator, const AnswerSearch& search, OnlineResult& res, int pairings) {
+void estimate_errors(const ErrorIndicator& indicator, const AnswerSearch& search, OnlineResult& res, int pairings,
+                     bool combination) {
   const Eigen::VectorXd u_s = indicator.problem().contact().restrict_to_surface(res.u);
-  const ErrorEstimate e =
-      indicator.estimate(res.mu, res.u_hat, res.lambda, search.pairing, u_s, pairings, &search.memory);
+  const SnapshotCombination snapshots{res.selected, res.coefficients};
+  const ErrorEstimate e = indicator.estimate(res.mu, res.u_hat, res.lambda, search.pairing, u_s, pairings,
+                                             &search.memory, combination ? &snapshots : nullptr);
   res.primal_estimate = e.primal;
   res.dual_estimate = e.dual;
   res.absolute_estimates = e.absolute;

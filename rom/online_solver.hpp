@@ -130,6 +130,10 @@ class OnlineSolver {
   /// \brief The full displacement of an answer (timed as reconstruction); default
   /// Φû + u_off(μ) (ReducedModel::reconstruct_primal).
   virtual Eigen::VectorXd reconstruct_primal(const OnlineResult& res) const;
+  /// \brief Whether an answer's displacement is the combination of the model's primal
+  /// snapshots given by `selected` and `coefficients` (the convex hull) rather than
+  /// Φû + u_off(μ): its primal error is then estimated on that combination.
+  virtual bool answer_combines_snapshots() const { return false; }
   /// \brief solve() with another step than solve_reduced(), for a method that
   /// reports more than OnlineResult (`step(res)` fills `res` as solve_reduced()).
   template <class Step>
@@ -154,9 +158,6 @@ class OnlineSolver {
   int m_estimate_pairings = 0;
 };
 
-/// \brief The full-order contact check of an online answer: sets `res.contact` and
-/// `res.check_time_s`, and turns a Success whose residuals exceed `tolerances` into
-/// Status::Inaccurate (message: the residuals above tolerance and their rows).
 /// \brief The pairing check_contact() searched at an answer, with the memory of that
 /// search (fom::SearchMemory), from which the error estimate's re-pairings start.
 struct AnswerSearch {
@@ -164,6 +165,11 @@ struct AnswerSearch {
   fom::SearchMemory memory;
 };
 
+/// \brief The full-order contact check of an online answer: sets `res.contact` and
+/// `res.check_time_s`, and turns a Success whose residuals exceed `tolerances` into
+/// Status::Inaccurate (message: the residuals above tolerance and their rows). The
+/// penetration and separation tolerances are relative to U, or to the answer's own
+/// largest surface displacement when that is smaller (fom::tolerances_on_own_scale()).
 /// \returns the search at the answer (storage of the calling thread, valid until its
 ///   next check), or nullptr when the answer has no fields.
 const AnswerSearch* check_contact(const ReducedModel& model, const fom::ContactTolerances& tolerances,
@@ -172,8 +178,10 @@ const AnswerSearch* check_contact(const ReducedModel& model, const fom::ContactT
 /// \brief The error estimate of an answer (OnlineResult::primal_estimate, dual_estimate,
 /// absolute_estimates, estimate_time_s, added to time_s), from the search that
 /// check_contact() made at it.
+/// \param combination the answer combines the model's primal snapshots
+///   (OnlineSolver::answer_combines_snapshots())
 void estimate_errors(const ErrorIndicator& indicator, const AnswerSearch& search, OnlineResult& res,
-                     int pairings = 0);
+                     int pairings = 0, bool combination = false);
 
 /// \brief How the threshold τ is applied to the dictionary violations.
 enum class TauScaling {

@@ -126,6 +126,37 @@ BOOST_AUTO_TEST_CASE(estimate_is_small_at_training_parameters_and_grows_between_
   BOOST_TEST(between > 10.0 * at_training);
 }
 
+BOOST_AUTO_TEST_CASE(a_convex_hull_answer_is_estimated_as_the_combination_it_returns) {
+  // The convex hull answers with a combination of snapshots, not Φû: at a training
+  // load it reproduces the snapshot exactly (δ = 1e-8 truncates Φ to ~1 % there), and
+  // its estimate must say 0, not the basis' truncation error; between loads it must
+  // follow the true error of the combination.
+  Hertz h;
+  const rom::SnapshotDatabase db = rom::generate_snapshots(*h.problem, 30, {});
+  rom::ReducedModelOptions options;
+  options.delta = 1e-8;
+  const rom::ReducedModel model(*h.problem, db, options);
+  BOOST_REQUIRE(model.has_primal_snapshots());
+  const auto hull = rom::make_online_solver("convex-hull", model);
+  const std::vector<fom::Param> train = fom::training_set(*h.problem, 30);
+  for (size_t i : {size_t{5}, size_t{9}}) {
+    const rom::OnlineResult at = hull->solve(train[i]);
+    const fom::FomSolution ref = h.fom_solver.solve(train[i]);
+    const fom::ReferenceErrors err = fom::reference_errors(*h.problem, at.u, at.lambda, ref.u, ref.lambda);
+    BOOST_TEST_CONTEXT("d = " << train[i](0)) {
+      BOOST_TEST(err.primal < 1e-10);
+      BOOST_TEST(at.primal_estimate < 1e-6);
+      // The projection Φû is not the answer: its error is far above the estimate.
+      BOOST_TEST(fom::relative_h1_error(*h.problem, model.reconstruct_primal(at.u_hat, train[i]), ref.u) > 1e-4);
+    }
+    const fom::Param mid = 0.5 * (train[i] + train[i + 1]);
+    const rom::OnlineResult between = hull->solve(mid);
+    const fom::FomSolution mid_ref = h.fom_solver.solve(mid);
+    const double error = fom::reference_errors(*h.problem, between.u, between.lambda, mid_ref.u, mid_ref.lambda).primal;
+    BOOST_TEST(between.primal_estimate == error, boost::test_tools::tolerance(0.2));
+  }
+}
+
 BOOST_AUTO_TEST_CASE(flags_a_query_whose_contact_zone_no_column_covers) {
   // Dictionary of shallow indentations only (small contact zones); a deep one needs
   // pressure on rows no column covers.
