@@ -128,10 +128,26 @@ std::unique_ptr<fom::Problem> open_run(const OfflineArgs& a, const Ranks& ranks)
 /// and one's snapshots would be lost: the second waits for the first (rank 0 holds the
 /// lock until the file is written).
 std::unique_ptr<FileLock> lock_for_append(const std::string& path, const Ranks& ranks) {
-  if (path.empty() || !ranks.root()) return nullptr;
-  return std::make_unique<FileLock>(path, [path] {
-    std::cerr << "contactrom: waiting for another run that is updating " << quoted(path, 200) << "\n";
-  });
+  if (path.empty()) return nullptr;
+  std::unique_ptr<FileLock> lock;
+  try {
+    if (ranks.root())
+      lock = std::make_unique<FileLock>(path, [path] {
+        std::cerr << "contactrom: waiting for another run that is updating " << quoted(path, 200) << "\n";
+      });
+  } catch (...) {
+#ifdef CONTACTROM_HAVE_MPI
+    if (ranks.size > 1) rom::mpi::all_ranks_ok(false);
+#endif
+    throw;
+  }
+#ifdef CONTACTROM_HAVE_MPI
+  // Every rank reads the database once rank 0 holds the lock, i.e. after the run it
+  // waited for has written it.
+  if (ranks.size > 1 && !rom::mpi::all_ranks_ok(true))
+    throw rom::mpi::RankFailure("rank 0 could not lock the database");
+#endif
+  return lock;
 }
 
 /// The flag of the adaptive setting `key` (max_snapshots: --max-snapshots).

@@ -34,6 +34,9 @@ void run_reduce(const ReduceArgs& a) {
   declare_input_files({a.db});
   check_output_path(a.out);
   rom::check_online_method(a.method);
+  // Every rank checks the method's settings before the ranks share the POD: a rank
+  // that refused them after it would leave the others waiting in a collective step.
+  rom::validate_online_options(a.method, a.solver_options());
   const auto t0 = std::chrono::steady_clock::now();
   // The primal snapshots stay on disk: the POD reads them by blocks (rom/pod.hpp).
   const rom::SnapshotDatabase db = rom::read_database(a.db, false);
@@ -47,17 +50,33 @@ void run_reduce(const ReduceArgs& a) {
   // Under mpirun the ranks share the POD (rom/pod_mpi.hpp); rank 0 builds and writes the model.
   std::unique_ptr<rom::mpi::WorldPodReduction> ranks;
   if (rom::mpi::active() && rom::mpi::world_size() > 1) {
+    if (a.pod == "svd")
+      throw InputError("--pod svd computes the POD in the memory of one process; under mpirun expected --pod "
+                       "snapshots or auto");
     ranks = std::make_unique<rom::mpi::WorldPodReduction>();
     model_options.pod.reduction = ranks.get();
     if (ranks->rank() != 0) {
       rom::share_reduced_model_pod(*problem, db, model_options);
+      // Rank 0 builds and writes the file: every rank exits with its outcome.
+      if (!rom::mpi::all_ranks_ok(true)) throw rom::mpi::RankFailure("rank 0 could not build or write the reduced model");
       return;
     }
   }
+  const auto agree = [&ranks](bool ok) { return !ranks || rom::mpi::all_ranks_ok(ok); };
+#else
+  const auto agree = [](bool) { return true; };
 #endif
-  const rom::OnlineModel rom(problem, db, model_options, a.method, a.solver_options());
-  warn_if_no_primal_modes(rom.model());
-  rom.save(a.out);
+  std::unique_ptr<const rom::OnlineModel> built;
+  try {
+    built = std::make_unique<const rom::OnlineModel>(problem, db, model_options, a.method, a.solver_options());
+    warn_if_no_primal_modes(built->model());
+    built->save(a.out);
+  } catch (...) {
+    agree(false);
+    throw;
+  }
+  agree(true);
+  const rom::OnlineModel& rom = *built;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::error_code ec;
   const auto bytes = std::filesystem::file_size(a.out, ec);

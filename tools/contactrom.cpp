@@ -90,6 +90,14 @@ int main(int argc, char** argv) {
   if (argc > 1 && argv[1][0] != '-') {
     const std::string name = argv[1];
     const bool known = std::any_of(table.begin(), table.end(), [&](const auto& e) { return e.name == name; });
+#ifdef CONTACTROM_HAVE_MPI
+    // Only offline and reduce share their work over ranks; any other command would run
+    // whole on every rank, print its report once per rank and write its files twice.
+    if (known && name != "offline" && name != "reduce" && rom::mpi::active() && rom::mpi::world_size() > 1)
+      return fail("'" + name + "' runs in one process, not under mpirun with " +
+                      std::to_string(rom::mpi::world_size()) + " ranks; expected mpirun only for offline and reduce",
+                  2);
+#endif
     if (!known) {
       std::string names;
       for (const auto& e : table) names += (names.empty() ? "" : ", ") + e.name;

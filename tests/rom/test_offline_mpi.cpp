@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "common/database_checks.hpp"
 #include <contactrom/rom/reduced_model_file.hpp>
@@ -113,6 +114,28 @@ BOOST_AUTO_TEST_CASE(mpi_offline_bad_argument_fails_on_every_rank_with_one_messa
       BOOST_TEST(r.exit_code != 0);
       BOOST_TEST(contactrom_lines(r.err) == 1, r.err);
       BOOST_TEST(!fs::exists(db));
+    }
+  }
+}
+
+BOOST_AUTO_TEST_CASE(mpi_refusals_end_every_rank_without_waiting) {
+  // Settings refused after the ranks had begun the shared POD left the others waiting
+  // in it; `timeout` turns such a hang into 124. A command that does not share its
+  // work over ranks is refused under mpirun rather than run once per rank.
+  const std::string dir = work_dir(), db = dir + "/refusals.h5";
+  BOOST_REQUIRE(run_command(exe + " offline --problem rope --out " + db).exit_code == 0);
+  const std::vector<std::string> refused = {" reduce --db " + db + " --option init=bogus --out " + dir + "/r.h5",
+                                            " reduce --db " + db + " --pod svd --out " + dir + "/r.h5",
+                                            std::string(" fom --problem rope --param 20 --json"),
+                                            " online --db " + db + " --param 20"};
+  for (const std::string& args : refused) {
+    const auto r = run_command("timeout 120 env " + mpirun(2) + exe + args);
+    BOOST_TEST_CONTEXT(args) {
+      BOOST_TEST(r.exit_code != 0);
+      BOOST_TEST(r.exit_code != 124);
+      BOOST_TEST(contactrom_lines(r.err) == 1, r.err);
+      BOOST_TEST(r.out.empty(), r.out);
+      BOOST_TEST(!fs::exists(dir + "/r.h5"));
     }
   }
 }
