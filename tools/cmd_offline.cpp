@@ -89,12 +89,11 @@ struct Ranks {
   bool root() const { return rank == 0; }
 };
 
-/// Writes the database `make()` returns on rank 0; every rank then agrees on the
-/// outcome, so that all of them exit with an error if making or writing it failed.
-void write_on_root(const std::string& path, const std::function<const rom::SnapshotDatabase&()>& make,
-                   const Ranks& ranks) {
+/// Runs `work` on rank 0; every rank then agrees on the outcome, so that all of them
+/// exit with an error (RankFailure(`failure`) on the others) if it failed.
+void on_root_then_agree(const Ranks& ranks, const std::function<void()>& work, const char* failure) {
   try {
-    if (ranks.root()) rom::write_database(path, make());
+    if (ranks.root()) work();
   } catch (...) {
 #ifdef CONTACTROM_HAVE_MPI
     if (ranks.size > 1) rom::mpi::all_ranks_ok(false);
@@ -102,9 +101,16 @@ void write_on_root(const std::string& path, const std::function<const rom::Snaps
     throw;
   }
 #ifdef CONTACTROM_HAVE_MPI
-  if (ranks.size > 1 && !rom::mpi::all_ranks_ok(true))
-    throw rom::mpi::RankFailure("rank 0 could not write the database");
+  if (ranks.size > 1 && !rom::mpi::all_ranks_ok(true)) throw rom::mpi::RankFailure(failure);
+#else
+  (void)failure;
 #endif
+}
+
+/// Writes the database `make()` returns on rank 0 (every rank agrees on the outcome).
+void write_on_root(const std::string& path, const std::function<const rom::SnapshotDatabase&()>& make,
+                   const Ranks& ranks) {
+  on_root_then_agree(ranks, [&] { rom::write_database(path, make()); }, "rank 0 could not write the database");
 }
 
 /// What every offline run checks first, on every rank (all refuse alike): one of --out
@@ -129,24 +135,17 @@ std::unique_ptr<fom::Problem> open_run(const OfflineArgs& a, const Ranks& ranks)
 /// lock until the file is written).
 std::unique_ptr<FileLock> lock_for_append(const std::string& path, const Ranks& ranks) {
   if (path.empty()) return nullptr;
-  std::unique_ptr<FileLock> lock;
-  try {
-    if (ranks.root())
-      lock = std::make_unique<FileLock>(path, [path] {
-        std::cerr << "contactrom: waiting for another run that is updating " << quoted(path, 200) << "\n";
-      });
-  } catch (...) {
-#ifdef CONTACTROM_HAVE_MPI
-    if (ranks.size > 1) rom::mpi::all_ranks_ok(false);
-#endif
-    throw;
-  }
-#ifdef CONTACTROM_HAVE_MPI
   // Every rank reads the database once rank 0 holds the lock, i.e. after the run it
   // waited for has written it.
-  if (ranks.size > 1 && !rom::mpi::all_ranks_ok(true))
-    throw rom::mpi::RankFailure("rank 0 could not lock the database");
-#endif
+  std::unique_ptr<FileLock> lock;
+  on_root_then_agree(
+      ranks,
+      [&] {
+        lock = std::make_unique<FileLock>(path, [path] {
+          std::cerr << "contactrom: waiting for another run that is updating " << quoted(path, 200) << "\n";
+        });
+      },
+      "rank 0 could not lock the database");
   return lock;
 }
 
