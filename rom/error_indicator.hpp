@@ -13,7 +13,9 @@
 /// \f$ V a + K^{-1} E_s y \f$ be evaluated from its coordinates a and the surface
 /// force y: \f$ V^T H V \f$, \f$ V^T H K^{-1} E_s \f$ and
 /// \f$ E_s^T K^{-1} H K^{-1} E_s \f$ (H: the Gram matrix of the H¹ norm), with
-/// \f$ V = [\Phi,\ \tilde L - Z] \f$.
+/// \f$ V = [\Phi,\ \tilde L - Z] \f$. A model that keeps its primal snapshots P also
+/// gets the same products of \f$ W = [P,\ L - Z] \f$ (L: the lifting terms), for
+/// answers that combine snapshots (the convex hull: \f$ a = (\alpha, \phi(\mu)) \f$).
 ///
 /// Per answer (û, λ_r) at μ, pairing P searched at its surface displacement u_s:
 ///  1. C, g at P; the FOM dual QP at that pairing (working set of the rows within a
