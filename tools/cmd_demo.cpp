@@ -4,8 +4,8 @@
 //      next to two-cylinder Hertz theory, active nodes, iterations, time);
 //   2. offline: N = 30 snapshots in parallel into DIR/hertz<N>.h5 (default DIR: a
 //      temporary folder, removed at the end);
-//   3. online: greedy active set (δ = 1e-8), warm-started (default) and as the paper's
-//      Alg. 1 (started from the empty set), on
+//   3. online: greedy active set (δ = 1e-8), warm-started (default) and from the
+//      empty set (`--option init=empty`, the start of the paper's Alg. 1), on
 //      the 119 validation parameters against the FOM: errors, sparsity, iterations,
 //      median time per query of ROM and FOM (factorisation reused), speedup.
 // Equivalent commands: contactrom offline --problem hertz --train 30 --out hertz30.h5
@@ -159,7 +159,7 @@ void run_demo(const DemoArgs& a) {
   rom::ReducedModelOptions model_options;
   model_options.delta = a.delta;
   const rom::ReducedModel model(*problem, rom::read_database(db_path), model_options);
-  // The default greedy (warm start) and the paper's Alg. 1 (empty start).
+  // The default greedy (warm start) and the same from the empty set (the paper's start).
   rom::GreedyOptions paper_options;
   paper_options.init = rom::WarmStart::Empty;
   const rom::GreedyActiveSet greedy(model), paper(model, paper_options);
@@ -177,7 +177,7 @@ void run_demo(const DemoArgs& a) {
   std::printf("\n3. Online greedy active set on %zu validation parameters (delta = %g: primal rank %d, %d dictionary "
               "columns)\n",
               params.size(), a.delta, s.primal_rank, s.dictionary_size);
-  std::printf("   %-36s %21s   %21s\n", "", "greedy (warm start)", "greedy (paper Alg. 1)");
+  std::printf("   %-36s %21s   %21s\n", "", "greedy (warm start)", "greedy (empty start)");
   std::printf("   %-36s %10s %10s   %10s %10s\n", "", "mean", "max", "mean", "max");
   std::printf("   %-36s %10.2e %10.2e   %10.2e %10.2e\n", "primal error (relative H1)", s.mean_primal_error,
               s.max_primal_error, sn.mean_primal_error, sn.max_primal_error);
