@@ -188,6 +188,7 @@ void run_demo(const DemoArgs& a) {
   std::printf("   %-36s %10.2f %10s   %10.2f\n", "iterations (reduced solves)", s.mean_iterations, "",
               sn.mean_iterations);
   std::printf("   %-36s %10d %10s   %10d\n", "not converged", s.nonconverged, "", sn.nonconverged);
+  std::printf("   %-36s %10d %10s   %10d\n", "inaccurate (contact check)", s.inaccurate, "", sn.inaccurate);
   std::printf("   %-36s %10.1f %10s   %10.1f     (us; full field +%.1f us)\n", "ROM time per query (median)",
               t.median_core_s * 1e6, "", tn.median_core_s * 1e6, (t.median_total_s - t.median_core_s) * 1e6);
   std::printf("   %-36s %10.1f us\n", "FOM time per query (median)", fom_median * 1e6);
