@@ -1,6 +1,8 @@
 #include <contactrom/core/input_file.hpp>
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -20,6 +22,10 @@ void check_input_file(const std::string& path, const std::string& label, std::ui
   }
   if (!S_ISREG(st.st_mode))
     throw InputError(label + " " + quoted(path, 200) + " is not a regular file (a folder, device or pipe); expected a file");
+  // Readable, as documented: an unreadable file is not "not HDF5" or "empty".
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw InputError(label + " " + quoted(path, 200) + " cannot be read: " + std::strerror(errno));
+  ::close(fd);
   if (static_cast<std::uintmax_t>(st.st_size) > max_bytes)
     throw InputError(label + " " + quoted(path, 200) + " has " + std::to_string(st.st_size) + " bytes, more than the " +
                      std::to_string(max_bytes) + " accepted");

@@ -14,17 +14,20 @@ double KktResiduals::max() const {
 }
 
 namespace {
-/// Throws InputError unless `v` has `expected` entries (a displacement of every dof,
-/// a pressure of every contact row): Eigen would read past a shorter one.
+/// Throws InputError unless `v` has `expected` entries: Eigen would read past a
+/// shorter one.
 void check_size(const Eigen::VectorXd& v, Eigen::Index expected, const char* what, const char* per) {
   if (v.size() != expected)
     throw InputError(std::string(what) + " has " + std::to_string(v.size()) + " entries; expected " +
                      std::to_string(expected) + ", one per " + per + " of the problem");
 }
-void check_fields(const Problem& problem, const Eigen::VectorXd* u, const Eigen::VectorXd* lambda, const char* u_name,
-                  const char* lambda_name) {
-  if (u) check_size(*u, problem.num_dofs(), u_name, "dof");
-  if (lambda) check_size(*lambda, problem.contact().num_constraints(), lambda_name, "contact row");
+/// A displacement: one value per dof.
+void check_displacement(const Problem& problem, const Eigen::VectorXd& u, const char* what) {
+  check_size(u, problem.num_dofs(), what, "dof");
+}
+/// A pressure: one value per contact row.
+void check_pressure(const Problem& problem, const Eigen::VectorXd& lambda, const char* what) {
+  check_size(lambda, problem.contact().num_constraints(), what, "contact row");
 }
 
 /// C u - g with the pairing recomputed from u (per row, weighted).
@@ -38,7 +41,7 @@ Eigen::VectorXd constraint_values(const Problem& problem, const Eigen::VectorXd&
 }  // namespace
 
 Eigen::VectorXd normal_gaps(const Problem& problem, const Eigen::VectorXd& u) {
-  check_fields(problem, &u, nullptr, "u", nullptr);
+  check_displacement(problem, u, "u");
   const ContactModel& contact = problem.contact();
   const Eigen::VectorXd us = contact.restrict_to_surface(u);
   const Pairing pairing = contact.search(us);
@@ -54,7 +57,8 @@ Eigen::VectorXd normal_gaps(const Problem& problem, const Eigen::VectorXd& u) {
 
 KktResiduals kkt_residuals(const Problem& problem, const Param& mu, const Eigen::VectorXd& u,
                            const Eigen::VectorXd& lambda) {
-  check_fields(problem, &u, &lambda, "u", "lambda");
+  check_displacement(problem, u, "u");
+  check_pressure(problem, lambda, "lambda");
   const ContactModel& contact = problem.contact();
   ConstraintMatrix c;
   const Eigen::VectorXd cv = constraint_values(problem, u, c);
@@ -95,8 +99,8 @@ KktResiduals kkt_residuals(const Problem& problem, const Param& mu, const Eigen:
 }
 
 double relative_h1_error(const Problem& problem, const Eigen::VectorXd& u, const Eigen::VectorXd& u_ref) {
-  check_fields(problem, &u, nullptr, "u", nullptr);
-  check_fields(problem, &u_ref, nullptr, "u_ref", nullptr);
+  check_displacement(problem, u, "u");
+  check_displacement(problem, u_ref, "u_ref");
   const Eigen::VectorXd e = u - u_ref;
   const double num = e.dot(problem.h1_gram() * e), den = u_ref.dot(problem.h1_gram() * u_ref);
   return den > 0.0 ? std::sqrt(std::max(num, 0.0) / den) : std::sqrt(std::max(num, 0.0));
@@ -104,8 +108,8 @@ double relative_h1_error(const Problem& problem, const Eigen::VectorXd& u, const
 
 double relative_l2_pressure_error(const Problem& problem, const Eigen::VectorXd& lambda,
                                   const Eigen::VectorXd& lambda_ref) {
-  check_fields(problem, nullptr, &lambda, nullptr, "lambda");
-  check_fields(problem, nullptr, &lambda_ref, nullptr, "lambda_ref");
+  check_pressure(problem, lambda, "lambda");
+  check_pressure(problem, lambda_ref, "lambda_ref");
   const Eigen::VectorXd& w = problem.contact().weights();
   const double num = w.dot((lambda - lambda_ref).cwiseAbs2()), den = w.dot(lambda_ref.cwiseAbs2());
   return den > 0.0 ? std::sqrt(num / den) : std::sqrt(num);
@@ -113,8 +117,10 @@ double relative_l2_pressure_error(const Problem& problem, const Eigen::VectorXd&
 
 ReferenceErrors reference_errors(const Problem& problem, const Eigen::VectorXd& u, const Eigen::VectorXd& lambda,
                                  const Eigen::VectorXd& u_ref, const Eigen::VectorXd& lambda_ref) {
-  check_fields(problem, &u, &lambda, "u", "lambda");
-  check_fields(problem, &u_ref, &lambda_ref, "u_ref", "lambda_ref");
+  check_displacement(problem, u, "u");
+  check_pressure(problem, lambda, "lambda");
+  check_displacement(problem, u_ref, "u_ref");
+  check_pressure(problem, lambda_ref, "lambda_ref");
   const SparseMatrix& gram = problem.h1_gram();
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(u_ref.size());
   const double scale = problem.displacement_scale() * std::sqrt(std::max(ones.dot(gram * ones), 0.0));
@@ -153,7 +159,7 @@ SolutionErrors compare_solutions(const Problem& problem, const Eigen::VectorXd& 
 }
 
 double contact_force(const Problem& problem, const Eigen::VectorXd& lambda) {
-  check_fields(problem, nullptr, &lambda, nullptr, "lambda");
+  check_pressure(problem, lambda, "lambda");
   return problem.contact().weights().dot(lambda);
 }
 

@@ -423,13 +423,13 @@ std::string find_problem_file(const std::string& name_or_path) {
     if (!fs::exists(name_or_path, ec)) throw InputError("problem file " + quoted(name_or_path, 200) + " not found");
     return name_or_path;
   }
-  const std::string path = problem_directory() + "/" + name_or_path + ".toml";
+  const std::string dir = problem_directory(), path = dir + "/" + name_or_path + ".toml";
   std::error_code ec;
   if (name_or_path.empty() || !fs::exists(path, ec)) {
     std::string list;
     for (const auto& n : shipped_problem_names()) list += (list.empty() ? "" : ", ") + n;
-    std::string where = "; the shipped problems are looked for in " + quoted(problem_directory(), 200);
-    if (!fs::is_directory(problem_directory(), ec))
+    std::string where = "; the shipped problems are looked for in " + quoted(dir, 200);
+    if (!fs::is_directory(dir, ec))
       where += ", which does not exist: set CONTACTROM_PROBLEM_DIR to the folder that holds them "
                "(PREFIX/share/contactrom/problems of an install)";
     throw InputError("unknown problem " + quoted(name_or_path, 200) + "; expected a problem file path or one of: " + list +

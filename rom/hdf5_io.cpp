@@ -1,8 +1,6 @@
 #include <contactrom/rom/hdf5_io.hpp>
 
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -437,8 +435,6 @@ hid_t open_file(const std::string& path, const std::string& label, const std::st
   // A regular file that can be read: a pipe or a device would block the signature
   // search below (or never end it), and an unreadable file is not "not HDF5".
   check_input_file(path, label, std::numeric_limits<std::uintmax_t>::max());
-  if (std::ifstream probe(path, std::ios::binary); !probe)
-    throw InputError(label + " " + quoted(path, 200) + " cannot be read: " + std::strerror(errno));
   silence();
   const int version = superblock_version(path);
   if (version < 0)

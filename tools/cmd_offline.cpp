@@ -40,6 +40,7 @@
 #include <contactrom/rom/snapshot_database.hpp>
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
+#include "tools/ranks.hpp"
 
 namespace contactrom::cli {
 namespace {
@@ -82,30 +83,6 @@ struct TemporaryPart {
   TemporaryPart& operator=(const TemporaryPart&) = delete;
   ~TemporaryPart() { std::remove(path.c_str()); }
 };
-
-/// Rank and size of the MPI run this process belongs to ({0, 1} when serial).
-struct Ranks {
-  int rank = 0, size = 1;
-  bool root() const { return rank == 0; }
-};
-
-/// Runs `work` on rank 0; every rank then agrees on the outcome, so that all of them
-/// exit with an error (RankFailure(`failure`) on the others) if it failed.
-void on_root_then_agree(const Ranks& ranks, const std::function<void()>& work, const char* failure) {
-  try {
-    if (ranks.root()) work();
-  } catch (...) {
-#ifdef CONTACTROM_HAVE_MPI
-    if (ranks.size > 1) rom::mpi::all_ranks_ok(false);
-#endif
-    throw;
-  }
-#ifdef CONTACTROM_HAVE_MPI
-  if (ranks.size > 1 && !rom::mpi::all_ranks_ok(true)) throw rom::mpi::RankFailure(failure);
-#else
-  (void)failure;
-#endif
-}
 
 /// Writes the database `make()` returns on rank 0 (every rank agrees on the outcome).
 void write_on_root(const std::string& path, const std::function<const rom::SnapshotDatabase&()>& make,
@@ -264,11 +241,7 @@ void print_adaptive_summary(const OfflineArgs& a, const fom::Problem& problem, c
 }
 
 void run_adaptive(const OfflineArgs& a) {
-#ifdef CONTACTROM_HAVE_MPI
-  const Ranks ranks{rom::mpi::world_rank(), rom::mpi::world_size()};
-#else
-  const Ranks ranks;
-#endif
+  const Ranks ranks = current_ranks();
   if (!a.part.empty()) throw InputError("--part does not apply to --adaptive; expected a whole adaptive run");
   const auto problem = open_run(a, ranks);
   const bool appending = !a.append.empty();
@@ -404,11 +377,7 @@ void print_offline_summary(const OfflineArgs& a, const fom::Problem& problem, co
 
 void run_offline(const OfflineArgs& a) {
   if (a.adaptive) return run_adaptive(a);
-#ifdef CONTACTROM_HAVE_MPI
-  const Ranks ranks{rom::mpi::world_rank(), rom::mpi::world_size()};
-#else
-  const Ranks ranks;
-#endif
+  const Ranks ranks = current_ranks();
   const auto problem = open_run(a, ranks);
   const std::unique_ptr<FileLock> lock = lock_for_append(a.append, ranks);
   const OfflinePlan plan = plan_offline(a, *problem);

@@ -19,6 +19,7 @@
 #endif
 #include "tools/cli.hpp"
 #include "tools/cli_common.hpp"
+#include "tools/ranks.hpp"
 
 namespace contactrom::cli {
 namespace {
@@ -46,36 +47,34 @@ void run_reduce(const ReduceArgs& a) {
   model_options.pod.algorithm = a.pod == "svd"         ? rom::PodAlgorithm::Svd
                                 : a.pod == "snapshots" ? rom::PodAlgorithm::Snapshots
                                                        : rom::PodAlgorithm::Auto;
+  // Under mpirun the ranks share the POD (rom/pod_mpi.hpp); rank 0 builds and writes
+  // the model, and every rank exits with its outcome.
+  const Ranks ranks = current_ranks();
+  const char* const failure = "rank 0 could not build or write the reduced model";
 #ifdef CONTACTROM_HAVE_MPI
-  // Under mpirun the ranks share the POD (rom/pod_mpi.hpp); rank 0 builds and writes the model.
-  std::unique_ptr<rom::mpi::WorldPodReduction> ranks;
-  if (rom::mpi::active() && rom::mpi::world_size() > 1) {
+  std::unique_ptr<rom::mpi::WorldPodReduction> reduction;
+  if (ranks.size > 1) {
     if (a.pod == "svd")
       throw InputError("--pod svd computes the POD in the memory of one process; under mpirun expected --pod "
                        "snapshots or auto");
-    ranks = std::make_unique<rom::mpi::WorldPodReduction>();
-    model_options.pod.reduction = ranks.get();
-    if (ranks->rank() != 0) {
+    reduction = std::make_unique<rom::mpi::WorldPodReduction>();
+    model_options.pod.reduction = reduction.get();
+    if (!ranks.root()) {
       rom::share_reduced_model_pod(*problem, db, model_options);
-      // Rank 0 builds and writes the file: every rank exits with its outcome.
-      if (!rom::mpi::all_ranks_ok(true)) throw rom::mpi::RankFailure("rank 0 could not build or write the reduced model");
+      on_root_then_agree(ranks, {}, failure);
       return;
     }
   }
-  const auto agree = [&ranks](bool ok) { return !ranks || rom::mpi::all_ranks_ok(ok); };
-#else
-  const auto agree = [](bool) { return true; };
 #endif
   std::unique_ptr<const rom::OnlineModel> built;
-  try {
-    built = std::make_unique<const rom::OnlineModel>(problem, db, model_options, a.method, a.solver_options());
-    warn_if_no_primal_modes(built->model());
-    built->save(a.out);
-  } catch (...) {
-    agree(false);
-    throw;
-  }
-  agree(true);
+  on_root_then_agree(
+      ranks,
+      [&] {
+        built = std::make_unique<const rom::OnlineModel>(problem, db, model_options, a.method, a.solver_options());
+        warn_if_no_primal_modes(built->model());
+        built->save(a.out);
+      },
+      failure);
   const rom::OnlineModel& rom = *built;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::error_code ec;

@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
 #ifdef CONTACTROM_HAVE_MPI
     // Only offline and reduce share their work over ranks; any other command would run
     // whole on every rank, print its report once per rank and write its files twice.
-    if (known && name != "offline" && name != "reduce" && rom::mpi::active() && rom::mpi::world_size() > 1)
+    if (known && name != "offline" && name != "reduce" && rom::mpi::world_size() > 1)
       return fail("'" + name + "' runs in one process, not under mpirun with " +
                       std::to_string(rom::mpi::world_size()) + " ranks; expected mpirun only for offline and reduce",
                   2);
