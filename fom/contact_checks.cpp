@@ -92,7 +92,60 @@ std::string pair_name(size_t q, const PairAtRest& p) {
          ")";
 }
 
+/// Whether `u` turns element e inside out: a corner whose Jacobian determinant
+/// (2D: the cross product of its two edges; hexahedron: the triple product of its
+/// three edges; tetrahedron: the volume) changes sign from the reference one.
+bool inverted(const Mesh& mesh, const Eigen::VectorXd& u, int e) {
+  const std::vector<int> nodes = mesh.element_nodes(e);
+  const int d = mesh.dim, k = static_cast<int>(nodes.size());
+  const auto at = [&](int i, bool deformed) -> Eigen::Vector3d {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    const int n = nodes[static_cast<size_t>(i)];
+    x.head(d) = mesh.nodes.col(n);
+    if (deformed) x.head(d) += u.segment(d * n, d);
+    return x;
+  };
+  // The edges from each corner, as corner, first, second[, third] node.
+  static constexpr int kQuad[4][3] = {{0, 1, 3}, {1, 2, 0}, {2, 3, 1}, {3, 0, 2}};
+  static constexpr int kHex[8][4] = {{0, 1, 3, 4}, {1, 2, 0, 5}, {2, 3, 1, 6}, {3, 0, 2, 7},
+                                     {4, 7, 5, 0}, {5, 4, 6, 1}, {6, 5, 7, 2}, {7, 6, 4, 3}};
+  static constexpr int kTet[1][4] = {{0, 1, 2, 3}};
+  const auto det = [&](const int* c, bool deformed) {
+    const Eigen::Vector3d o = at(c[0], deformed), a = at(c[1], deformed) - o, b = at(c[2], deformed) - o;
+    if (d == 2) return a.x() * b.y() - a.y() * b.x();
+    return a.cross(b).dot(at(c[3], deformed) - o);
+  };
+  const auto flips = [&](const auto& corners, int count) {
+    for (int i = 0; i < count; ++i)
+      if (det(corners[i], true) * det(corners[i], false) <= 0.0) return true;
+    return false;
+  };
+  if (d == 2) return flips(kQuad, 4);
+  return k == 8 ? flips(kHex, 8) : flips(kTet, 1);
+}
+
 }  // namespace
+
+std::vector<std::string> solution_warnings(const Problem& problem, const Eigen::VectorXd& u) {
+  std::vector<std::string> out;
+  const Mesh* mesh = problem.mesh();
+  if (!mesh || u.size() != problem.num_dofs()) return out;
+  std::vector<int> count(mesh->body_names.size(), 0), total(mesh->body_names.size(), 0);
+  for (int e = 0; e < mesh->num_elements(); ++e) {
+    const size_t b = static_cast<size_t>(mesh->element_body(e));
+    if (b >= count.size()) continue;
+    ++total[b];
+    if (inverted(*mesh, u, e)) ++count[b];
+  }
+  for (size_t b = 0; b < count.size(); ++b)
+    if (count[b] > 0)
+      out.push_back("the solution turns " + std::to_string(count[b]) + " of the " + std::to_string(total[b]) +
+                    " elements of body " + quoted(mesh->body_names[b], 200) +
+                    " inside out: far beyond the small-strain model, and the bodies may have passed through each"
+                    " other where the contact search cannot see it; expected displacements small against the"
+                    " bodies");
+  return out;
+}
 
 std::vector<std::string> reference_contact_warnings(const Problem& problem) {
   std::vector<std::string> out;

@@ -24,6 +24,15 @@ constexpr double kReferenceOverlapFraction = 0.1;
 /// surface) while lying within its mean segment (facet edge) length of it (never paired). Empty for the rope and for problems without those.
 std::vector<std::string> reference_contact_warnings(const Problem& problem);
 
+/// \brief One-line warnings about a solution `u` (all dofs) of `problem`, per body:
+/// elements that `u` turns inside out (the deformed Jacobian determinant at a corner
+/// of a quadrilateral or hexahedron, or the volume of a tetrahedron, changes sign).
+/// Such a displacement is far beyond the small-strain model, and bodies may have
+/// passed through each other where the contact search cannot see it (a slave node
+/// carried past its master body faces no master at all), even though the solution
+/// meets its KKT conditions. Empty when no element is inverted, and for the rope.
+std::vector<std::string> solution_warnings(const Problem& problem, const Eigen::VectorXd& u);
+
 /// \brief Throws InputError naming the pair unless every contact pair has at least
 /// one slave node facing its master curve or surface (paired) in the reference configuration:
 /// a pair none of whose nodes is ever paired enforces nothing.

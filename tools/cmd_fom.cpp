@@ -31,7 +31,7 @@ void run_fom(const FomArgs& a) {
   auto problem = fom::make_problem(a.problem, popt);
   declare_problem_inputs(*problem);
   const fom::Param mu = parse_problem_param(*problem, a.param);
-  const std::vector<std::string> warnings = fom::reference_contact_warnings(*problem);
+  std::vector<std::string> warnings = fom::reference_contact_warnings(*problem);
   for (const std::string& w : warnings) std::cerr << "contactrom: warning: " << w << "\n";
   const std::unique_ptr<fom::FullOrderSolver> solver = baselines::make_fom_solver(*problem, a.solver);
   const double setup = solver->setup_time();
@@ -42,6 +42,10 @@ void run_fom(const FomArgs& a) {
     throw InputError("the " + a.solver + " solver returned no solution for problem " + quoted(problem->name(), 200) + " (status " +
                      to_string(sol.status) + (sol.message.empty() ? "" : ": " + sol.message) + ")");
   const fom::KktResiduals& kkt = sol.kkt;  // the residuals the status was certified with
+  for (const std::string& w : fom::solution_warnings(*problem, sol.u)) {
+    std::cerr << "contactrom: warning: " << w << "\n";
+    warnings.push_back(w);
+  }
   if (!a.out.empty()) {
     fom::write_fields(a.out, problem->name(), *problem, mu, sol.u, sol.lambda);
   }

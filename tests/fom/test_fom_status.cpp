@@ -320,3 +320,30 @@ BOOST_AUTO_TEST_CASE(overlaps_and_unpaired_slave_nodes_are_warned_about_and_a_pa
   BOOST_TEST(msg.find("no slave node facing its master curve") != std::string::npos, msg);
   fs::remove_all(dir);
 }
+
+BOOST_AUTO_TEST_CASE(solutions_that_turn_elements_inside_out_are_warned_about) {
+  // A solution of the KKT conditions may still be far outside the small-strain model;
+  // a mirror image of a body (x ↦ −x: u = −2x) turns every element of it inside out.
+  for (const char* name : {"hertz", "hertz3d"}) {
+    const auto problem = fom::make_problem(name);
+    const fom::Mesh& mesh = *problem->mesh();
+    const int d = mesh.dim;
+    const fom::ActiveSetSolver solver(*problem);
+    const fom::FomSolution sol = solver.solve(0.5 * (problem->param_lower() + problem->param_upper()));
+    BOOST_TEST(fom::solution_warnings(*problem, sol.u).empty(), name);  // an ordinary load
+    Eigen::VectorXd mirror = Eigen::VectorXd::Zero(problem->num_dofs());
+    std::vector<char> in_body(static_cast<size_t>(mesh.num_nodes()), 0);
+    for (int e = 0; e < mesh.num_elements(); ++e)
+      if (mesh.element_body(e) == 0)
+        for (int n : mesh.element_nodes(e)) in_body[static_cast<size_t>(n)] = 1;
+    for (int n = 0; n < mesh.num_nodes(); ++n)
+      if (in_body[static_cast<size_t>(n)]) mirror(d * n) = -2.0 * mesh.nodes(0, n);
+    const std::vector<std::string> w = fom::solution_warnings(*problem, mirror);
+    BOOST_TEST_REQUIRE(w.size() == 1u, name);
+    int total = 0;
+    for (int e = 0; e < mesh.num_elements(); ++e) total += mesh.element_body(e) == 0;
+    const std::string all = "turns " + std::to_string(total) + " of the " + std::to_string(total) + " elements of body '" +
+                            mesh.body_names[0] + "' inside out";
+    BOOST_TEST(w[0].find(all) != std::string::npos, w[0]);
+  }
+}
