@@ -35,9 +35,12 @@ struct NodeToFaceOptions {
   /// unpaired when it lies beyond that boundary edge (along the facet's plane, away
   /// from the facet) by more than this fraction of the edge's length and by more than
   /// its distance from the facet's plane (the 3D form of a projection beyond the end
-  /// of a 2D master chain). The second bound keeps nodes on a symmetry plane through
-  /// the boundary paired when the facet tilts. Default 1e-8.
-  double boundary_tolerance = 1e-8;
+  /// of a 2D master chain, whose ends reach as far). Within it the node pairs with
+  /// the boundary facet extended: blocks of the same footprint put slave nodes on the
+  /// master's boundary edges, which non-matching meshes move out by a little.
+  /// The second bound keeps nodes on a symmetry plane through the boundary paired
+  /// when the facet tilts. Default 0.1.
+  double boundary_tolerance = 0.1;
 };
 
 /// \brief Closest point of `p` on the triangle (a, b, c).

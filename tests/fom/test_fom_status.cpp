@@ -347,3 +347,45 @@ BOOST_AUTO_TEST_CASE(solutions_that_turn_elements_inside_out_are_warned_about) {
     BOOST_TEST(w[0].find(all) != std::string::npos, w[0]);
   }
 }
+
+BOOST_AUTO_TEST_CASE(flush_blocks_in_3d_converge_with_the_uniaxial_force) {
+  // Two blocks of the same footprint (a quarter model: hexahedra under tetrahedra, the
+  // meshes do not match), the top pushed down by d: uniaxial stress, contact force
+  // E d A / (h₁ + h₂) = d. The slave nodes on the master's boundary edges slide out
+  // by the two meshes' different lateral expansion; they stay paired with the edge's
+  // facet extended, as at the ends of a 2D master chain.
+  const std::string dir = contactrom::test::temp_dir();
+  const std::string geo = write_file(
+      dir, "stack.geo",
+      "SetFactory(\"OpenCASCADE\");\nBox(1) = {0,0,-0.5, 1,1,0.5};\nBox(2) = {0,0,0, 1,1,0.5};\ne = 1e-6;\n"
+      "bs() = Abs(Boundary{ Volume{1}; });\nbc() = Unique(Abs(Boundary{ Surface{bs()}; }));\n"
+      "Transfinite Curve{ bc() } = 3;\nTransfinite Surface{ bs() };\nRecombine Surface{ bs() };\n"
+      "Transfinite Volume{1};\nRecombine Volume{1};\nMeshSize{ PointsOf{ Volume{2}; } } = 0.2;\n"
+      "Physical Volume(\"bottom\") = {1};\nPhysical Volume(\"top\") = {2};\n"
+      "Physical Surface(\"bottom_base\") = Surface In BoundingBox{-e,-e,-0.5-e, 1+e,1+e,-0.5+e};\n"
+      "tz() = Surface In BoundingBox{-e,-e,-e, 1+e,1+e,e};\nts() = Abs(Boundary{ Volume{2}; });\n"
+      "btop() = tz(); btop() -= ts();\ntface() = tz(); tface() -= btop();\n"
+      "Physical Surface(\"bottom_top\") = btop();\nPhysical Surface(\"top_face\") = tface();\n"
+      "Physical Surface(\"symx\") = Surface In BoundingBox{-e,-e,-0.5-e, e,1+e,0.5+e};\n"
+      "Physical Surface(\"symy\") = Surface In BoundingBox{-e,-e,-0.5-e, 1+e,e,0.5+e};\n"
+      "Physical Surface(\"top_lid\") = Surface In BoundingBox{-e,-e,0.5-e, 1+e,1+e,0.5+e};\n");
+  const auto problem = fom::make_problem(write_file(
+      dir, "stack.toml",
+      "[problem]\nname = \"stack\"\nmesh = \"" + geo + "\"\nformulation = \"3d\"\ndisplacement_scale = 0.02\n"
+      "[[parameters]]\nname = \"d\"\nrange = [0.0, 0.02]\nlower_open = true\n"
+      "[[bodies]]\ngroup = \"bottom\"\nyoung = 1.0\npoisson = 0.3\n"
+      "[[bodies]]\ngroup = \"top\"\nyoung = 1.0\npoisson = 0.3\n"
+      "[[dirichlet]]\ngroup = \"bottom_base\"\ndisplacement = [\"free\", \"free\", 0.0]\n"
+      "[[dirichlet]]\ngroup = \"top_lid\"\ndisplacement = [\"free\", \"free\", \"-d\"]\n"
+      "[[dirichlet]]\ngroup = \"symx\"\ndisplacement = [0.0, \"free\", \"free\"]\n"
+      "[[dirichlet]]\ngroup = \"symy\"\ndisplacement = [\"free\", 0.0, \"free\"]\n"
+      "[[contact]]\nslave = \"top_face\"\nmaster = \"bottom_top\"\n"));
+  const fom::ActiveSetSolver solver(*problem);
+  for (double d : {0.005, 0.0105, 0.02}) {
+    const fom::FomSolution sol = solver.solve(fom::Param::Constant(1, d));
+    BOOST_TEST(sol.status == Status::Success, "d = " << d << ": " << sol.message);
+    BOOST_TEST(sol.pairing_iterations < 20, "d = " << d);
+    BOOST_TEST(std::abs(fom::contact_force(*problem, sol.lambda) - d) < 0.01 * d, "d = " << d);
+  }
+  fs::remove_all(dir);
+}
