@@ -132,9 +132,10 @@ py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& probl
   py::array_t<double> primal(n), dual(n), time(n), penetration(n), separation(n), primal_estimate(n), dual_estimate(n);
   py::array_t<int> sparsity(n), iterations(n);
   py::array_t<bool> converged(n), absolute(n);
-  py::list status;
+  py::list status, reference_status;
   for (py::ssize_t i = 0; i < n; ++i) {
     const rom::EvaluationRow& row = s.rows[i];
+    reference_status.append(to_string(row.fom_status));
     mus.push_back(row.mu);
     primal.mutable_at(i) = row.primal_error;
     dual.mutable_at(i) = row.dual_error;
@@ -163,6 +164,7 @@ py::dict summary_dict(const rom::EvaluationSummary& s, const fom::Problem& probl
   rows["separation"] = separation;
   rows["primal_estimate"] = primal_estimate;
   rows["dual_estimate"] = dual_estimate;
+  rows["reference_status"] = reference_status;
   d["rows"] = rows;
   return d;
 }

@@ -101,7 +101,8 @@ EstimateQuality estimate_quality(const std::vector<EvaluationRow>& rows) {
     if (!(ratio <= hi)) hi = std::isnan(hi) ? ratio : std::max(hi, ratio);
   };
   for (const EvaluationRow& row : rows) {
-    if (row.absolute_errors || row.absolute_estimates || !std::isfinite(row.primal_estimate) ||
+    if (row.fom_status != Status::Success || row.absolute_errors || row.absolute_estimates ||
+        !std::isfinite(row.primal_estimate) ||
         !std::isfinite(row.dual_estimate) || !std::isfinite(row.primal_error) || !std::isfinite(row.dual_error))
       continue;
     ++q.rows;
@@ -167,7 +168,9 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
       row.kkt = fom::kkt_residuals(problem, params[i], res.u, res.lambda);
       s.max_kkt = std::max(s.max_kkt, row.kkt.max());
     }
-    s.add_errors(errors);
+    // An error against a reference that did not converge measures nothing: the row
+    // keeps it (flagged by its reference_status), the statistics leave it out.
+    if (ref.status == Status::Success) s.add_errors(errors);
     s.mean_sparsity += row.sparsity;
     s.max_sparsity = std::max(s.max_sparsity, row.sparsity);
     s.mean_iterations += row.iterations;
@@ -194,7 +197,7 @@ void write_evaluation_csv(const std::string& path, const fom::Problem& problem, 
   write_file_atomically(path, [&](std::ostream& out) {
     for (const std::string& name : problem.param_names()) out << name << ',';
     out << "primal_error,dual_error,sparsity,iterations,time_s,converged,status,selected,errors,penetration,"
-           "separation,primal_estimate,dual_estimate\n";
+           "separation,primal_estimate,dual_estimate,reference_status\n";
     for (const EvaluationRow& row : summary.rows) {
       for (int k = 0; k < row.mu.size(); ++k) out << format_number(row.mu(k)) << ',';
       out << format_number(row.primal_error) << ',' << format_number(row.dual_error) << ',' << row.sparsity << ','
@@ -203,7 +206,7 @@ void write_evaluation_csv(const std::string& path, const fom::Problem& problem, 
       for (size_t j = 0; j < row.selected.size(); ++j) out << (j ? " " : "") << row.selected[j];
       out << ',' << (row.absolute_errors ? "absolute" : "relative") << ',' << format_number(row.contact.penetration)
           << ',' << format_number(row.contact.complementarity) << ',' << format_number(row.primal_estimate) << ','
-          << format_number(row.dual_estimate) << '\n';
+          << format_number(row.dual_estimate) << ',' << to_string(row.fom_status) << '\n';
     }
   });
 }

@@ -79,7 +79,8 @@ struct ErrorStatistics {
 };
 
 /// \brief How well the error estimates of a set of rows match the true errors, over
-/// the rows whose errors and estimates are both relative and finite.
+/// the rows whose errors and estimates are both relative and finite and whose FOM
+/// reference succeeded.
 struct EstimateQuality {
   int rows = 0;                    ///< rows compared
   /// Spearman rank correlation of estimate and true error (NaN below 3 rows).
@@ -116,7 +117,9 @@ struct EvaluationSummary : ErrorStatistics {
   double mean_time_s = 0.0, median_time_s = 0.0;
   int nonconverged = 0;   ///< ROM queries that hit the iteration cap or failed
   int inaccurate = 0;     ///< ROM queries that converged with contact residuals above tolerance (Status::Inaccurate)
-  int fom_failures = 0;   ///< reference FOM solves whose status != Success
+  /// Reference FOM solves whose status != Success: their rows are left out of the
+  /// error statistics (ErrorStatistics) and of the EstimateQuality.
+  int fom_failures = 0;
   bool kkt = false;       ///< whether the rows' KKT residuals were computed (EvaluationOptions::kkt)
   double max_kkt = 0.0;   ///< largest KKT residual over the rows (if computed)
   EstimateQuality estimates;         ///< the error estimates against the true errors
@@ -159,7 +162,8 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
 /// converged (0/1), status, selected (space-separated database snapshot indices),
 /// errors ("relative", or "absolute" where the FOM displacement is near zero),
 /// penetration and separation (the answer's contact residuals, units of U),
-/// primal_estimate and dual_estimate (the answer's error estimates).
+/// primal_estimate and dual_estimate (the answer's error estimates), reference_status
+/// (the status of the FOM reference the errors were measured against).
 void write_evaluation_csv(const std::string& path, const fom::Problem& problem, const EvaluationSummary& summary);
 
 }  // namespace contactrom::rom

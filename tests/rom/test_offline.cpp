@@ -169,7 +169,7 @@ BOOST_AUTO_TEST_CASE(cli_offline_then_online_validation) {
   BOOST_TEST(j["dictionary_size"].get<int>() == 12);
   BOOST_TEST(j["mean_dual_error"].get<double>() < 0.2);
   const std::string table = contactrom::test::slurp(csv);
-  BOOST_TEST(table.rfind("d,primal_error,dual_error,sparsity,iterations,time_s,converged,status,selected,errors,penetration,separation,primal_estimate,dual_estimate\n", 0) ==
+  BOOST_TEST(table.rfind("d,primal_error,dual_error,sparsity,iterations,time_s,converged,status,selected,errors,penetration,separation,primal_estimate,dual_estimate,reference_status\n", 0) ==
              0);
   BOOST_TEST(lines(table) == 1 + 119);
 
