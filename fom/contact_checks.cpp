@@ -15,6 +15,7 @@ namespace {
 struct PairAtRest {
   std::string slave, master;
   int rows = 0, paired = 0, unpaired_near = 0;
+  int facing = 0;  ///< paired slave nodes whose outward normal opposes the master's
   double overlap = 0.0;  ///< largest penetration of a paired slave node (length)
   int dim = 2;
 };
@@ -42,6 +43,56 @@ double mean_master_length(const Mesh& mesh, const std::string& master) {
   return sum / static_cast<double>(std::max<size_t>(n, 1));
 }
 
+/// Outward unit normals (dim x nodes; zero off the group) of the boundary group
+/// `name` (2D: its segments, 3D: its facets) at its nodes: each segment or facet
+/// oriented away from the centroid of the element it bounds, averaged per node.
+Eigen::MatrixXd outward_normals(const Mesh& mesh, const std::string& name) {
+  const int d = mesh.dim;
+  std::vector<std::vector<int>> pieces;
+  if (d == 3) {
+    const auto it = mesh.faces.find(name);
+    if (it != mesh.faces.end())
+      for (const auto& f : it->second) pieces.push_back(f[3] < 0 ? std::vector<int>{f[0], f[1], f[2]}
+                                                                  : std::vector<int>{f[0], f[1], f[2], f[3]});
+  } else if (mesh.segments.count(name)) {
+    for (const auto& seg : mesh.group_segments(name)) pieces.push_back({seg[0], seg[1]});
+  }
+  std::vector<std::vector<int>> of_node(static_cast<size_t>(mesh.num_nodes()));
+  for (const auto& piece : pieces)
+    for (int n : piece) of_node[static_cast<size_t>(n)].clear();
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    for (int n : mesh.element_nodes(e))
+      if (static_cast<size_t>(n) < of_node.size()) of_node[static_cast<size_t>(n)].push_back(e);
+  Eigen::MatrixXd normals = Eigen::MatrixXd::Zero(d, mesh.num_nodes());
+  for (const auto& piece : pieces) {
+    Eigen::Vector3d x[4], n = Eigen::Vector3d::Zero(), mid = Eigen::Vector3d::Zero();
+    for (size_t i = 0; i < piece.size(); ++i) {
+      x[i].setZero();
+      x[i].head(d) = mesh.nodes.col(piece[i]);
+      mid += x[i] / static_cast<double>(piece.size());
+    }
+    if (d == 2)
+      n << x[1].y() - x[0].y(), x[0].x() - x[1].x(), 0.0;
+    else
+      n = (x[1] - x[0]).cross(x[2] - x[0]);
+    for (int e : of_node[static_cast<size_t>(piece[0])]) {
+      const std::vector<int> en = mesh.element_nodes(e);
+      bool bounds = true;
+      for (int node : piece) bounds = bounds && std::find(en.begin(), en.end(), node) != en.end();
+      if (!bounds) continue;
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      for (int node : en) centroid.head(d) += mesh.nodes.col(node) / static_cast<double>(en.size());
+      if (n.dot(centroid - mid) > 0.0) n = -n;
+      break;
+    }
+    if (n.norm() > 0.0) n.normalize();
+    for (int node : piece) normals.col(node) += n.head(d);
+  }
+  for (int j = 0; j < normals.cols(); ++j)
+    if (normals.col(j).norm() > 0.0) normals.col(j).normalize();
+  return normals;
+}
+
 std::vector<PairAtRest> pairs_at_rest(const Problem& problem) {
   std::vector<PairAtRest> out;
   const ContactModel& contact = problem.contact();
@@ -57,9 +108,11 @@ std::vector<PairAtRest> pairs_at_rest(const Problem& problem) {
   // "Near" a master: within its mean segment (2D) or facet edge (3D) length (a node
   // just beyond an edge, as where two surfaces of different sizes meet), per pair.
   std::vector<double> reach(specs.size(), 0.0);
+  std::vector<Eigen::MatrixXd> slave_normals(specs.size());
   for (size_t q = 0; q < specs.size(); ++q) {
     out[q].slave = specs[q].slave, out[q].master = specs[q].master, out[q].dim = mesh->dim;
     reach[q] = mean_master_length(*mesh, specs[q].master);
+    slave_normals[q] = outward_normals(*mesh, specs[q].slave);
   }
   for (int s = 0; s < contact.num_constraints(); ++s) {
     const size_t q = static_cast<size_t>(contact.pair_of_row(s));
@@ -69,6 +122,8 @@ std::vector<PairAtRest> pairs_at_rest(const Problem& problem) {
     if (pairing.segment[static_cast<size_t>(s)] >= 0) {
       ++pair.paired;
       pair.overlap = std::max(pair.overlap, -g(s) / contact.weights()(s));
+      const int node = contact.slave_node(s);
+      if (node >= 0 && slave_normals[q].col(node).dot(pairing.normal.col(s)) < 0.0) ++pair.facing;
       continue;
     }
     // Unpaired: near the master (one of its nodes within reach)?
@@ -170,11 +225,17 @@ std::vector<std::string> reference_contact_warnings(const Problem& problem) {
 
 void check_contact_pairs_face(const Problem& problem) {
   const std::vector<PairAtRest> pairs = pairs_at_rest(problem);
-  for (size_t q = 0; q < pairs.size(); ++q)
+  for (size_t q = 0; q < pairs.size(); ++q) {
     if (pairs[q].rows > 0 && pairs[q].paired == 0)
       throw InputError(pair_name(q, pairs[q]) + " has no slave node facing its master " + boundary_word(pairs[q]) +
                        " in the reference configuration, so none is ever paired; expected " + boundary_word(pairs[q]) +
                        "s that face each other");
+    if (pairs[q].paired > 0 && pairs[q].facing == 0)
+      throw InputError(pair_name(q, pairs[q]) + ": at each of its " + std::to_string(pairs[q].paired) +
+                       " paired slave nodes the slave " + boundary_word(pairs[q]) + "'s outward normal points the"
+                       " same way as the master's, so the slave faces away from the master and the bodies would pass"
+                       " through each other unseen; expected the side of the slave body that meets the master");
+  }
 }
 
 }  // namespace contactrom::fom

@@ -94,6 +94,12 @@ class ContactModel {
     (void)row;
     return 0;
   }
+  /// The mesh node of a constraint row's slave side (−1 for models without slave
+  /// nodes: the rope, obstacles).
+  virtual int slave_node(int row) const {
+    (void)row;
+    return -1;
+  }
 
   /// \brief Contact search in the deformed configuration, every row.
   /// \param u_surface full displacement restricted to surface_dofs()
@@ -202,6 +208,7 @@ class NodeToSegmentContact final : public ContactModel {
   int num_pairs() const override { return static_cast<int>(m_pairs.size()); }
   /// Pair of a constraint row.
   int pair_of_row(int row) const override;
+  int slave_node(int row) const override { return m_slave[static_cast<size_t>(row)]; }
 
  private:
   struct Pair {

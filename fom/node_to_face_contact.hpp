@@ -112,6 +112,7 @@ class NodeToFaceContact final : public ContactModel {
   int num_pairs() const override { return static_cast<int>(m_pairs.size()); }
   /// Pair of a constraint row.
   int pair_of_row(int row) const override { return m_row_pair[static_cast<size_t>(row)]; }
+  int slave_node(int row) const override { return m_slave[static_cast<size_t>(row)]; }
 
  private:
   struct Pair {

@@ -186,9 +186,23 @@ std::vector<FreeRigidMotion> free_rigid_motions(const Problem& problem, double r
       ++rows[p];
     }
   }
+  // A body meshed in several unconnected pieces: each piece is named by where it is.
+  std::vector<int> pieces_of_body(mesh->body_names.size(), 0);
+  for (const std::vector<int>& b : bodies)
+    for (int body : b) ++pieces_of_body[static_cast<size_t>(body)];
   for (size_t p = 0; p < np; ++p) {
     std::string names;
-    for (size_t k = 0; k < bodies[p].size(); ++k) names += (k ? "+'" : "'") + mesh->body_names[bodies[p][k]] + "'";
+    bool split = false;
+    for (size_t k = 0; k < bodies[p].size(); ++k) {
+      names += (k ? "+'" : "'") + mesh->body_names[bodies[p][k]] + "'";
+      split = split || pieces_of_body[static_cast<size_t>(bodies[p][k])] > 1;
+    }
+    if (split) {
+      const Eigen::VectorXd c = 0.5 * (lo[p] + hi[p]);
+      std::string at;
+      for (int d = 0; d < dim; ++d) at += (d ? ", " : "") + format_number(std::round(c(d) * 1e6) / 1e6);
+      names += " (its piece around (" + at + "), not connected to the rest of it)";
+    }
     if (rows[p] == 0) {
       out.push_back({names, "held by no Dirichlet condition (free to move rigidly)"});
       continue;

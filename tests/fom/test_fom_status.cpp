@@ -389,3 +389,48 @@ BOOST_AUTO_TEST_CASE(flush_blocks_in_3d_converge_with_the_uniaxial_force) {
   }
   fs::remove_all(dir);
 }
+
+BOOST_AUTO_TEST_CASE(a_slave_that_faces_away_from_its_master_is_refused) {
+  // The top block's top face as the slave: its nodes project onto the master (the
+  // bottom block's top) with a positive gap, but its outward normal points up like
+  // the master's; the face that meets the master is in no pair, so the blocks would
+  // pass through each other with every residual zero. Whatever the curves' orientation.
+  const std::string dir = contactrom::test::temp_dir();
+  for (bool clockwise : {false, true}) {
+    const std::string geo = write_file(dir, "blocks.geo", blocks_geo(clockwise));
+    std::string toml = blocks_toml(geo, "[0.0, 0.1]");
+    BOOST_CHECK_NO_THROW(fom::make_problem(write_file(dir, "ok.toml", toml)));
+    toml.replace(toml.find("slave = \"top_base\""), 18, "slave = \"top_top\"");
+    const std::string msg = contactrom::test::input_error_of([&] { fom::make_problem(write_file(dir, "away.toml", toml)); });
+    BOOST_TEST(msg.find("contact pair 0 (slave 'top_top' on master 'bottom_top'): at each of its 5 paired slave nodes"
+                        " the slave curve's outward normal points the same way as the master's") != std::string::npos,
+               "clockwise " << clockwise << ": " << msg);
+  }
+  // 3D: the block's top face over the slab.
+  std::string toml = contactrom::test::slurp(blocks3d_toml(dir, 0.0, "[0.0, 0.0, \"-d\"]"));
+  toml.replace(toml.find("slave = \"block_bottom\""), 22, "slave = \"block_top\"");
+  const std::string msg = contactrom::test::input_error_of([&] { fom::make_problem(write_file(dir, "away3.toml", toml)); });
+  BOOST_TEST(msg.find("the slave surface's outward normal points the same way as the master's") != std::string::npos, msg);
+  fs::remove_all(dir);
+}
+
+BOOST_AUTO_TEST_CASE(a_loose_piece_of_a_body_is_named_by_where_it_is) {
+  // A square [3, 3.5] x [0, 0.5] meshed into body 'top' but connected to nothing: the
+  // body itself is held, the piece is not.
+  const std::string dir = contactrom::test::temp_dir();
+  std::string geo = blocks_geo(false);
+  geo.replace(geo.find("Physical Surface(\"top\", 2) = {2};"), 33,
+              "Point(9) = {3, 0, 0}; Point(10) = {3.5, 0, 0}; Point(11) = {3.5, 0.5, 0}; Point(12) = {3, 0.5, 0};\n"
+              "Line(9) = {9, 10}; Line(10) = {10, 11}; Line(11) = {11, 12}; Line(12) = {12, 9};\n"
+              "Curve Loop(3) = {9, 10, 11, 12}; Plane Surface(3) = {3};\n"
+              "Transfinite Curve{9, 10, 11, 12} = 3; Transfinite Surface{3}; Recombine Surface{3};\n"
+              "Physical Surface(\"top\", 2) = {2, 3};");
+  const std::string msg = contactrom::test::input_error_of([&] {
+    const auto problem = fom::make_problem(write_file(dir, "loose.toml", blocks_toml(write_file(dir, "loose.geo", geo), "[0.0, 0.1]")));
+    fom::ActiveSetSolver solver(*problem);
+  });
+  BOOST_TEST(msg.find("body 'top' (its piece around (3.25, 0.25), not connected to the rest of it) is held by no"
+                      " Dirichlet condition") != std::string::npos,
+             msg);
+  fs::remove_all(dir);
+}
