@@ -78,10 +78,15 @@ py::dict report_dict(const baselines::VerificationReport& r, const fom::Referenc
   return d;
 }
 
+/// Problem.from_file and contactrom.problem: meshing runs without the GIL and stops on
+/// Ctrl-C.
 std::shared_ptr<fom::Problem> make(py::handle name_or_path, int refine) {
+  const std::string name = path_arg(name_or_path);
   fom::ProblemOptions options;
   options.refine = refine;
-  return fom::make_problem(path_arg(name_or_path), options);
+  options.progress = interrupt_check();  // Ctrl-C kills gmsh
+  py::gil_scoped_release release;
+  return fom::make_problem(name, options);
 }
 
 }  // namespace
