@@ -61,6 +61,7 @@ struct FomResult {
   fom::FomSolution solution;
   fom::KktResiduals kkt;
   double contact_force = 0.0;
+  std::vector<std::string> warnings;  ///< fom::solution_warnings (elements turned inside out), as `fom --json`
 };
 
 /// \brief The FOM solver of `FullOrderSolver`: the active-set solver or Ipopt.
@@ -78,6 +79,10 @@ struct ReducedModel {
   std::shared_ptr<const rom::OnlineModel> rom;
   std::shared_ptr<const rom::SnapshotDatabase> db;
 };
+
+/// \brief Issues `message` as a Python RuntimeWarning (the caller holds the GIL).
+/// \throws py::error_already_set when a warnings filter turns it into an error.
+void runtime_warning(const std::string& message);
 
 /// \brief μ from a Python number or sequence, checked as the CLI checks `--param`
 /// (same messages: the values are written back as the shortest text that reads as

@@ -128,6 +128,10 @@ ProgressCallback interrupt_check() {
   };
 }
 
+void runtime_warning(const std::string& message) {
+  if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+}
+
 std::string option_text(py::handle value) {
   if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
   // numpy scalars (np.int64(3), np.float32(1e-6), np.bool_(True)): by their kind.

@@ -1,13 +1,16 @@
-"""Problems made from files: meshing releases the GIL and stops on Ctrl-C."""
+"""Problems made from files: meshing releases the GIL and stops on Ctrl-C, and the
+warnings the CLI prints about a problem and a FOM solution reach Python."""
 import os
 import signal
 import threading
 import time
+import warnings
 
 import numpy as np
 import pytest
 
 import contactrom
+from conftest import run_cli_json
 
 # Two quad blocks, the bottom one [0, 1] x [0, 0.5] clamped at its base, the top one
 # [0, 1] x [y0, y0 + 0.5] pressed down by d at its top; the top's base is the slave.
@@ -126,3 +129,44 @@ def test_other_threads_run_while_gmsh_meshes(tmp_path):
     assert end - start >= 1.4
     assert len(during) > 20, len(during)
     assert np.max(np.diff([start, *during, end])) < 0.5
+
+
+def test_reference_overlap_is_a_runtime_warning_and_listed(tmp_path):
+    # The top block sunk 0.05 into the bottom one: half of U = 0.1, more than 10 %.
+    path = blocks(tmp_path, y0=0.45)
+    with pytest.warns(RuntimeWarning, match=r"problem 'blocks': contact pair 0 \(slave 'top_base' on master "
+                                            r"'bottom_top'\) overlaps by 0\.05"):
+        problem = contactrom.Problem.from_file(path)
+    assert len(problem.warnings) == 1 and "overlaps by 0.05" in problem.warnings[0]
+    with pytest.warns(RuntimeWarning, match="overlaps by 0.05"):
+        contactrom.problem(path)
+    # The CLI's warnings, word for word.
+    assert run_cli_json("fom", "--problem", path, "--param", "0.01")["warnings"] == problem.warnings
+    # Touching blocks: no warning at all, an empty list.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        flush = contactrom.Problem.from_file(blocks(tmp_path, y0=0.5))
+    assert flush.warnings == []
+
+
+def test_solution_that_turns_elements_inside_out_is_warned_about(tmp_path):
+    # Pressed down by 1.2, both blocks (0.5 high each, as stiff as each other) are
+    # turned inside out: a KKT point far beyond the small-strain model.
+    path = blocks(tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        problem = contactrom.Problem.from_file(path)
+        fom = contactrom.FullOrderSolver(problem)
+        small = fom.solve(0.05)
+    assert small.warnings == []
+    with pytest.warns(RuntimeWarning, match=r"FOM solution of 'blocks' at mu = 1\.2: the solution turns \d+ of the "
+                                            r"\d+ elements of body 'top' inside out") as record:
+        large = fom.solve(1.2)
+    assert len(record) == 2 and len(large.warnings) == 2
+    assert "body 'bottom'" in large.warnings[0] and "body 'top'" in large.warnings[1]
+    assert run_cli_json("fom", "--problem", path, "--param", "1.2")["warnings"] == large.warnings
+    # A list of solves: one warning, counting the solutions that carry some.
+    with pytest.warns(RuntimeWarning, match=r"1 of the 2 FOM solutions of 'blocks' carry warnings") as record:
+        both = fom.solve_all([0.05, 1.2], threads=2)
+    assert len(record) == 1
+    assert both[0].warnings == [] and both[1].warnings == large.warnings
