@@ -99,6 +99,7 @@ void check_vector(const Eigen::VectorXd& v, const char* name, Eigen::Index size,
 
 /// \brief A list of parameters (one per row of a 2-D array, or a 1-D array / list
 /// of numbers for a one-parameter problem), each checked by to_param.
+/// \throws InputError for a wrong shape, a bad value or no rows at all.
 std::vector<fom::Param> to_params(const fom::Problem& problem, py::handle values);
 
 /// \brief Parameters as an (n, n_params) numpy array.
