@@ -74,15 +74,22 @@ void write_all(int fd, const std::string& bytes) {
   ::_exit(0);
 }
 
+/// Longest wait between two calls of the caller's progress callback, in ms.
+constexpr int kProgressIntervalMs = 100;
+
 /// Reads the child's bytes until end of file or the deadline; whether it was reached.
-bool read_until(int fd, double time_limit_s, std::string& bytes) {
+/// `progress` (if any) is called between waits of at most kProgressIntervalMs; what it
+/// throws propagates.
+bool read_until(int fd, double time_limit_s, std::string& bytes, const ProgressCallback& progress) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(time_limit_s);
+  const double longest_wait_ms = progress ? kProgressIntervalMs : 60000.0;
   char buffer[1 << 16];
   for (;;) {
+    if (progress) progress(0, 1);
     const double left = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
     if (left <= 0) return false;
     struct pollfd p = {fd, POLLIN, 0};
-    const int ready = ::poll(&p, 1, static_cast<int>(std::min(left * 1000.0 + 1.0, 60000.0)));
+    const int ready = ::poll(&p, 1, static_cast<int>(std::min(left * 1000.0 + 1.0, longest_wait_ms)));
     if (ready < 0 && errno == EINTR) continue;
     if (ready <= 0) continue;
     const ssize_t n = ::read(fd, buffer, sizeof buffer);
@@ -90,6 +97,14 @@ bool read_until(int fd, double time_limit_s, std::string& bytes) {
     if (n <= 0) return true;  // end of file: the child is done (or gone)
     bytes.append(buffer, static_cast<std::size_t>(n));
   }
+}
+
+/// Waits for the child `pid` to end (retrying on EINTR); its wait status.
+int reap(pid_t pid) {
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return status;
 }
 
 ChildOutcome outcome(int status, const std::string& bytes) {
@@ -118,7 +133,7 @@ ChildOutcome outcome(int status, const std::string& bytes) {
 }  // namespace
 
 ChildOutcome run_in_child_process(const std::function<std::string()>& work, double time_limit_s,
-                                  const std::string& where) {
+                                  const std::string& where, const ProgressCallback& progress) {
   int fds[2];
   if (::pipe(fds) != 0) throw std::runtime_error(where + ": cannot create a pipe: " + std::strerror(errno));
   std::fflush(nullptr);  // nothing buffered may be written twice
@@ -134,12 +149,18 @@ ChildOutcome run_in_child_process(const std::function<std::string()>& work, doub
   }
   ::close(fds[1]);
   std::string bytes;
-  const bool finished = read_until(fds[0], time_limit_s, bytes);
+  bool finished = false;
+  try {
+    finished = read_until(fds[0], time_limit_s, bytes, progress);
+  } catch (...) {  // the caller stops the work (Ctrl-C): no child is left running or unreaped
+    ::close(fds[0]);
+    ::kill(pid, SIGKILL);
+    reap(pid);
+    throw;
+  }
   ::close(fds[0]);
   if (!finished) ::kill(pid, SIGKILL);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
+  const int status = reap(pid);
   if (!finished) {
     ChildOutcome out;
     out.end = ChildOutcome::End::TimedOut;

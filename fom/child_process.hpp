@@ -6,6 +6,8 @@
 #include <functional>
 #include <string>
 
+#include <contactrom/core/parallel_for.hpp>
+
 namespace contactrom::fom {
 
 /// \brief How the child of run_in_child_process() ended.
@@ -33,9 +35,12 @@ struct ChildOutcome {
 /// handler inherited from the caller runs. Its answer comes back through a pipe,
 /// read within `time_limit_s` seconds.
 /// \param where names the work in the messages of a failed pipe or fork
+/// \param progress called with (0, 1) from the calling thread about every 0.1 s while
+///   the parent waits (optional); an exception it throws kills the child (SIGKILL),
+///   reaps it and propagates
 /// \throws std::runtime_error if no pipe or process can be created.
 ChildOutcome run_in_child_process(const std::function<std::string()>& work, double time_limit_s,
-                                  const std::string& where);
+                                  const std::string& where, const ProgressCallback& progress = {});
 
 /// \brief Name of a signal number for messages ("SIGSEGV", "signal 40").
 std::string signal_name(int sig);

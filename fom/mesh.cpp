@@ -153,7 +153,8 @@ Mesh load_mesh(const std::string& path, const MeshOptions& options) {
   const std::string where = "mesh " + quoted(path, 200);
   gmsh_api::load();  // once per process, before the fork: every later child shares it
   const ChildOutcome child = run_in_child_process(
-      [&] { return serialize_mesh(mesh_with_gmsh(path, options)); }, options.time_limit_s, where);
+      [&] { return serialize_mesh(mesh_with_gmsh(path, options)); }, options.time_limit_s, where,
+      options.progress);
   switch (child.end) {
     case ChildOutcome::End::Answered:
       return deserialize_mesh(child.text, where);

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <contactrom/core/parallel_for.hpp>
+
 namespace contactrom::fom {
 
 /// \brief A 2D Q1 mesh with named node/segment groups, or a 3D mesh of tetrahedra
@@ -100,6 +102,10 @@ struct MeshOptions {
   /// file when it runs longer (e.g. a `.geo` with a NaN radius loops forever). Must be
   /// > 0; default 600.
   double time_limit_s = 600.0;
+  /// Called from the calling thread about every 0.1 s while gmsh runs, with (0, 1);
+  /// an exception it throws (e.g. the Python module's Ctrl-C check) stops gmsh: its
+  /// process is killed and reaped, and the exception propagates. Optional.
+  ProgressCallback progress;
 };
 
 /// \brief Meshes a `.geo` file (or reads a `.msh`) with the gmsh API and returns

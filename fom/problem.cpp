@@ -449,6 +449,7 @@ std::unique_ptr<Problem> make_problem(const std::string& name_or_path, const Pro
   mesh_options.refine = def.refine;
   mesh_options.max_nodes = def.max_mesh_nodes;
   mesh_options.time_limit_s = def.mesh_time_limit;
+  mesh_options.progress = options.progress;
   std::error_code ec;
   if (!std::filesystem::exists(def.mesh, ec))
     throw InputError(def.where(def.mesh_where) + ": mesh file " + quoted(def.mesh, 200) +

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include <contactrom/core/parallel_for.hpp>
 #include <contactrom/fom/contact_model.hpp>
 #include <contactrom/fom/elasticity.hpp>
 #include <contactrom/fom/mesh.hpp>
@@ -33,6 +34,11 @@ struct ProblemOptions {
   /// Extra uniform refinements on top of the file's `refine` (`--refine k`), default 0.
   /// Not used by `rope` (fom/rope.hpp has its own options).
   int refine = 0;
+  /// Called from the calling thread about every 0.1 s while gmsh meshes the problem's
+  /// `.geo` or `.msh` file, with (0, 1) (MeshOptions::progress); an exception it throws
+  /// stops meshing (gmsh's process is killed) and propagates. Optional; the Python
+  /// module's Ctrl-C check.
+  ProgressCallback progress;
 };
 
 /// \brief What a Problem is made of, as a builder fills it: build_problem() from a

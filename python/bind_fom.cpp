@@ -5,6 +5,7 @@
 #include <contactrom/core/errors.hpp>
 #include <contactrom/core/parallel_for.hpp>
 #include "python/bindings.hpp"
+#include <contactrom/fom/contact_checks.hpp>
 #include <contactrom/fom/rope.hpp>
 #include <contactrom/rom/offline.hpp>
 
@@ -54,8 +55,22 @@ FomResult finish(const fom::Problem& problem, fom::FomSolution solution) {
   FomResult r;
   r.kkt = solution.kkt;  // the residuals its status was certified with
   r.contact_force = fom::contact_force(problem, solution.lambda);
+  r.warnings = fom::solution_warnings(problem, solution.u);
   r.solution = std::move(solution);
   return r;
+}
+
+/// "mu = 0.05, 0.02": a parameter in messages.
+std::string param_text(const fom::Param& mu) {
+  std::string text = "mu = ";
+  for (Eigen::Index k = 0; k < mu.size(); ++k) text += (k ? ", " : "") + format_number(mu(k));
+  return text;
+}
+
+/// The warnings of one FOM solution at mu, each as a RuntimeWarning naming the problem and mu.
+void warn_solution(const fom::Problem& problem, const fom::Param& mu, const FomResult& r) {
+  for (const std::string& w : r.warnings)
+    runtime_warning("FOM solution of " + quoted(problem.name(), 200) + " at " + param_text(mu) + ": " + w);
 }
 
 /// `errors`: the errors against the reference by the rule of `online` (relative, or
@@ -78,10 +93,23 @@ py::dict report_dict(const baselines::VerificationReport& r, const fom::Referenc
   return d;
 }
 
+/// Problem.from_file and contactrom.problem: meshing runs without the GIL and stops on
+/// Ctrl-C; the reference-configuration contact warnings (as the CLI prints them) are
+/// issued as RuntimeWarnings.
 std::shared_ptr<fom::Problem> make(py::handle name_or_path, int refine) {
+  const std::string name = path_arg(name_or_path);
   fom::ProblemOptions options;
   options.refine = refine;
-  return fom::make_problem(path_arg(name_or_path), options);
+  options.progress = interrupt_check();  // Ctrl-C kills gmsh
+  std::shared_ptr<fom::Problem> problem;
+  std::vector<std::string> warnings;
+  {
+    py::gil_scoped_release release;
+    problem = fom::make_problem(name, options);
+    warnings = fom::reference_contact_warnings(*problem);
+  }
+  for (const std::string& w : warnings) runtime_warning("problem " + quoted(problem->name(), 200) + ": " + w);
+  return problem;
 }
 
 }  // namespace
@@ -130,6 +158,14 @@ with u = u_lift(mu) + u0 on all dofs (Dirichlet dofs kept).)doc");
             return py::cast(Eigen::MatrixXd(p.mesh()->nodes.transpose()));
           },
           "Node coordinates, shape (n_nodes, dim) (dim = 2 or 3; rope: the 1-D abscissae).")
+      .def_property_readonly(
+          "warnings",
+          [](const fom::Problem& p) {
+            py::gil_scoped_release release;
+            return fom::reference_contact_warnings(p);
+          },
+          "Warnings about the contact pairs in the reference configuration (surfaces that overlap, slave nodes "
+          "just beyond their master), as `contactrom fom` prints them; a list of str, empty when none.")
       .def_property_readonly("fingerprint", &fom::Problem::fingerprint)
       .def_property_readonly("displacement_scale", &fom::Problem::displacement_scale)
       .def("check_param", [](const fom::Problem& p, py::handle mu) { return to_param(p, mu); }, py::arg("mu"),
@@ -203,6 +239,9 @@ with u = u_lift(mu) + u0 on all dofs (Dirichlet dofs kept).)doc");
       .def_property_readonly("active", [](const FomResult& r) { return r.solution.active; })
       .def_property_readonly("time_s", [](const FomResult& r) { return r.solution.time_s; })
       .def_property_readonly("contact_force", [](const FomResult& r) { return r.contact_force; })
+      .def_readonly("warnings", &FomResult::warnings,
+                    "Warnings about the solution (elements it turns inside out), as `contactrom fom` prints them; a "
+                    "list of str, empty when none.")
       .def_property_readonly("kkt", [](const FomResult& r) { return kkt_dict(r.kkt); },
                              "Relative KKT residuals (stationarity, penetration, negative_pressure, complementarity, max).")
       .def("__repr__", [](const FomResult& r) {
@@ -234,8 +273,13 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
           "solve",
           [](const FullOrderSolver& s, py::handle mu) {
             const fom::Param p = to_param(*s.problem, mu);
-            py::gil_scoped_release release;
-            return finish(*s.problem, s.solve(p));
+            FomResult r;
+            {
+              py::gil_scoped_release release;
+              r = finish(*s.problem, s.solve(p));
+            }
+            warn_solution(*s.problem, p, r);
+            return r;
           },
           py::arg("mu"), "Solves at mu (GIL released). RuntimeError if the solver returns no solution at all.")
       .def(
@@ -244,9 +288,21 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
             check_threads(threads, "threads");
             const std::vector<fom::Param> ps = to_params(*s.problem, params);
             std::vector<FomResult> out(ps.size());
-            py::gil_scoped_release release;
-            parallel_for(static_cast<int>(ps.size()), threads,
-                              [&](int i) { out[i] = finish(*s.problem, s.solve(ps[i])); }, interrupt_check());
+            {
+              py::gil_scoped_release release;
+              parallel_for(static_cast<int>(ps.size()), threads,
+                           [&](int i) { out[i] = finish(*s.problem, s.solve(ps[i])); }, interrupt_check());
+            }
+            // One warning for the list: how many solutions carry warnings, and the first.
+            size_t first = out.size(), warned = 0;
+            for (size_t i = 0; i < out.size(); ++i) {
+              if (out[i].warnings.empty()) continue;
+              if (warned++ == 0) first = i;
+            }
+            if (warned > 0)
+              runtime_warning(std::to_string(warned) + " of the " + std::to_string(out.size()) + " FOM solutions of " +
+                              quoted(s.problem->name(), 200) + " carry warnings (FomSolution.warnings); the first, at " +
+                              param_text(ps[first]) + ": " + out[first].warnings.front());
             return out;
           },
           py::arg("params"), py::arg("threads") = 0,

@@ -4,6 +4,8 @@
 // invalid_input.
 #include <cmath>
 #include <functional>
+#include <optional>
+#include <string>
 
 #include <contactrom/core/errors.hpp>
 #include <contactrom/core/exact_scaling.hpp>
@@ -16,12 +18,15 @@
 namespace contactrom::python {
 namespace {
 
-/// Result of a sparse kernel: x and how the solve ended.
+/// Result of a sparse kernel: x and how the solve ended (the keys of `contactrom sparse --json`).
 struct SparseResult {
   Eigen::VectorXd x;
   Status status = Status::Success;
   int iterations = 0;
   std::vector<Eigen::Index> support;
+  double residual = 0.0;           ///< ||A x - b||_2 (the kernel's matrix and right-hand side)
+  double relative_residual = 0.0;  ///< residual / ||b|| (the residual itself when b = 0)
+  std::optional<std::string> stop_reason;  ///< OMP's (rom::to_string(OmpStop)); none for the other kernels
 };
 
 void check_system(const char* kernel, const Eigen::MatrixXd& a, const Eigen::VectorXd& b, const char* a_name,
@@ -51,6 +56,10 @@ SparseResult run(Solver& solver, const Eigen::MatrixXd& d, const Eigen::VectorXd
   }
   r.status = solver.info();
   r.iterations = solver.iterations();
+  // As `contactrom sparse`: norms that neither underflow nor overflow with extreme data.
+  r.residual = (d * r.x - x).stableNorm();
+  const double x_norm = x.stableNorm();
+  r.relative_residual = x_norm > 0.0 ? r.residual / x_norm : r.residual;
   for (Eigen::Index i = 0; i < r.x.size(); ++i)
     if (r.x(i) != 0.0) r.support.push_back(i);
   return r;
@@ -83,11 +92,21 @@ void bind_focuss(py::module_& m, const char* name, const char* doc) {
 }  // namespace
 
 void bind_kernels(py::module_& m) {
-  py::class_<SparseResult>(m, "SparseResult", "Solution of a sparse kernel: x, status, iterations, support.")
+  py::class_<SparseResult>(m, "SparseResult",
+                           "Solution of a sparse kernel: x, status, iterations, support, residual, relative_residual "
+                           "and (OMP) stop_reason, as `contactrom sparse --json`.")
       .def_property_readonly("x", [](py::object self) { return vector_view(self.cast<const SparseResult&>().x, self); })
       .def_property_readonly("status", [](const SparseResult& r) { return std::string(to_string(r.status)); })
       .def_readonly("iterations", &SparseResult::iterations)
       .def_readonly("support", &SparseResult::support, "Indices of the non-zero entries of x, ascending.")
+      .def_readonly("residual", &SparseResult::residual,
+                    "||A x - b||_2 for nnls(A, b), ||D x - signal||_2 for omp/focuss/nnfocuss(D, signal), at the "
+                    "returned x.")
+      .def_readonly("relative_residual", &SparseResult::relative_residual,
+                    "residual / ||b|| (or / ||signal||); the residual itself when that norm is 0.")
+      .def_readonly("stop_reason", &SparseResult::stop_reason,
+                    "OMP: why it stopped, 'residual_tolerance', 'atom_limit' (success) or 'no_progress' "
+                    "(no_convergence); None for nnls, focuss and nnfocuss.")
       .def("__repr__", [](const SparseResult& r) {
         return "<contactrom.SparseResult " + std::string(to_string(r.status)) + ", " +
                std::to_string(r.support.size()) + " non-zeros>";
@@ -117,7 +136,10 @@ void bind_kernels(py::module_& m) {
         o.max_atoms = max_atoms;
         o.tolerance = tolerance;
         rom::Omp solver(o);
-        return run(solver, d, x, [&](const Eigen::MatrixXd& ds, const Eigen::VectorXd& xs) { return solver.compute(ds).solve(xs); });
+        SparseResult r =
+            run(solver, d, x, [&](const Eigen::MatrixXd& ds, const Eigen::VectorXd& xs) { return solver.compute(ds).solve(xs); });
+        r.stop_reason = rom::to_string(solver.stop_reason());
+        return r;
       },
       py::arg("D"), py::arg("x"), py::arg("max_atoms") = -1, py::arg("tolerance") = 1e-8,
       "Orthogonal matching pursuit: sparse alpha with D alpha ~ x (||x - D alpha|| <= tolerance ||x||).");

@@ -50,13 +50,9 @@ std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, doub
     py::gil_scoped_release release;
     r->rom = std::make_shared<rom::OnlineModel>(database.problem, *r->db, model_options, method, solver_options);
   }
-  if (r->rom->model().primal_rank() == 0 &&
-      PyErr_WarnEx(PyExc_RuntimeWarning,
-                   ("ReducedModel: delta " + format_number(delta) +
-                    " keeps no POD mode; the reduced displacement is the offset alone")
-                       .c_str(),
-                   1) != 0)
-    throw py::error_already_set();  // the warning was turned into an error
+  if (r->rom->model().primal_rank() == 0)
+    runtime_warning("ReducedModel: delta " + format_number(delta) +
+                    " keeps no POD mode; the reduced displacement is the offset alone");
   return r;
 }
 

@@ -61,6 +61,7 @@ struct FomResult {
   fom::FomSolution solution;
   fom::KktResiduals kkt;
   double contact_force = 0.0;
+  std::vector<std::string> warnings;  ///< fom::solution_warnings (elements turned inside out), as `fom --json`
 };
 
 /// \brief The FOM solver of `FullOrderSolver`: the active-set solver or Ipopt.
@@ -79,6 +80,10 @@ struct ReducedModel {
   std::shared_ptr<const rom::SnapshotDatabase> db;
 };
 
+/// \brief Issues `message` as a Python RuntimeWarning (the caller holds the GIL).
+/// \throws py::error_already_set when a warnings filter turns it into an error.
+void runtime_warning(const std::string& message);
+
 /// \brief μ from a Python number or sequence, checked as the CLI checks `--param`
 /// (same messages: the values are written back as the shortest text that reads as
 /// the same double). \throws InputError for a wrong count, a non-finite value or a
@@ -94,6 +99,7 @@ void check_vector(const Eigen::VectorXd& v, const char* name, Eigen::Index size,
 
 /// \brief A list of parameters (one per row of a 2-D array, or a 1-D array / list
 /// of numbers for a one-parameter problem), each checked by to_param.
+/// \throws InputError for a wrong shape, a bad value or no rows at all.
 std::vector<fom::Param> to_params(const fom::Problem& problem, py::handle values);
 
 /// \brief Parameters as an (n, n_params) numpy array.

@@ -67,6 +67,13 @@ std::vector<fom::Param> to_params(const fom::Problem& problem, py::handle values
                      std::to_string(problem.num_params()) + ")" + (one ? " or (n,)" : "") + " (" +
                      problem.range_text() + ")");
   const py::ssize_t width = a.ndim() == 1 ? 1 : a.shape(1);
+  // As the CLI refuses an empty parameter file: no rows would give an empty database,
+  // no solutions or error statistics of nothing.
+  if (a.shape(0) == 0)
+    throw InputError("params of " + quoted(problem.name(), 200) + " has no rows (shape (0" +
+                     (a.ndim() == 2 ? ", " + std::to_string(width) : std::string(",")) +
+                     ")); expected at least one parameter, an array of shape (n, " + std::to_string(problem.num_params()) +
+                     ") with n >= 1");
   std::vector<fom::Param> out;
   for (py::ssize_t i = 0; i < a.shape(0); ++i) out.push_back(checked_param(problem, a.data() + i * width, width));
   return out;
@@ -126,6 +133,10 @@ ProgressCallback interrupt_check() {
     py::gil_scoped_acquire gil;
     if (PyErr_CheckSignals() != 0) throw PythonErrorPending();
   };
+}
+
+void runtime_warning(const std::string& message) {
+  if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) != 0) throw py::error_already_set();
 }
 
 std::string option_text(py::handle value) {

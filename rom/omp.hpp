@@ -43,6 +43,18 @@ enum class OmpStop {
                       ///< selected ones (Status::NoConvergence: tolerance not met)
 };
 
+/// \brief The name of a stop reason, as `contactrom sparse --json` and Python's
+/// SparseResult.stop_reason give it: not_run, residual_tolerance, atom_limit, no_progress.
+inline const char* to_string(OmpStop stop) {
+  switch (stop) {
+    case OmpStop::NotRun: return "not_run";
+    case OmpStop::ResidualTolerance: return "residual_tolerance";
+    case OmpStop::AtomLimit: return "atom_limit";
+    case OmpStop::NoProgress: return "no_progress";
+  }
+  return "not_run";
+}
+
 /// \brief Orthogonal Matching Pursuit, batch form:
 /// \f[ \mathcal I \gets \mathcal I \cup \arg\max_j |\hat d_j^T(x - D\alpha)|,\qquad
 ///     \alpha_{\mathcal I} = (\hat D_{\mathcal I}^T \hat D_{\mathcal I})^{-1}

@@ -78,14 +78,7 @@ SparseRun run_method(const SparseArgs& args, bool has_tol, bool has_max_iter, bo
     run.coefficients = omp.compute(d).solve(x);
     run.status = omp.info();
     run.iterations = omp.iterations();
-    const char* reason = "not_run";
-    switch (omp.stop_reason()) {
-      case rom::OmpStop::NotRun: reason = "not_run"; break;
-      case rom::OmpStop::ResidualTolerance: reason = "residual_tolerance"; break;
-      case rom::OmpStop::AtomLimit: reason = "atom_limit"; break;
-      case rom::OmpStop::NoProgress: reason = "no_progress"; break;
-    }
-    run.extra["stop_reason"] = reason;
+    run.extra["stop_reason"] = rom::to_string(omp.stop_reason());
   } else {
     rom::FocussOptions options;
     if (has_tol) options.tolerance = args.tolerance;

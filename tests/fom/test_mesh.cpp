@@ -3,9 +3,11 @@
 #define BOOST_TEST_MODULE fom_mesh
 #include <boost/test/unit_test.hpp>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -587,6 +589,30 @@ BOOST_AUTO_TEST_CASE(gmsh_running_past_the_time_limit_is_stopped) {
   const TempFile geo("loop.geo", "For i In {1:1e15}\n  x = i;\nEndFor\nPoint(1) = {0,0,0,0.1};\n");
   const std::string msg = refusal_within_time_limit(geo);
   BOOST_TEST(contains(msg, "time limit of 2 s"), msg);
+}
+
+BOOST_AUTO_TEST_CASE(a_progress_callback_that_throws_stops_gmsh_at_once_and_reaps_it) {
+  // How the Python module's Ctrl-C stops meshing: the callback, called about every
+  // 0.1 s while gmsh runs, throws; gmsh's process is killed and reaped, and the
+  // exception reaches the caller long before the time limit (600 s).
+  const TempFile geo("loop.geo", "For i In {1:1e15}\n  x = i;\nEndFor\nPoint(1) = {0,0,0,0.1};\n");
+  struct Stop {};
+  contactrom::fom::MeshOptions options;
+  int calls = 0;
+  const auto start = std::chrono::steady_clock::now();
+  options.progress = [&](int, int) {
+    ++calls;
+    if (std::chrono::steady_clock::now() - start > std::chrono::milliseconds(300)) throw Stop{};
+  };
+  BOOST_CHECK_THROW(load_mesh(geo.path.string(), options), Stop);
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  BOOST_TEST(elapsed >= 0.3);
+  BOOST_TEST(elapsed < 2.0);
+  BOOST_TEST(calls >= 3);  // called again and again while gmsh ran
+  errno = 0;
+  BOOST_TEST(::waitpid(-1, nullptr, WNOHANG) == -1);  // no child of this process is left, running or not
+  BOOST_TEST(errno == ECHILD);
+  BOOST_TEST(load_mesh(kMeshDir + "hertz.geo").fingerprint() == hertz().fingerprint());  // gmsh still works
 }
 
 BOOST_AUTO_TEST_CASE(a_nan_radius_is_refused_in_one_line) {

@@ -236,3 +236,26 @@ def test_parameters_are_numbers_and_settings_agree():
     with pytest.raises(TypeError, match="resume is a SnapshotDatabase"):
         contactrom.offline_adaptive(hertz, tolerance=0.1, resume="x.h5")
     assert "FallbackModel" in contactrom.__all__
+
+
+def test_empty_parameter_lists_are_refused(hertz_db_path, tmp_path):
+    # No rows would give errors of 0.0 over nothing, an empty database or no
+    # solutions; the CLI refuses an empty parameter file the same way.
+    hertz = contactrom.problem("hertz")
+    rom = contactrom.ReducedModel(contactrom.load_database(hertz_db_path))
+    fom = contactrom.FullOrderSolver(hertz)
+    calls = {"evaluate": rom.evaluate, "offline": lambda p: contactrom.offline(hertz, p),
+             "FullOrderSolver.solve_all": fom.solve_all, "ReducedModel.solve_all": rom.solve_all}
+    for name, call in calls.items():
+        for empty in (np.zeros((0, 1)), np.zeros(0), []):
+            with pytest.raises(ValueError) as excinfo:
+                call(empty)
+            assert message_of(excinfo).startswith("params of 'hertz' has no rows (shape (0"), name
+            assert message_of(excinfo).endswith("expected at least one parameter, an array of shape (n, 1) with n >= 1")
+            assert "\n" not in message_of(excinfo)
+    with pytest.raises(ValueError, match=r"has no rows \(shape \(0, 1\)\)"):
+        rom.evaluate(np.zeros((0, 1)))
+    (tmp_path / "empty.csv").write_text("d\n")
+    assert "expected at least one row" in cli_error("online", "--db", str(hertz_db_path), "--params",
+                                                    str(tmp_path / "empty.csv"))
+    assert len(rom.solve_all([0.1])) == 1  # one row is a list

@@ -5,6 +5,7 @@ import pytest
 import scipy.optimize
 
 import contactrom
+from conftest import run_cli_json
 
 
 @pytest.fixture
@@ -75,10 +76,36 @@ def test_extreme_magnitudes_give_the_same_answer(planted, scale, tmp_path):
         # (a coefficient near zero may fall into the subnormal range: absolute tolerance)
         assert np.allclose(alone.x * scale, plain.x, rtol=1e-12, atol=1e-12 * np.abs(plain.x).max()), kernel
     # The CLI: the same coefficients, and a residual that does not underflow.
-    from conftest import run_cli_json
     np.savetxt(tmp_path / "D.csv", np.eye(2) * scale, delimiter=",")
     np.savetxt(tmp_path / "x.csv", np.array([scale, 2 * scale]))
     out = run_cli_json("sparse", "--method", "nnls", "--dictionary", str(tmp_path / "D.csv"), "--signal",
                        str(tmp_path / "x.csv"))
     assert out["status"] == "success" and out["coefficients"] == [1.0, 2.0]
     assert out["relative_residual"] == 0.0
+
+
+def test_results_carry_the_residual_and_omp_s_stop_reason(planted, tmp_path):
+    # The keys of `contactrom sparse --json`: an atom limit is a success with a large
+    # residual, told apart from convergence by stop_reason.
+    D, alpha, x = planted
+    capped = contactrom.omp(D, x, max_atoms=2)
+    assert capped.status == "success" and capped.stop_reason == "atom_limit"
+    assert capped.residual == pytest.approx(np.linalg.norm(D @ capped.x - x), rel=1e-12)
+    assert capped.relative_residual == pytest.approx(capped.residual / np.linalg.norm(x), rel=1e-12)
+    assert capped.relative_residual > 0.1
+    full = contactrom.omp(D, x, tolerance=1e-12)
+    assert full.stop_reason == "residual_tolerance" and full.relative_residual <= 1e-12
+    nothing = contactrom.omp(np.zeros((3, 0)), np.array([1.0, 2.0, 3.0]))
+    assert nothing.stop_reason == "no_progress" and nothing.relative_residual == 1.0
+    for kernel in (contactrom.nnls, contactrom.focuss, contactrom.nnfocuss):
+        r = kernel(np.abs(D), np.abs(D) @ np.abs(alpha))
+        assert r.stop_reason is None
+        assert r.relative_residual < 1e-8, kernel
+    zero = contactrom.nnls(np.eye(2), np.zeros(2))
+    assert zero.residual == zero.relative_residual == 0.0
+    np.savetxt(tmp_path / "D.csv", D, delimiter=",")
+    np.savetxt(tmp_path / "x.csv", x)
+    out = run_cli_json("sparse", "--method", "omp", "--atoms", "2", "--dictionary", str(tmp_path / "D.csv"),
+                       "--signal", str(tmp_path / "x.csv"))
+    assert out["stop_reason"] == capped.stop_reason
+    assert out["relative_residual"] == pytest.approx(capped.relative_residual, rel=1e-9)
