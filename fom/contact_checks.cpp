@@ -44,49 +44,32 @@ double mean_master_length(const Mesh& mesh, const std::string& master) {
 }
 
 /// Outward unit normals (dim x nodes; zero off the group) of the boundary group
-/// `name` (2D: its segments, 3D: its facets) at its nodes: each segment or facet
-/// oriented away from the centroid of the element it bounds, averaged per node.
+/// `name` at its nodes, each segment's or facet's averaged per node. The mesh orients
+/// them: 2D chains run with their body on the left, so (t_y, −t_x) points out of it
+/// (as the contact model's master normals); 3D facets are counter-clockwise seen from
+/// outside.
 Eigen::MatrixXd outward_normals(const Mesh& mesh, const std::string& name) {
   const int d = mesh.dim;
-  std::vector<std::vector<int>> pieces;
+  Eigen::MatrixXd normals = Eigen::MatrixXd::Zero(d, mesh.num_nodes());
+  const auto point = [&](int node) {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    x.head(d) = mesh.nodes.col(node);
+    return x;
+  };
+  const auto add = [&](const int* nodes, int count, Eigen::Vector3d n) {
+    if (n.norm() > 0.0) n.normalize();
+    for (int a = 0; a < count; ++a) normals.col(nodes[a]) += n.head(d);
+  };
   if (d == 3) {
     const auto it = mesh.faces.find(name);
     if (it != mesh.faces.end())
-      for (const auto& f : it->second) pieces.push_back(f[3] < 0 ? std::vector<int>{f[0], f[1], f[2]}
-                                                                  : std::vector<int>{f[0], f[1], f[2], f[3]});
+      for (const auto& f : it->second)
+        add(f.data(), f[3] < 0 ? 3 : 4, (point(f[1]) - point(f[0])).cross(point(f[2]) - point(f[0])));
   } else if (mesh.segments.count(name)) {
-    for (const auto& seg : mesh.group_segments(name)) pieces.push_back({seg[0], seg[1]});
-  }
-  std::vector<std::vector<int>> of_node(static_cast<size_t>(mesh.num_nodes()));
-  for (const auto& piece : pieces)
-    for (int n : piece) of_node[static_cast<size_t>(n)].clear();
-  for (int e = 0; e < mesh.num_elements(); ++e)
-    for (int n : mesh.element_nodes(e))
-      if (static_cast<size_t>(n) < of_node.size()) of_node[static_cast<size_t>(n)].push_back(e);
-  Eigen::MatrixXd normals = Eigen::MatrixXd::Zero(d, mesh.num_nodes());
-  for (const auto& piece : pieces) {
-    Eigen::Vector3d x[4], n = Eigen::Vector3d::Zero(), mid = Eigen::Vector3d::Zero();
-    for (size_t i = 0; i < piece.size(); ++i) {
-      x[i].setZero();
-      x[i].head(d) = mesh.nodes.col(piece[i]);
-      mid += x[i] / static_cast<double>(piece.size());
+    for (const auto& seg : mesh.group_segments(name)) {
+      const Eigen::Vector3d t = point(seg[1]) - point(seg[0]);
+      add(seg.data(), 2, Eigen::Vector3d(t.y(), -t.x(), 0.0));
     }
-    if (d == 2)
-      n << x[1].y() - x[0].y(), x[0].x() - x[1].x(), 0.0;
-    else
-      n = (x[1] - x[0]).cross(x[2] - x[0]);
-    for (int e : of_node[static_cast<size_t>(piece[0])]) {
-      const std::vector<int> en = mesh.element_nodes(e);
-      bool bounds = true;
-      for (int node : piece) bounds = bounds && std::find(en.begin(), en.end(), node) != en.end();
-      if (!bounds) continue;
-      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-      for (int node : en) centroid.head(d) += mesh.nodes.col(node) / static_cast<double>(en.size());
-      if (n.dot(centroid - mid) > 0.0) n = -n;
-      break;
-    }
-    if (n.norm() > 0.0) n.normalize();
-    for (int node : piece) normals.col(node) += n.head(d);
   }
   for (int j = 0; j < normals.cols(); ++j)
     if (normals.col(j).norm() > 0.0) normals.col(j).normalize();

@@ -53,7 +53,8 @@ struct Mesh {
   std::map<std::string, std::vector<std::array<int, 4>>> faces;
   std::vector<std::string> body_names;        ///< physical surface (2D) or volume (3D) names, by body index
   /// Physical curve name -> its line elements (node pairs), ordered as a chain
-  /// from one end of the curve to the other (consecutive segments share a node).
+  /// from one end of the curve to the other (consecutive segments share a node),
+  /// running with the body of its first segment on the left.
   std::map<std::string, std::vector<std::array<int, 2>>> segments;
   /// Physical curve name -> its node ids, in chain order (one more than segments
   /// for an open curve, as many as segments for a closed one).

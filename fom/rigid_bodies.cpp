@@ -191,6 +191,7 @@ std::vector<FreeRigidMotion> free_rigid_motions(const Problem& problem, double r
   for (const std::vector<int>& b : bodies)
     for (int body : b) ++pieces_of_body[static_cast<size_t>(body)];
   for (size_t p = 0; p < np; ++p) {
+    const Eigen::VectorXd c = 0.5 * (lo[p] + hi[p]);  // the piece's centre
     std::string names;
     bool split = false;
     for (size_t k = 0; k < bodies[p].size(); ++k) {
@@ -198,7 +199,6 @@ std::vector<FreeRigidMotion> free_rigid_motions(const Problem& problem, double r
       split = split || pieces_of_body[static_cast<size_t>(bodies[p][k])] > 1;
     }
     if (split) {
-      const Eigen::VectorXd c = 0.5 * (lo[p] + hi[p]);
       std::string at;
       for (int d = 0; d < dim; ++d) at += (d ? ", " : "") + format_number(std::round(c(d) * 1e6) / 1e6);
       names += " (its piece around (" + at + "), not connected to the rest of it)";
@@ -209,7 +209,6 @@ std::vector<FreeRigidMotion> free_rigid_motions(const Problem& problem, double r
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(ata[p]);
     const Eigen::VectorXd& ev = eig.eigenvalues();  // ascending
-    const Eigen::VectorXd c = 0.5 * (lo[p] + hi[p]);
     const double size = std::max((hi[p] - lo[p]).norm(), 1e-300);
     int free = 0;
     while (free < modes && ev(free) <= relative_tolerance * ev(modes - 1)) ++free;
