@@ -56,6 +56,8 @@ FomResult finish(const fom::Problem& problem, fom::FomSolution solution) {
   r.kkt = solution.kkt;  // the residuals its status was certified with
   r.contact_force = fom::contact_force(problem, solution.lambda);
   r.warnings = fom::solution_warnings(problem, solution.u);
+  r.problem_name = problem.name();
+  r.problem_fingerprint = problem.fingerprint();
   r.solution = std::move(solution);
   return r;
 }
@@ -314,6 +316,11 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
          const FomResult* reference, double degenerate_tol) {
         const fom::Param p = to_param(*problem, mu);
         check_sizes(*problem, u, lam);
+        if (reference && reference->problem_fingerprint != problem->fingerprint())
+          throw InputError("reference is a solution of problem " + quoted(reference->problem_name, 200) +
+                           " (fingerprint " + reference->problem_fingerprint + "), not of " +
+                           quoted(problem->name(), 200) + " (fingerprint " + problem->fingerprint() +
+                           "); expected a FomSolution of the same problem file and mesh");
         baselines::VerificationReport r;
         fom::ReferenceErrors errors;
         {

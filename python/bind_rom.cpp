@@ -34,8 +34,6 @@ rom::OffsetKind offset_kind(const py::object& offset_arg, const py::object& lift
 std::unique_ptr<ReducedModel> build_reduced_model(const Database& database, double delta, const std::string& method,
                                                   const py::dict& options, const py::object& offset,
                                                   bool include_failed, const py::object& lifting) {
-  if (!(delta >= 0.0 && delta <= 1.0))
-    throw InputError("delta = " + format_number(delta) + " is outside [0, 1]; expected a POD tolerance such as 1e-8");
   rom::check_online_method(method);
   std::map<std::string, std::string> values;
   for (const auto& [key, value] : options) values[py::str(key)] = option_text(value);

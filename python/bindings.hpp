@@ -62,6 +62,7 @@ struct FomResult {
   fom::KktResiduals kkt;
   double contact_force = 0.0;
   std::vector<std::string> warnings;  ///< fom::solution_warnings (elements turned inside out), as `fom --json`
+  std::string problem_name, problem_fingerprint;  ///< the problem it solves (verify refuses another's)
 };
 
 /// \brief The FOM solver of `FullOrderSolver`: the active-set solver or Ipopt.

@@ -35,15 +35,16 @@ Eigen::MatrixXd lifting_coordinates(const Eigen::MatrixXd& phi, const fom::Probl
   return out;
 }
 
-/// Refuses a database whose sizes are not the problem's, or a negative δ.
+/// Refuses a database whose sizes are not the problem's, or a δ outside [0, 1].
 void check_model_input(const fom::Problem& problem, const SnapshotDatabase& db, const ReducedModelOptions& options) {
   const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();
   if (db.num_dofs() != nd || db.num_constraints() != nc)
     throw InputError("database of problem " + quoted(db.problem.name, 200) + " has " + std::to_string(db.num_dofs()) + " dofs and " +
                      std::to_string(db.num_constraints()) + " contact rows, but " + problem.name() + " has " +
                      std::to_string(nd) + " and " + std::to_string(nc));
-  if (!(options.delta >= 0.0))
-    throw InputError("POD tolerance delta = " + std::to_string(options.delta) + " invalid; expected >= 0");
+  if (!(options.delta >= 0.0 && options.delta <= 1.0))
+    throw InputError("delta = " + format_number(options.delta) +
+                     " is outside [0, 1]; expected a POD tolerance such as 1e-8");
 }
 
 }  // namespace

@@ -131,8 +131,8 @@ void read_settings(hid_t f, const std::string& label, StoredModel& s) {
   s.method = hdf5::read_string_attribute(f, "method");
   ReducedModelOptions& o = s.data.options;
   o.delta = hdf5::read_double_attribute(f, "delta");
-  if (!(o.delta >= 0.0) || !std::isfinite(o.delta))
-    throw hdf5::Refused("attribute delta is " + format_number(o.delta) + ", expected a number >= 0");
+  if (!(o.delta >= 0.0 && o.delta <= 1.0))
+    throw hdf5::Refused("attribute delta is " + format_number(o.delta) + ", expected a number in [0, 1]");
   o.offset = read_offset_kind(f);
   o.include_failed_snapshots = hdf5::read_int_attribute(f, "include_failed_snapshots") != 0;
   const std::vector<std::string> keys = hdf5::read_string_list(f, "options/keys", hdf5::file_size(f));

@@ -56,6 +56,9 @@ def test_unknown_method_and_option(hertz_db_path):
     with pytest.raises(ValueError) as e:
         contactrom.ReducedModel(db, method="cpg", options={"nonsense": 1})
     assert message_of(e) == expected
+    for delta in (-1e-8, 1.5, float("nan")):
+        with pytest.raises(ValueError, match=r"delta = \S+ is outside \[0, 1\]; expected a POD tolerance such as 1e-8"):
+            contactrom.ReducedModel(db, delta=delta)
 
 
 def test_shape_errors_name_the_argument():

@@ -170,3 +170,25 @@ def test_solution_that_turns_elements_inside_out_is_warned_about(tmp_path):
         both = fom.solve_all([0.05, 1.2], threads=2)
     assert len(record) == 1
     assert both[0].warnings == [] and both[1].warnings == large.warnings
+
+
+def test_verify_refuses_a_reference_of_another_problem_of_the_same_sizes(tmp_path):
+    # The same mesh with a stiffer bottom block: the fields have the same sizes, so
+    # only the problem's fingerprint tells the two apart.
+    (tmp_path / "soft").mkdir()
+    (tmp_path / "stiff").mkdir()
+    soft = contactrom.Problem.from_file(blocks(tmp_path / "soft"))
+    stiff_path = blocks(tmp_path / "stiff")
+    with open(stiff_path) as f:
+        text = f.read()
+    with open(stiff_path, "w") as f:
+        f.write(text.replace("young = 1.0", "young = 3.0", 1))
+    stiff = contactrom.Problem.from_file(stiff_path)
+    assert (soft.num_dofs, soft.num_constraints) == (stiff.num_dofs, stiff.num_constraints)
+    a = contactrom.FullOrderSolver(soft).solve(0.05)
+    b = contactrom.FullOrderSolver(stiff).solve(0.05)
+    assert np.abs(a.u - b.u).max() > 1e-3  # the two answers do differ
+    with pytest.raises(ValueError, match=r"reference is a solution of problem 'blocks' \(fingerprint [0-9a-f]{16}\), "
+                                         r"not of 'blocks' \(fingerprint [0-9a-f]{16}\)"):
+        contactrom.verify(soft, 0.05, a.u, a.lam, reference=b)
+    assert contactrom.verify(soft, 0.05, a.u, a.lam, reference=a)["status"] == "success"
