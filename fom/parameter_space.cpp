@@ -62,6 +62,17 @@ std::string ParameterSpace::range_text() const {
   return out;
 }
 
+std::string ParameterSpace::text(const Param& mu) const {
+  const bool named = mu.size() == size();
+  std::string out = named ? "" : "mu = ";
+  for (Eigen::Index i = 0; i < mu.size(); ++i) {
+    if (i) out += ", ";
+    if (named) out += names[static_cast<size_t>(i)] + " = ";
+    out += format_number(mu(i));
+  }
+  return out;
+}
+
 Param ParameterSpace::parse(const std::string& text, const std::string& problem_name) const {
   const std::string expected = "; expected " + range_text();
   std::vector<std::string> items;

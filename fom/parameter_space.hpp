@@ -31,6 +31,9 @@ struct ParameterSpace {
   void check(const Param& mu, const std::string& problem_name) const;
   /// Human-readable ranges, e.g. "d in (0, 0.3]" or "d_x in [0, 4], d_y in [0.1, 0.3]".
   std::string range_text() const;
+  /// A parameter in messages, e.g. "d = 0.15" or "d_x = 2, d_y = 0.1" (mu of another
+  /// size: its values alone, "mu = 2, 0.1").
+  std::string text(const Param& mu) const;
   /// \brief Parses "V" or "V1,V2,..." (one value per parameter, in order) and checks the range:
   /// the one parser of parameter text (fom::parse_param, parse_problem_param).
   /// \throws InputError for an empty item, a non-number (trailing characters, NaN,

@@ -62,17 +62,10 @@ FomResult finish(const fom::Problem& problem, fom::FomSolution solution) {
   return r;
 }
 
-/// "mu = 0.05, 0.02": a parameter in messages.
-std::string param_text(const fom::Param& mu) {
-  std::string text = "mu = ";
-  for (Eigen::Index k = 0; k < mu.size(); ++k) text += (k ? ", " : "") + format_number(mu(k));
-  return text;
-}
-
 /// The warnings of one FOM solution at mu, each as a RuntimeWarning naming the problem and mu.
 void warn_solution(const fom::Problem& problem, const fom::Param& mu, const FomResult& r) {
   for (const std::string& w : r.warnings)
-    runtime_warning("FOM solution of " + quoted(problem.name(), 200) + " at " + param_text(mu) + ": " + w);
+    runtime_warning("FOM solution of " + quoted(problem.name(), 200) + " at " + problem.parameters().text(mu) + ": " + w);
 }
 
 /// `errors`: the errors against the reference by the rule of `online` (relative, or
@@ -304,7 +297,7 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
             if (warned > 0)
               runtime_warning(std::to_string(warned) + " of the " + std::to_string(out.size()) + " FOM solutions of " +
                               quoted(s.problem->name(), 200) + " carry warnings (FomSolution.warnings); the first, at " +
-                              param_text(ps[first]) + ": " + out[first].warnings.front());
+                              s.problem->parameters().text(ps[first]) + ": " + out[first].warnings.front());
             return out;
           },
           py::arg("params"), py::arg("threads") = 0,

@@ -56,16 +56,6 @@ struct OfflineArgs {
   std::map<std::string, std::string> adaptive_settings;
 };
 
-std::string param_text(const fom::Problem& problem, const fom::Param& mu) {
-  std::string out;
-  for (int k = 0; k < mu.size(); ++k) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%s%s=%.10g", k ? ", " : "", problem.param_names()[k].c_str(), mu(k));
-    out += buf;
-  }
-  return out;
-}
-
 /// The part "k/K" of the training set (rom::part_range), for splitting a run over jobs.
 std::vector<fom::Param> training_part(const std::vector<fom::Param>& params, const std::string& text) {
   int k = 0, parts = 0;
@@ -170,7 +160,7 @@ rom::AdaptiveOptions adaptive_options(const OfflineArgs& a, const rom::SnapshotD
 void report_round(const fom::Problem& problem, const rom::AdaptiveRound& r) {
   std::ostringstream line;
   line << std::setprecision(3) << "contactrom: adaptive round " << r.round << ": " << r.snapshots << " snapshots, "
-       << r.candidates << " candidates, max indicator " << r.max_indicator << " at " << param_text(problem, r.worst)
+       << r.candidates << " candidates, max indicator " << r.max_indicator << " at " << problem.parameters().text(r.worst)
        << ", mean " << r.mean_indicator;
   if (r.failed) line << ", " << r.failed << " without estimate";
   line << "; added " << r.added.size() << " (" << r.time_s << " s)";
@@ -334,7 +324,7 @@ int warn_failed_snapshots(const fom::Problem& problem, const rom::SnapshotDataba
   for (int j = 0; j < db.num_snapshots(); ++j) {
     if (db.status[j] == Status::Success) continue;
     ++failed;
-    std::cerr << "contactrom: warning: snapshot " << j << " (" << param_text(problem, db.parameter(j))
+    std::cerr << "contactrom: warning: snapshot " << j << " (" << problem.parameters().text(db.parameter(j))
               << ") status " << to_string(db.status[j]) << "; stored with its status and left out of the ROM\n";
   }
   return failed;

@@ -159,7 +159,7 @@ def test_solution_that_turns_elements_inside_out_is_warned_about(tmp_path):
         fom = contactrom.FullOrderSolver(problem)
         small = fom.solve(0.05)
     assert small.warnings == []
-    with pytest.warns(RuntimeWarning, match=r"FOM solution of 'blocks' at mu = 1\.2: the solution turns \d+ of the "
+    with pytest.warns(RuntimeWarning, match=r"FOM solution of 'blocks' at d = 1\.2: the solution turns \d+ of the "
                                             r"\d+ elements of body 'top' inside out") as record:
         large = fom.solve(1.2)
     assert len(record) == 2 and len(large.warnings) == 2
