@@ -556,10 +556,16 @@ void check_database(const SnapshotDatabase& db, const fom::Problem& problem, con
 void check_database_problem(const SnapshotDatabase& db, const fom::Problem& problem, const std::string& path) {
   if (db.problem.name != problem.name())
     throw InputError("database " + quoted(path, 200) + " was built for problem " + quoted(db.problem.name, 200) + ", not " + quoted(problem.name(), 200));
-  if (db.problem.fingerprint != problem.fingerprint())
+  if (db.problem.fingerprint != problem.fingerprint()) {
+    // The fingerprint hashes the problem file's text and the mesh: say which changed.
+    const bool text_changed = !db.problem.text.empty() && db.problem.text != problem.definition().text;
     throw InputError("database " + quoted(path, 200) + " was built for mesh fingerprint " + db.problem.fingerprint +
-                     " but the current " + problem.name() + " mesh is " + problem.fingerprint() +
-                     "; rebuild it with contactrom offline");
+                     " but the current " + problem.name() + " mesh is " + problem.fingerprint() + " (" +
+                     (text_changed ? "the problem file's text differs from the copy the database stores, comments and "
+                                     "spacing included"
+                                   : "the mesh differs: the .geo file, the refinement or gmsh's node order") +
+                     "); rebuild it with contactrom offline");
+  }
   if (db.num_dofs() != problem.num_dofs() || db.num_constraints() != problem.contact().num_constraints() ||
       db.parameters.rows() != problem.num_params())
     throw InputError("database " + quoted(path, 200) + " holds " + std::to_string(db.num_dofs()) + " dofs, " +

@@ -153,7 +153,7 @@ CommandRegistrar reg("bench", [](CLI::App& app) {
   sub->add_option("--problem", a->problem, "a shipped problem (contactrom problems) or a problem file path");
   sub->add_option("--db", a->db, "a snapshot database instead of --problem (no offline stage)");
   add_integer(sub, "--train", a->train, "training size (default: the problem file's [training] default_size; hertz 30)", 1, 10000000);
-  add_integer(sub, "--level", a->level, "training level (default: the problem file's default_size; ironing 7, ironing2 3)", 0, 20);
+  add_integer(sub, "--level", a->level, "training level (default: the problem file's default_size; ironing 7, ironing2 3)", 1, 20);
   add_integer(sub, "--refine", a->refine, "extra uniform mesh refinements (each splits every quad in four)", 0, 6);
   add_number(sub, "--delta", a->delta, "POD energy tolerance (default 1e-8)", Interval::closed(0, 1));
   add_integer(sub, "--repeats", a->repeats, "timing passes over the queries (default 3)", 1, 1000);

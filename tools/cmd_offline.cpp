@@ -407,7 +407,7 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
   auto* train = add_integer(sub, "--train", args->train,
                             "training size N, for problems with uniform or random training (hertz: d_i = 0.3 i/N)", 1, 10000000);
   auto* level = add_integer(sub, "--level", args->level,
-                            "training level n, for problems with nested training (ironing: 2^n+1 points)", 0, 20);
+                            "training level n, for problems with nested training (ironing: 2^n+1 points)", 1, 20);
   add_integer(sub, "--refine", args->refine, "extra uniform mesh refinements (each splits every quad in four)", 0, 6);
   train->excludes(level);
   auto* out = sub->add_option("--out", args->out, "output database (.h5)")->check(non_empty_path());

@@ -242,6 +242,13 @@ BOOST_AUTO_TEST_CASE(database_of_another_mesh_or_problem_is_refused) {
   BOOST_TEST_MESSAGE(msg);
   BOOST_TEST(msg.find("database 'db.h5' was built for mesh fingerprint ffffffffffffffff but the current hertz mesh is " +
                       hertz->fingerprint()) != std::string::npos);
+  BOOST_TEST(msg.find("(the mesh differs") != std::string::npos, msg);
+  // A database that stores its problem file: an edited file (here one comment more)
+  // is named as the cause, not the mesh.
+  SnapshotDatabase edited = other_mesh;
+  edited.problem.text = hertz->definition().text + "# a note\n";
+  const std::string msg3 = input_error_of([&] { contactrom::rom::check_database(edited, *hertz, "db.h5"); });
+  BOOST_TEST(msg3.find("(the problem file's text differs from the copy the database stores") != std::string::npos, msg3);
 
   SnapshotDatabase other_problem = db;
   other_problem.problem.name = "ironing";
