@@ -59,6 +59,7 @@ KktResiduals kkt_residuals(const Problem& problem, const Param& mu, const Eigen:
                            const Eigen::VectorXd& lambda) {
   check_displacement(problem, u, "u");
   check_pressure(problem, lambda, "lambda");
+  problem.check_param(mu);
   const ContactModel& contact = problem.contact();
   ConstraintMatrix c;
   const Eigen::VectorXd cv = constraint_values(problem, u, c);

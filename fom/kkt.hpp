@@ -35,6 +35,7 @@ struct KktResiduals {
 Eigen::VectorXd normal_gaps(const Problem& problem, const Eigen::VectorXd& u);
 
 /// \brief KKT residuals of (u, λ) at μ; `u` is the full displacement (lifting included).
+/// \throws InputError for a `u`, λ or μ of the wrong size, or a μ outside its range.
 KktResiduals kkt_residuals(const Problem& problem, const Param& mu, const Eigen::VectorXd& u,
                            const Eigen::VectorXd& lambda);
 

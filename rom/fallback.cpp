@@ -21,6 +21,12 @@ FallbackSolver::FallbackSolver(const OnlineSolver& rom, FallbackOptions options)
   positive("primal_tolerance", m_options.primal_tolerance);
   positive("dual_tolerance", m_options.dual_tolerance);
   positive("safety_factor", m_options.safety_factor);
+  // Without an indicator every answer would go to the FOM. (A problem whose
+  // estimates are NaN for another reason is allowed: the reason is each answer's.)
+  if (!rom.estimates_errors())
+    throw InputError("fallback: the " + rom.name() +
+                     " solver estimates no error (its option estimate is off), so every query would go to the FOM; "
+                     "expected a solver made with estimate on");
 }
 
 FallbackSolver::~FallbackSolver() = default;

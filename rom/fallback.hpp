@@ -54,6 +54,8 @@ class FallbackSolver {
  public:
   /// \param rom an online solver that estimates its errors (make_online_solver with
   ///   the `estimate` option on); it and its model must outlive this object.
+  /// \throws InputError for a solver with the estimate off, or a tolerance or safety
+  ///   factor that is not a finite number > 0.
   FallbackSolver(const OnlineSolver& rom, FallbackOptions options = {});
   ~FallbackSolver();
   /// Whether the ROM's answer `res` is kept (status success, finite estimates within

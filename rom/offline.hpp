@@ -51,8 +51,10 @@ struct OfflineOptions {
 /// file comment) and returns them as a database. Snapshots whose status is not
 /// Success are kept (with their status) — the caller reports them, and the reduced
 /// model leaves them out.
-/// \param training_kind "train" or "level", \param training_size n, recorded in the
-///   database so that `online` can rebuild the validation set.
+/// \param training_kind "train", "level", "list" or "adaptive" (InputError for another),
+///   \param training_size n, recorded in the database so that `online` can rebuild the
+///   validation set. An empty `params` gives a database of no snapshot (an MPI rank or a
+///   `--part` with no parameter of its own), which a reduced model refuses.
 SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vector<fom::Param>& params,
                                     const std::string& training_kind, int training_size,
                                     const OfflineOptions& options = {});

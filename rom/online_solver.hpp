@@ -118,6 +118,8 @@ class OnlineSolver {
   void set_error_indicator(std::shared_ptr<const ErrorIndicator> indicator, int pairings = 0) {
     m_indicator = std::move(indicator), m_estimate_pairings = pairings;
   }
+  /// Whether an error indicator is set (the `estimate` option on).
+  bool estimates_errors() const { return m_indicator != nullptr; }
   /// Sets the tolerances of the contact check.
   void set_contact_tolerances(const fom::ContactTolerances& tolerances) { m_tolerances = tolerances, m_tolerances_set = true; }
 

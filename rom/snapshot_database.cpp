@@ -368,7 +368,14 @@ void remove_primal_files(const SnapshotDatabase& db) {
   for (const std::string& path : db.primal_files) std::remove(path.c_str());
 }
 
+bool is_training_kind(const std::string& kind) {
+  return kind == "train" || kind == "level" || kind == "list" || kind == "adaptive";
+}
+
 void write_database(const std::string& path, const SnapshotDatabase& db) {
+  if (!is_training_kind(db.training_kind))
+    throw InputError("training kind " + quoted(db.training_kind, 200) +
+                     " unknown; expected 'train', 'level', 'list' or 'adaptive' (what read_database accepts)");
   const hsize_t n = static_cast<hsize_t>(db.num_snapshots());
   const hsize_t stored = db.primal_in_memory() ? static_cast<hsize_t>(db.primal.cols()) : db.primal_refs.size();
   if (db.dual.cols() != db.parameters.cols() || stored != n || db.status.size() != n || db.iterations.size() != n ||
@@ -529,8 +536,7 @@ SnapshotDatabase read_database(const std::string& path, bool load_primal) {
     if (db.parameters.rows() != static_cast<Eigen::Index>(db.problem.param_names.size()))
       throw hdf5::Refused("dataset /parameters has " + std::to_string(db.parameters.rows()) +
                         " columns but param_names lists " + std::to_string(db.problem.param_names.size()));
-    if (db.training_kind != "train" && db.training_kind != "level" && db.training_kind != "list" &&
-        db.training_kind != "adaptive")
+    if (!is_training_kind(db.training_kind))
       throw hdf5::Refused("attribute training_kind is " + quoted(db.training_kind, 200) +
                           ", expected 'train', 'level', 'list' or 'adaptive'");
     if (db.training_kind == "adaptive") db.adaptive = read_adaptive(f);

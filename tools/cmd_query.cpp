@@ -7,8 +7,10 @@
 // tolerances is answered by the FOM, built from the file's problem and mesh
 // (rom/fallback.hpp); the output says which answers came from where.
 #include <chrono>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include <contactrom/core/atomic_file.hpp>
@@ -26,6 +28,7 @@ namespace {
 struct QueryArgs {
   std::string rom, param, params, out, fields, fallback = "none";
   double primal_tolerance = rom::FallbackOptions().primal_tolerance, dual_tolerance = rom::FallbackOptions().dual_tolerance;
+  bool tolerance_given = false;  // --primal-tolerance or --dual-tolerance
   bool json = false;
 };
 
@@ -52,6 +55,13 @@ nlohmann::json result_json(const rom::OnlineModel& rom, const rom::OnlineResult&
 
 void run_query(const QueryArgs& a) {
   if (a.param.empty() == a.params.empty()) throw InputError("give exactly one of --param V and --params FILE.csv");
+  const bool use_fom = a.fallback == "fom";
+  if (a.tolerance_given && !use_fom)
+    throw InputError("--primal-tolerance and --dual-tolerance apply to --fallback fom only");
+  if (!a.out.empty() && !a.fields.empty() && std::filesystem::path(a.out).lexically_normal() ==
+                                                 std::filesystem::path(a.fields).lexically_normal())
+    throw InputError("--out and --fields name the same path " + quoted(a.out, 200) +
+                     "; expected a CSV file and a folder of fields");
   declare_input_files({a.rom, a.params});
   if (!a.out.empty()) check_output_path(a.out);
   const auto t0 = std::chrono::steady_clock::now();
@@ -64,8 +74,8 @@ void run_query(const QueryArgs& a) {
   rom::FallbackOptions fallback_options;
   fallback_options.primal_tolerance = a.primal_tolerance;
   fallback_options.dual_tolerance = a.dual_tolerance;
-  const rom::FallbackSolver fallback(rom.solver(), fallback_options);
-  const bool use_fom = a.fallback == "fom";
+  std::optional<rom::FallbackSolver> fallback;
+  if (use_fom) fallback.emplace(rom.solver(), fallback_options);
   std::vector<rom::OnlineResult> results;
   std::vector<rom::FallbackAnswer> answers;
   std::vector<std::string> sources;
@@ -73,7 +83,7 @@ void run_query(const QueryArgs& a) {
   int failed = 0, from_fom = 0;
   for (const fom::Param& mu : params) {
     if (use_fom) {
-      answers.push_back(fallback.solve(mu));
+      answers.push_back(fallback->solve(mu));
       results.push_back(answers.back().result);
       sources.push_back(answers.back().from_fom ? "fom" : "rom");
       from_fom += answers.back().from_fom ? 1 : 0;
@@ -109,7 +119,7 @@ void run_query(const QueryArgs& a) {
   j["mean_time_s"] = mean_time;
   if (use_fom) {
     j["fallbacks"] = from_fom;
-    j["fom_setup_time_s"] = fallback.fom_setup_time();
+    j["fom_setup_time_s"] = fallback->fom_setup_time();
   }
   j["queries"] = nlohmann::json::array();
   for (size_t i = 0; i < results.size(); ++i) {
@@ -168,14 +178,17 @@ CommandRegistrar reg("query", [](CLI::App& app) {
                   "fom: answer by the FOM a query whose reduced answer is not success or whose error estimates (x 3) "
                   "exceed the tolerances; none (default): the reduced answer always")
       ->check(CLI::IsMember({"none", "fom"}));
-  add_number(sub, "--primal-tolerance", args->primal_tolerance,
+  auto* primal = add_number(sub, "--primal-tolerance", args->primal_tolerance,
              "--fallback fom: largest relative H1 error of an answer kept from the ROM (default 0.05)",
              Interval::greater_than(0));
-  add_number(sub, "--dual-tolerance", args->dual_tolerance,
+  auto* dual = add_number(sub, "--dual-tolerance", args->dual_tolerance,
              "--fallback fom: largest relative L2 pressure error of an answer kept from the ROM (default 0.2)",
              Interval::greater_than(0));
   sub->add_flag("--json", args->json, "print one JSON object");
-  sub->callback([args] { run_query(*args); });
+  sub->callback([args, primal, dual] {
+    args->tolerance_given = primal->count() > 0 || dual->count() > 0;
+    run_query(*args);
+  });
 });
 
 }  // namespace

@@ -53,4 +53,14 @@ BOOST_AUTO_TEST_CASE(fallback_answers_are_labelled_and_timed) {
   for (const auto& q : k["queries"]) BOOST_TEST(q["source"].get<std::string>() == "rom");
   // A bad choice is an input error.
   BOOST_TEST(run_command(kExe + " query --rom " + rom + " --param 0.1 --fallback ipopt").exit_code != 0);
+  // Tolerances without --fallback fom would be ignored: refused instead.
+  const auto ignored = run_command(kExe + " query --rom " + rom + " --param 0.1 --primal-tolerance 0.01");
+  BOOST_TEST(ignored.exit_code == 2);
+  BOOST_TEST(ignored.err.find("apply to --fallback fom only") != std::string::npos, ignored.err);
+  // --out and --fields on one path: refused by name, and nothing is created there.
+  const std::string same = dir + "/same";
+  const auto clash = run_command(kExe + " query --rom " + rom + " --param 0.1 --out " + same + " --fields " + same);
+  BOOST_TEST(clash.exit_code == 2);
+  BOOST_TEST(clash.err.find("--out and --fields name the same path") != std::string::npos, clash.err);
+  BOOST_TEST(!std::ifstream(same).good());
 }

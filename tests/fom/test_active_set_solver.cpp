@@ -335,3 +335,18 @@ BOOST_AUTO_TEST_CASE(condensation_matches_dense_inverse_columns) {
     }
   }
 }
+
+BOOST_AUTO_TEST_CASE(kkt_residuals_refuse_a_parameter_of_the_wrong_size_or_range) {
+  // A μ of another size gave residuals of fewer load terms, with no error.
+  const ActiveSetSolver& solver = fixture().solver("ironing2");
+  const Problem& p = solver.problem();
+  Param mu(2);
+  mu << 2.0, 0.2;
+  const FomSolution s = solver.solve(mu);
+  BOOST_TEST_REQUIRE(s.status == Status::Success);
+  BOOST_TEST(kkt_residuals(p, mu, s.u, s.lambda).max() <= 1e-10);
+  Param nan_mu = mu;
+  nan_mu(1) = std::nan("");
+  for (const Param& bad : {Param(Param::Zero(0)), Param(Param::Constant(1, 2.0)), Param(Param::Constant(3, 0.2)), nan_mu})
+    BOOST_CHECK_THROW(kkt_residuals(p, bad, s.u, s.lambda), InputError);
+}

@@ -30,7 +30,7 @@ struct Hertz {
   rom::SnapshotDatabase snapshots(const std::vector<fom::Param>& params) const {
     rom::OfflineOptions options;
     options.threads = 2;
-    return rom::generate_snapshots(*problem, params, "uniform", static_cast<int>(params.size()), options);
+    return rom::generate_snapshots(*problem, params, "train", static_cast<int>(params.size()), options);
   }
 };
 

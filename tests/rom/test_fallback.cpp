@@ -4,7 +4,10 @@
 #define BOOST_TEST_MODULE rom_fallback
 #include <boost/test/unit_test.hpp>
 
+#include <fstream>
+#include <limits>
 #include <memory>
+#include <string>
 
 #include <contactrom/fom/active_set_solver.hpp>
 #include <contactrom/fom/kkt.hpp>
@@ -13,6 +16,7 @@
 #include <contactrom/rom/offline.hpp>
 #include <contactrom/rom/online_methods.hpp>
 #include <contactrom/rom/reduced_model.hpp>
+#include <contactrom/rom/snapshot_database.hpp>
 
 using namespace contactrom;
 
@@ -23,7 +27,7 @@ fom::Param param(double d) { return fom::Param::Constant(1, d); }
 BOOST_AUTO_TEST_CASE(fom_answers_where_the_rom_cannot_and_rom_where_it_can) {
   const auto problem = fom::make_problem("hertz");
   const std::vector<fom::Param> train{param(0.02), param(0.03), param(0.04), param(0.05)};
-  const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, train, "uniform", 4, {});
+  const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, train, "train", 4, {});
   const rom::ReducedModel model(*problem, db);
   const auto solver = rom::make_online_solver("greedy", model);
   const rom::FallbackSolver fallback(*solver);
@@ -56,11 +60,31 @@ BOOST_AUTO_TEST_CASE(fom_answers_where_the_rom_cannot_and_rom_where_it_can) {
   BOOST_TEST(picky.solve(param(0.035)).from_fom);
 }
 
-BOOST_AUTO_TEST_CASE(an_answer_without_estimates_is_not_kept) {
+BOOST_AUTO_TEST_CASE(a_solver_without_estimates_is_refused) {
+  // With the estimate off every query would go to the FOM: refused when built.
   const auto problem = fom::make_problem("hertz");
   const rom::SnapshotDatabase db = rom::generate_snapshots(*problem, 12, {});
   const rom::ReducedModel model(*problem, db);
   const auto solver = rom::make_online_solver("greedy", model, rom::options_from_map("greedy", {{"estimate", "false"}}));
-  const rom::FallbackSolver fallback(*solver);
-  BOOST_TEST(fallback.solve(param(0.1)).from_fom);
+  BOOST_CHECK_EXCEPTION(rom::FallbackSolver fallback(*solver), InputError, [](const InputError& e) {
+    return std::string(e.what()).find("estimates no error (its option estimate is off)") != std::string::npos;
+  });
+  // An answer whose estimates are NaN is not kept (as with a parameter-dependent stiffness).
+  const auto estimating = rom::make_online_solver("greedy", model);
+  const rom::FallbackSolver fallback(*estimating);
+  rom::OnlineResult res = estimating->solve(param(0.1));
+  std::string reason;
+  BOOST_TEST(fallback.keeps(res, reason));
+  res.dual_estimate = std::numeric_limits<double>::quiet_NaN();
+  BOOST_TEST(!fallback.keeps(res, reason));
+  BOOST_TEST(reason.find("no error estimate") == 0u, reason);
+}
+
+BOOST_AUTO_TEST_CASE(a_training_kind_the_reader_refuses_is_refused) {
+  const auto problem = fom::make_problem("hertz");
+  BOOST_CHECK_THROW(rom::generate_snapshots(*problem, {param(0.1)}, "uniform", 1), InputError);
+  rom::SnapshotDatabase db = rom::generate_snapshots(*problem, {param(0.1)}, "train", 1);
+  db.training_kind = "foo";
+  BOOST_CHECK_THROW(rom::write_database("never_written.h5", db), InputError);
+  BOOST_TEST(!std::ifstream("never_written.h5").good());
 }
