@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 
 #include <contactrom/core/errors.hpp>
 #include <contactrom/core/format.hpp>
@@ -185,8 +187,39 @@ std::vector<std::string> solution_warnings(const Problem& problem, const Eigen::
   return out;
 }
 
+namespace {
+
+/// A default U (no `displacement_scale` in the file) far above some prescribed
+/// displacement: the largest is likely a slide, and the residuals and statuses
+/// relative to it are then too lenient for the indentation. Empty otherwise.
+std::string default_scale_warning(const Problem& problem) {
+  const ProblemDefinition& def = problem.definition();
+  if (def.displacement_scale > 0.0) return "";
+  double largest = 0.0, smallest = std::numeric_limits<double>::infinity();
+  std::string where;
+  for (const DirichletSpec& d : def.dirichlet)
+    for (size_t k = 0; k < d.displacement.size(); ++k) {
+      if (!d.displacement[k]) continue;
+      const double v = std::max(std::abs(d.displacement[k]->min_over(def.parameters)),
+                                std::abs(d.displacement[k]->max_over(def.parameters)));
+      if (!(v > 0.0)) continue;  // a fixed component is no displacement scale
+      smallest = std::min(smallest, v);
+      if (v > largest) largest = v, where = "group " + quoted(d.group, 200) + ", component " + "xyz"[k];
+    }
+  constexpr double kRatio = 5.0;
+  if (!(largest >= kRatio * smallest)) return "";
+  return "displacement_scale is not set, so U = " + format_number(largest) +
+         ", the largest prescribed displacement (" + where + "), " + format_number(std::round(10.0 * largest / smallest) / 10.0) +
+         " times the smallest nonzero one (" + format_number(smallest) +
+         "); penetration, complementarity and the reduced answers' statuses are relative to U, so a slide makes them "
+         "lenient: expected displacement_scale set to the indentation in the problem file";
+}
+
+}  // namespace
+
 std::vector<std::string> reference_contact_warnings(const Problem& problem) {
   std::vector<std::string> out;
+  if (std::string w = default_scale_warning(problem); !w.empty()) out.push_back(std::move(w));
   const std::vector<PairAtRest> pairs = pairs_at_rest(problem);
   const double u = problem.displacement_scale();
   for (size_t q = 0; q < pairs.size(); ++q) {

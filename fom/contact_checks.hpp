@@ -21,7 +21,10 @@ constexpr double kReferenceOverlapFraction = 0.1;
 /// configuration: a pair whose paired slave nodes penetrate their master by more
 /// than kReferenceOverlapFraction·U (naming the largest overlap), and slave nodes
 /// that project beyond an end of their master curve (an edge of their master
-/// surface) while lying within its mean segment (facet edge) length of it (never paired). Empty for the rope and for problems without those.
+/// surface) while lying within its mean segment (facet edge) length of it (never paired);
+/// and, first, a default displacement scale U (no `displacement_scale` in the problem
+/// file) at least 5 times some other nonzero prescribed displacement (a slide sets U,
+/// not the indentation). Empty for the rope and for problems without those.
 std::vector<std::string> reference_contact_warnings(const Problem& problem);
 
 /// \brief One-line warnings about a solution `u` (all dofs) of `problem`, per body:

@@ -434,3 +434,26 @@ BOOST_AUTO_TEST_CASE(a_loose_piece_of_a_body_is_named_by_where_it_is) {
              msg);
   fs::remove_all(dir);
 }
+
+BOOST_AUTO_TEST_CASE(a_default_displacement_scale_set_by_a_slide_is_warned_about) {
+  // The top block slid by 0.6 and pressed by d ≤ 0.1 with no displacement_scale: U
+  // defaults to the slide, six times the indentation, and the problem says so.
+  const std::string dir = contactrom::test::temp_dir();
+  const std::string geo = write_file(dir, "s.geo", shifted_blocks_geo(1.0, 0.0, 0.5));
+  const auto without_scale = [](std::string text) {
+    const std::string line = "displacement_scale = 0.1\n";
+    return text.erase(text.find(line), line.size());
+  };
+  const auto slid = fom::make_problem(write_file(dir, "slid.toml", without_scale(blocks_toml(geo, "[0.0, 0.1]", "0.6"))));
+  BOOST_TEST(slid->displacement_scale() == 0.6);
+  const auto w = fom::reference_contact_warnings(*slid);
+  BOOST_TEST_REQUIRE(w.size() == 1u);
+  BOOST_TEST(w[0].find("displacement_scale is not set, so U = 0.6, the largest prescribed displacement (group "
+                       "'top_top', component x), 6 times the smallest nonzero one (0.1)") == 0u, w[0]);
+  // Pressed only, or with the scale set: nothing to say.
+  BOOST_TEST(fom::reference_contact_warnings(
+                 *fom::make_problem(write_file(dir, "pressed.toml", without_scale(blocks_toml(geo, "[0.0, 0.1]")))))
+                 .empty());
+  BOOST_TEST(fom::reference_contact_warnings(*fom::make_problem(write_file(dir, "set.toml", blocks_toml(geo, "[0.0, 0.1]", "0.6"))))
+                 .empty());
+}
