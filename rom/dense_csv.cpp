@@ -44,7 +44,8 @@ double parse_value(const std::string& field, const std::string& name, std::size_
 
 }  // namespace
 
-Eigen::MatrixXd read_dense_csv(std::istream& in, const std::string& name) {
+Eigen::MatrixXd read_dense_csv(std::istream& in, const std::string& name, std::vector<std::size_t>* row_lines) {
+  if (row_lines) row_lines->clear();
   std::vector<double> values;
   std::size_t columns = 0;
   std::size_t rows = 0;
@@ -86,9 +87,10 @@ Eigen::MatrixXd read_dense_csv(std::istream& in, const std::string& name) {
                        std::to_string(first_data_line) + ")");
     }
     ++rows;
+    if (row_lines) row_lines->push_back(line_number);
   }
   if (in.bad()) throw InputError(name + ": read error");
-  if (rows == 0) throw InputError(name + ": no values (empty file), expected at least one row of numbers");
+  if (rows == 0) throw InputError(name + ": no values (nothing but blank lines, comments or a header), expected at least one row of numbers");
   Eigen::MatrixXd matrix(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(columns));
   for (std::size_t i = 0; i < rows; ++i) {
     for (std::size_t j = 0; j < columns; ++j) {

@@ -15,6 +15,7 @@
 #include <Eigen/Dense>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 namespace contactrom::rom {
 
@@ -27,8 +28,8 @@ namespace contactrom::rom {
 Eigen::MatrixXd read_dense_csv(const std::string& path);
 
 /// \brief Parses CSV text from a stream; `name` is used in error messages in place
-/// of a file name.
-Eigen::MatrixXd read_dense_csv(std::istream& in, const std::string& name);
+/// of a file name. `row_lines` (optional) receives the line number of every row.
+Eigen::MatrixXd read_dense_csv(std::istream& in, const std::string& name, std::vector<std::size_t>* row_lines = nullptr);
 
 /// \brief Reads a vector from a CSV file holding either one column (one value per
 /// line) or one row.

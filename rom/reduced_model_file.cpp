@@ -342,7 +342,8 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
     break;
   }
   std::istringstream lines(all);
-  const Eigen::MatrixXd values = read_dense_csv(lines, "parameter file " + quoted(path, 200));
+  std::vector<std::size_t> row_lines;
+  const Eigen::MatrixXd values = read_dense_csv(lines, "parameter file " + quoted(path, 200), &row_lines);
   if (values.cols() != problem.num_params())
     throw InputError("parameter file " + quoted(path, 200) + " has " + std::to_string(values.cols()) + " values per line, but " +
                      problem.name() + " has " + std::to_string(problem.num_params()) + " parameters (" + header + ")");
@@ -352,7 +353,8 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
     try {
       problem.check_param(mu);
     } catch (const InputError& e) {
-      throw InputError("parameter file " + quoted(path, 200) + " data row " + std::to_string(i + 1) + ": " + e.what());
+      throw InputError("parameter file " + quoted(path, 200) + " line " + std::to_string(row_lines[static_cast<size_t>(i)]) +
+                       ": " + e.what());
     }
     out.push_back(mu);
   }

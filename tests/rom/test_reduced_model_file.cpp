@@ -446,10 +446,11 @@ BOOST_AUTO_TEST_CASE(parameter_csv_is_checked_row_by_row) {
   BOOST_TEST(params[1](0) == 0.2);
   {
     std::ofstream f(path);
-    f << "0.1\n0.4\n";
+    f << "d\n0.1\n# comment\n\n0.4\n";
   }
+  // The line of the value, counting the header, comments and blank lines.
   const std::string e = one_line_error([&] { contactrom::rom::read_parameter_csv(path, *hertz()); });
-  BOOST_TEST(e.find("data row 2") != std::string::npos, e);
+  BOOST_TEST(e.find("line 5: parameter d = 0.4 is outside") != std::string::npos, e);
   {
     std::ofstream f(path);
     f << "0.1,0.2\n";

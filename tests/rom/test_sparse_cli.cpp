@@ -160,7 +160,7 @@ BOOST_AUTO_TEST_CASE(csv_reader_errors_name_file_line_and_column) {
   BOOST_TEST(message_of("1,,2\n") == "m.csv: line 1, column 2: empty value, expected a number");
   BOOST_TEST(message_of("1,nan\n") == "m.csv: line 1, column 2: 'nan' is not a finite number");
   BOOST_TEST(message_of("1,2x\n") == "m.csv: line 1, column 2: '2x' is not a number");
-  BOOST_TEST(message_of("\n# only a comment\n").find("m.csv: no values (empty file)") == 0u);
+  BOOST_TEST(message_of("\n# only a comment\n").find("m.csv: no values (nothing but blank lines, comments or a header)") == 0u);
 }
 
 BOOST_AUTO_TEST_CASE(vector_reader_takes_a_row_or_a_column_only) {
@@ -274,7 +274,7 @@ BOOST_AUTO_TEST_CASE(bad_input_gives_a_one_line_error_and_exit_code_2) {
       {sparse_args("omp", dir.file("text.csv"), x), "text.csv: line 2, column 2: 'five' is not a number"},
       {sparse_args("nnls", d, dir.file("x3.csv")), "has 3 values, expected 2 (the rows of dictionary"},
       {sparse_args("lasso", d, x), "unknown --method 'lasso': expected nnls, omp, focuss or nnfocuss"},
-      {sparse_args("nnls", dir.file("empty.csv"), x), "empty.csv: no values (empty file)"},
+      {sparse_args("nnls", dir.file("empty.csv"), x), "empty.csv: no values (nothing but blank lines, comments or a header)"},
       {sparse_args("nnls", d, x, "--atoms 2"), "--atoms applies to --method omp only"},
       {"bench-sparse --repeats 0", "--repeats '0' is outside the range; expected an integer in [1, 1000]"},
   };
