@@ -224,7 +224,7 @@ void print_adaptive_summary(const OfflineArgs& a, const fom::Problem& problem, c
     return;
   }
   std::cout << std::setprecision(3) << "offline " << problem.name() << " adaptive: " << db.num_snapshots()
-            << " snapshots in " << rec.num_rounds() << " rounds, max indicator (" << settings.indicator << ") " << worst
+            << " snapshots in " << rec.num_rounds() << (rec.num_rounds() == 1 ? " round" : " rounds") << ", max indicator (" << settings.indicator << ") " << worst
             << (converged ? " < " : " >= ") << settings.tolerance << (converged ? "" : " (not reached)") << "\n"
             << "wall time " << db.wall_time_s << " s\n"
             << (appending ? "appended to " : "database written to ") << out << "\n";
@@ -242,6 +242,14 @@ void run_adaptive(const OfflineArgs& a) {
   rom::AdaptiveOptions options = adaptive_options(a, appending ? &existing : nullptr);
   if (!appending && !a.adaptive_settings.count("tolerance"))
     throw InputError("offline --adaptive needs --tolerance EPS (e.g. 0.05)");
+  if (options.model.delta >= 1.0 && ranks.root())
+    std::cerr << "contactrom: warning: delta " << format_number(options.model.delta)
+              << " keeps no POD mode (primal rank 0); every round's reduced solution is the offset alone and no contact "
+                 "can be enforced; expected a delta well below 1 (paper: 1e-6 to 1e-10)\n";
+  if (appending && options.max_snapshots <= existing.num_snapshots() && ranks.root())
+    std::cerr << "contactrom: warning: " << quoted(a.append, 200) << " holds " << existing.num_snapshots()
+              << " snapshots already, at least --max-snapshots " << options.max_snapshots
+              << ": no round adds any; expected a larger --max-snapshots\n";
   distribute_over_ranks(options, ranks);
   options.on_round = [&](const rom::AdaptiveRound& r, const rom::SnapshotDatabase& db) {
     // atomically, on rank 0: the file always holds whole rounds
@@ -282,6 +290,9 @@ OfflinePlan plan_offline(const OfflineArgs& a, const fom::Problem& problem) {
                         : fom::resolve_training_size(sampling, problem.name(), a.train, a.level, false);
   plan.training = fom::training_set(problem, plan.n);
   plan.params = a.part.empty() ? plan.training : training_part(plan.training, a.part);
+  if (!a.part.empty() && plan.params.empty() && current_ranks().root())
+    std::cerr << "contactrom: warning: part " << a.part << " of the " << plan.training.size()
+              << " training parameters holds none (more parts than parameters); its database holds no snapshot\n";
   if (plan.appending) {
     rom::check_appendable(plan.existing, a.append, problem, sampling.selector(), plan.n);
     plan.params = rom::parameters_not_in(plan.existing, plan.params);

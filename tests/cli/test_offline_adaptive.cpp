@@ -3,6 +3,7 @@
 // --params` on it, and bad settings refused with exit code 2 and one line.
 #define BOOST_TEST_MODULE cli_offline_adaptive
 #include <boost/test/unit_test.hpp>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -63,6 +64,13 @@ BOOST_AUTO_TEST_CASE(append_continues_a_stopped_run_to_the_database_of_one_run) 
   const auto no_set = run_command(kExe + " online --db " + dir + "/whole.h5 --validation");
   BOOST_TEST(no_set.exit_code == 2);
   BOOST_TEST(no_set.err.find("--params") != std::string::npos, no_set.err);
+
+  // Continuing a run that already holds --max-snapshots says that no round adds any.
+  std::filesystem::copy_file(dir + "/whole.h5", dir + "/full.h5");
+  const auto full = run_command(kExe + " offline --problem hertz --adaptive --max-snapshots 8 --append " + dir + "/full.h5");
+  BOOST_REQUIRE_MESSAGE(full.exit_code == 0, full.err);
+  BOOST_TEST(full.err.find("holds 8 snapshots already, at least --max-snapshots 8: no round adds any") != std::string::npos,
+             full.err);
 }
 
 BOOST_AUTO_TEST_CASE(bad_settings_exit_2_with_one_line) {
