@@ -182,6 +182,7 @@ EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<
     if (ref.status != Status::Success) ++s.fom_failures;
     times.push_back(row.time_s);
     s.rows.push_back(std::move(row));
+    if (options.progress) options.progress(static_cast<int>(i) + 1, static_cast<int>(params.size()));
   }
   const double n = std::max<double>(1.0, static_cast<double>(params.size()));
   s.mean_sparsity /= n;

@@ -57,6 +57,7 @@ struct EvaluationRow {
 /// \brief Settings of evaluate_online.
 struct EvaluationOptions {
   bool kkt = false;  ///< compute the FOM KKT residuals of every ROM solution. Default false.
+  ProgressCallback progress;  ///< called after every query (optional)
 };
 
 /// \brief Means and maxima of errors against the FOM, by the rule of

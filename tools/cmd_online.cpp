@@ -10,6 +10,8 @@
 //    validation set by the parameters listed in FILE (one per line, --param order).
 //  - --param V: one query, compared with the FOM; --out DIR writes
 //    DIR/<problem>_<method>.vtu and DIR/<problem>_<method>_surface.csv.
+#include <unistd.h>
+
 #include <algorithm>
 #include <iomanip>
 #include <iostream>
@@ -36,7 +38,7 @@ namespace {
 struct OnlineArgs : MethodArgs {
   std::string db, param, params, out;
   int threads = 0;
-  bool validation = false, json = false, kkt = false;
+  bool validation = false, json = false, kkt = false, progress = false;
 };
 
 nlohmann::json selected_json(const std::vector<int>& selected) { return selected; }
@@ -105,10 +107,20 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
   const std::vector<fom::Param> params =
       a.params.empty() ? rom::database_validation_set(db, problem) : rom::read_parameter_csv(a.params, problem);
   const fom::ActiveSetSolver fom_solver(problem);
-  const std::vector<fom::FomSolution> refs = rom::compute_references(fom_solver, params, a.threads);
+  // Two stages on stderr: the FOM references (in parallel), then the reduced queries.
+  const bool show = a.progress || ::isatty(STDERR_FILENO);
+  std::vector<fom::FomSolution> refs;
+  {
+    ProgressBar bar(std::cerr, "online: FOM references", show);
+    refs = rom::compute_references(fom_solver, params, a.threads, [&bar](int done, int total) { bar.update(done, total); });
+    bar.finish();
+  }
   rom::EvaluationOptions options;
   options.kkt = a.kkt;
+  ProgressBar bar(std::cerr, "online: reduced queries", show);
+  options.progress = [&bar](int done, int total) { bar.update(done, total); };
   const rom::EvaluationSummary s = rom::evaluate_online(solver, params, refs, options);
+  bar.finish();
   if (!a.out.empty()) rom::write_evaluation_csv(a.out, problem, s);
 
   nlohmann::json j;
@@ -184,6 +196,8 @@ CommandRegistrar reg("online", [](CLI::App& app) {
       ->check(non_empty_path());
   add_threads(sub, args->threads, "threads for the FOM references");
   sub->add_flag("--kkt", args->kkt, "also compute the FOM KKT residuals of every ROM solution");
+  sub->add_flag("--progress", args->progress,
+                "validation: draw the progress bars (FOM references, reduced queries) even when stderr is not a terminal");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_online(*args); });
 });
