@@ -41,10 +41,13 @@ BOOST_AUTO_TEST_CASE(parameter_list_rows_equal_single_queries) {
     for (const std::string& p : points) f << p << "\n";
   }
   const auto r = run_command(kExe + " online --db " + db + " --method greedy --validation --params " + list +
-                             " --out " + out + " --json");
+                             " --out " + out + " --json --progress");
   BOOST_REQUIRE_MESSAGE(r.exit_code == 0, r.err);
   const auto j = nlohmann::json::parse(r.out);
   BOOST_TEST(j["validation_size"].get<int>() == 3);
+  // --progress: both stages drawn to the end on stderr, stdout only the JSON.
+  BOOST_TEST(r.err.find("online: FOM references") != std::string::npos, r.err);
+  BOOST_TEST(r.err.find("online: reduced queries [##############################] 3/3") != std::string::npos, r.err);
   const auto rows = csv_rows(out);
   BOOST_REQUIRE(rows.size() == 4u);
   for (size_t i = 0; i < points.size(); ++i) {
