@@ -37,6 +37,11 @@ std::string join(const std::vector<std::string>& items, const std::string& separ
   return out;
 }
 
+std::string join_or(const std::vector<std::string>& items) {
+  if (items.size() < 2) return join(items);
+  return join(std::vector<std::string>(items.begin(), items.end() - 1)) + " or " + items.back();
+}
+
 std::string quoted(const std::string& text, std::size_t max_length) {
   std::string out = "'";
   const size_t shown = std::min(text.size(), max_length);

@@ -16,6 +16,9 @@ std::string format_number(double value);
 /// \brief `items` separated by `separator` (default ", "): {"a", "b"} → "a, b".
 std::string join(const std::vector<std::string>& items, const std::string& separator = ", ");
 
+/// \brief The choices of a message: {"a", "b", "c"} → "a, b or c".
+std::string join_or(const std::vector<std::string>& items);
+
 /// \brief `text` between single quotes, fit for a one-line message: control
 /// bytes are written as `\xNN`, and text beyond `max_length` bytes is cut
 /// and marked with "... (N bytes)".

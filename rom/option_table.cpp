@@ -22,10 +22,7 @@ std::string describe_option_type(const OptionSpec& spec) {
       if (r.upper >= 1e9) return "an integer >= " + whole(r.lower);
       return "an integer in [" + whole(r.lower) + ", " + whole(r.upper) + "]";
     }
-    case OptionType::Choice: {  // "a, b or c", as the methods' own messages say
-      std::vector<std::string> head(spec.choices.begin(), spec.choices.end() - (spec.choices.empty() ? 0 : 1));
-      return head.empty() ? join(spec.choices, "") : join(head, ", ") + " or " + spec.choices.back();
-    }
+    case OptionType::Choice: return join_or(spec.choices);  // "a, b or c", as the methods' own messages say
     case OptionType::Flag: return "true or false (1 or 0)";
     case OptionType::Text: return "a non-empty word";
   }

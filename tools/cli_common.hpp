@@ -9,6 +9,8 @@
 #include <variant>
 
 #include <contactrom/core/atomic_file.hpp>
+#include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
 #include <contactrom/core/parallel_for.hpp>
 #include <contactrom/fom/input_values.hpp>
 #include <contactrom/fom/kkt.hpp>
@@ -44,6 +46,22 @@ CLI::Option* add_integer(CLI::App* sub, const std::string& name, Int& target, co
       ->type_name("INT");
 }
 
+/// Adds an option that takes one of `choices` (`names`: "--name" or "--name,--alias");
+/// another word ends the run with one line naming the option and the choices.
+inline CLI::Option* add_word(CLI::App* sub, const std::string& names, std::string& target, const std::string& help,
+                             const std::vector<std::string>& choices) {
+  const std::string name = names.substr(0, names.find(','));
+  return sub->add_option_function<std::string>(
+                names,
+                [&target, name, choices](const std::string& text) {
+                  if (std::find(choices.begin(), choices.end(), text) == choices.end())
+                    throw InputError(name + " " + quoted(text, 200) + " unknown; expected " + join_or(choices));
+                  target = text;
+                },
+                help)
+      ->type_name("WORD");
+}
+
 /// Adds `--threads`: 0 (the default: all cores) or 1..kMaxThreads, as Python's
 /// `threads=`; `help` says what runs on them.
 template <typename Int>
@@ -62,7 +80,7 @@ CLI::Option* add_setting(CLI::App* sub, const std::string& name, T& target, cons
   if constexpr (std::is_same_v<T, double>)
     return add_number(sub, name, target, help, spec.range);
   else if constexpr (std::is_same_v<T, std::string>)
-    return sub->add_option(name, target, help)->check(CLI::IsMember(spec.choices));
+    return add_word(sub, name, target, help, spec.choices);
   else
     return add_integer(sub, name, target, help, static_cast<long long>(spec.range.lower),
                        static_cast<long long>(std::min(spec.range.upper, 9e18)));
@@ -201,10 +219,10 @@ inline void add_method_options(CLI::App* sub, MethodArgs& a) {
   add_number(sub, "--delta", a.delta, "POD energy tolerance of the primal basis (default 1e-8)", Interval::closed(0, 1));
   add_setting(sub, "--tau", a.tau, rom::active_set_settings_table(), "tau");
   add_setting(sub, "--tau-scaling", a.tau_scaling, rom::active_set_settings_table(), "tau_scaling");
-  sub->add_option("--offset,--lifting", a.offset,
-                  "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet"
-                  " (--lifting: the same option)")
-      ->check(CLI::IsMember({"harmonic", "dirichlet"}));
+  add_word(sub, "--offset,--lifting", a.offset,
+           "offset of the reduced displacement: harmonic (default; unconstrained FOM response) | dirichlet"
+           " (--lifting: the same option)",
+           {"harmonic", "dirichlet"});
   add_setting(sub, "--max-iterations", a.max_iterations, rom::active_set_settings_table(), "max_iterations");
   sub->add_option("--option", a.options, "method setting KEY=VALUE, repeatable; each method's keys are listed below");
 }

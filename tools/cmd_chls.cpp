@@ -195,8 +195,7 @@ CommandRegistrar reg_hull("hull-report", [](CLI::App& app) {
   auto* sub = app.add_subcommand("hull-report", "Convex-hull ROM errors, sparsity and KKT compliance per query");
   sub->add_option("--db", args->db, "snapshot database written by contactrom offline")
       ->check(non_empty_path())->required();
-  sub->add_option("--set", args->set, "training | validation (default)")
-      ->check(CLI::IsMember({"training", "validation"}));
+  add_word(sub, "--set", args->set, "training | validation (default)", {"training", "validation"});
   add_number(sub, "--delta", args->delta, "POD/SVD energy tolerance (default 1e-8; paper rope: 1e-7)", Interval::closed(0, 1));
   const auto& hull = rom::convex_hull_option_table();
   add_setting(sub, "--basis", args->basis, hull, "basis");

@@ -100,10 +100,8 @@ CommandRegistrar reg("fom", [](CLI::App& app) {
   auto* sub = app.add_subcommand("fom", "Solve one full-order contact problem");
   sub->add_option("--problem", args->problem, "a shipped problem (contactrom problems) or a problem file path")->required();
   sub->add_option("--param", args->param, "parameter values V or V1,V2,... in the problem's order (contactrom problems)")->required();
-  sub->add_option("--refine", args->refine, "extra uniform mesh refinements (each splits every quad in four)")
-      ->check(CLI::Range(0, 6));
-  sub->add_option("--solver", args->solver, "active-set (default) | ipopt")
-      ->check(CLI::IsMember({"active-set", "ipopt"}));
+  add_integer(sub, "--refine", args->refine, "extra uniform mesh refinements (each splits every quad in four)", 0, 6);
+  add_word(sub, "--solver", args->solver, "active-set (default) | ipopt", {"active-set", "ipopt"});
   sub->add_option("--out", args->out, "folder for <problem>.vtu and <problem>_surface.csv")
       ->check(non_empty_path());
   sub->add_flag("--json", args->json, "print one JSON object");

@@ -108,10 +108,10 @@ CommandRegistrar reg("reduce", [](CLI::App& app) {
       ->check(non_empty_path())->required();
   add_method_options(sub, *args);
   sub->add_option("--out", args->out, "reduced-model file to write (HDF5)")->check(non_empty_path())->required();
-  sub->add_option("--pod", args->pod,
-                  "POD algorithm: auto (svd up to 2^24 snapshot entries, else snapshots), svd (BDCSVD in memory) or "
-                  "snapshots (method of snapshots with a Rayleigh-Ritz step, read by blocks)")
-      ->check(CLI::IsMember({"auto", "svd", "snapshots"}));
+  add_word(sub, "--pod", args->pod,
+           "POD algorithm: auto (svd up to 2^24 snapshot entries, else snapshots), svd (BDCSVD in memory) or "
+           "snapshots (method of snapshots with a Rayleigh-Ritz step, read by blocks)",
+           {"auto", "svd", "snapshots"});
   add_threads(sub, args->threads, "worker threads of the POD");
   sub->add_flag("--json", args->json, "print one JSON object");
   sub->callback([args] { run_reduce(*args); });

@@ -8,17 +8,22 @@
 // Bad input ends with one line on stderr ("contactrom: error: ...") and exit code 2;
 // numerical non-convergence is reported in the output with a status instead.
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <memory>
 #include <new>
+#include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <contactrom/core/atomic_file.hpp>
 #include <contactrom/core/blas_threads.hpp>
 #include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
 #include <contactrom/core/version.hpp>
 #include <contactrom/fom/input_values.hpp>
 #include "tools/cli.hpp"
@@ -57,6 +62,25 @@ std::string one_line(const std::string& text) {
     out = out.substr(0, kHead) + "[... " + std::to_string(out.size() - kHead - kTail) + " characters cut ...]" +
           out.substr(out.size() - kTail);
   return out;
+}
+
+/// CLI11's "The following arguments were not expected: 1 --threads" (its words, in
+/// reverse order) as our one line: the unknown option named first, else the stray
+/// values.
+std::string extras_message(const std::string& what, const std::string& command) {
+  const size_t colon = what.find(": ");
+  std::vector<std::string> extras;
+  std::istringstream words(colon == std::string::npos ? "" : what.substr(colon + 2));
+  for (std::string w; words >> w;) extras.insert(extras.begin(), w);
+  const std::string help = "see contactrom " + command + " --help";
+  for (const std::string& w : extras)
+    if (w.size() > 1 && w[0] == '-' && !std::isdigit(static_cast<unsigned char>(w[1])) && w[1] != '.')
+      return "option " + contactrom::quoted(w) + " unknown to '" + command + "'; " + help;
+  std::vector<std::string> quoted_extras;
+  for (const std::string& w : extras) quoted_extras.push_back(contactrom::quoted(w));
+  if (quoted_extras.empty()) return what;
+  return "unexpected argument" + std::string(extras.size() > 1 ? "s " : " ") + contactrom::join(quoted_extras) +
+         "; expected options with one value each (a parameter vector is one value, V1,V2); " + help;
 }
 
 int fail(const std::string& message, int code) {
@@ -106,6 +130,8 @@ int main(int argc, char** argv) {
   }
   try {
     app.parse(argc, argv);
+  } catch (const CLI::ExtrasError& e) {
+    return fail(extras_message(e.what(), argc > 1 ? argv[1] : ""), 2);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
     return fail(e.what(), 2);
