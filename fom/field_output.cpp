@@ -35,7 +35,16 @@ FileWriter vtu_writer(const Problem& problem, const Param& mu, const Eigen::Vect
     const int np = mesh ? mesh->num_nodes() : static_cast<int>(rope_x.size());
     const int ncell = mesh ? mesh->num_elements() : np - 1;
     out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-        << "  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"" << np << "\" NumberOfCells=\"" << ncell << "\">\n";
+        << "  <UnstructuredGrid>\n";
+    // The parameter of the solution, one field value per parameter, named after it.
+    if (mu.size() == problem.num_params() && mu.size() > 0) {
+      out << "    <FieldData>\n";
+      for (Eigen::Index k = 0; k < mu.size(); ++k)
+        out << "      <DataArray type=\"Float64\" Name=\"" << problem.param_names()[static_cast<size_t>(k)]
+            << "\" NumberOfTuples=\"1\" format=\"ascii\">" << format_number(mu(k)) << "</DataArray>\n";
+      out << "    </FieldData>\n";
+    }
+    out << "    <Piece NumberOfPoints=\"" << np << "\" NumberOfCells=\"" << ncell << "\">\n";
     Eigen::MatrixXd pts = Eigen::MatrixXd::Zero(np, 3);
     for (int i = 0; i < np; ++i) {
       if (mesh) pts.row(i).head(mesh->dim) = mesh->nodes.col(i).transpose();

@@ -95,11 +95,14 @@ void run_query(const QueryArgs& a) {
   }
   // The CSV and every field file are published together, or none of them.
   if (!a.fields.empty()) {
-    const std::string stem = problem.name() + "_" + rom.method();
+    // <problem>_<method>[_i], or _fom[_i] for an answer the FOM gave; i is the query's row.
     std::vector<fom::FieldSet> sets;
-    for (size_t i = 0; i < results.size(); ++i)
+    for (size_t i = 0; i < results.size(); ++i) {
+      const bool fom_answer = use_fom && answers[i].from_fom;
+      const std::string stem = problem.name() + "_" + (fom_answer ? std::string("fom") : rom.method());
       sets.push_back({results.size() == 1 ? stem : stem + "_" + std::to_string(i), results[i].mu, &results[i].u,
                       &results[i].lambda});
+    }
     std::vector<std::pair<std::string, FileWriter>> csv;
     if (!a.out.empty()) csv.emplace_back(a.out, rom::query_csv_writer(rom, results, sources));
     fom::write_field_sets(a.fields, problem, sets, csv);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <boost/test/unit_test.hpp>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -26,7 +27,8 @@ BOOST_AUTO_TEST_CASE(fallback_answers_are_labelled_and_timed) {
   }
   // Tolerances no answer meets: every answer is the FOM's.
   const auto all = run_command(kExe + " query --rom " + rom + " --params " + list +
-                               " --fallback fom --primal-tolerance 1e-12 --dual-tolerance 1e-12 --json --out " + out);
+                               " --fallback fom --primal-tolerance 1e-12 --dual-tolerance 1e-12 --json --out " + out +
+                               " --fields " + dir + "/fields");
   BOOST_REQUIRE_MESSAGE(all.exit_code == 0, all.err);
   const auto j = nlohmann::json::parse(all.out);
   BOOST_TEST(j["fallbacks"].get<int>() == 2);
@@ -39,6 +41,16 @@ BOOST_AUTO_TEST_CASE(fallback_answers_are_labelled_and_timed) {
     BOOST_TEST(std::abs(q["contact_force"].get<double>() - force) <= 1e-12 * force);
     BOOST_TEST(q["fom_time_s"].get<double>() > 0.0);
     BOOST_TEST(!q["fallback_reason"].get<std::string>().empty());
+  }
+  // The fields of a FOM answer are named so, and record their parameter.
+  for (const char* name : {"/fields/hertz_fom_0.vtu", "/fields/hertz_fom_1.vtu"})
+    BOOST_TEST(std::ifstream(dir + name).good(), name);
+  BOOST_TEST(!std::ifstream(dir + "/fields/hertz_greedy_0.vtu").good());
+  {
+    std::ifstream vtu(dir + "/fields/hertz_fom_1.vtu");
+    const std::string text((std::istreambuf_iterator<char>(vtu)), std::istreambuf_iterator<char>());
+    BOOST_TEST(text.find("<FieldData>\n      <DataArray type=\"Float64\" Name=\"d\" NumberOfTuples=\"1\" "
+                         "format=\"ascii\">0.2</DataArray>") != std::string::npos);
   }
   std::ifstream csv(out);
   std::string header;
