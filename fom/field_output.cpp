@@ -6,6 +6,7 @@
 
 #include <contactrom/core/atomic_file.hpp>
 #include <contactrom/core/errors.hpp>
+#include <contactrom/core/format.hpp>
 #include <contactrom/fom/input_values.hpp>
 #include <contactrom/fom/kkt.hpp>
 #include <contactrom/fom/rope.hpp>
