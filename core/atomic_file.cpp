@@ -115,6 +115,10 @@ class SignalSafePaths {
 
 SignalSafePaths g_temporaries;  // files being written
 SignalSafePaths g_folders;      // folders an output created, removed if still empty
+SignalSafePaths g_notes;        // lines printed on stderr when a signal ends the process
+std::mutex g_note_mutex;
+std::string g_note;             // the line in g_notes (set_interrupt_note)
+std::string g_next_note_path, g_next_note;  // set_interrupt_note_on_publish
 
 void register_temporary(const std::string& tmp) { g_temporaries.add(tmp); }
 void unregister_temporary(const std::string& tmp) { g_temporaries.remove(tmp); }
@@ -132,6 +136,7 @@ extern "C" void remove_temporaries_and_end(int sig) {
   }
   g_temporaries.for_each([](const char* path) { ::unlink(path); });
   g_folders.for_each([](const char* path) { ::rmdir(path); });  // fails, harmlessly, unless empty
+  g_notes.for_each([](const char* line) { (void)!::write(STDERR_FILENO, line, std::strlen(line)); });
   std::signal(sig, SIG_DFL);
   ::raise(sig);
 }
@@ -179,6 +184,19 @@ void remove_temporaries_on_signals() {
   // Past a file-size limit (ulimit -f) a write fails with EFBIG instead of ending
   // the process: reported like a full disk, temporaries removed.
   std::signal(SIGXFSZ, SIG_IGN);
+}
+
+void set_interrupt_note(const std::string& line) {
+  const std::lock_guard<std::mutex> lock(g_note_mutex);
+  if (!g_note.empty()) g_notes.remove(g_note);
+  g_note = line.empty() || line.back() == '\n' ? line : line + "\n";
+  if (!g_note.empty()) g_notes.add(g_note);
+}
+
+void set_interrupt_note_on_publish(const std::string& path, const std::string& line) {
+  const std::lock_guard<std::mutex> lock(g_note_mutex);
+  g_next_note_path = path;
+  g_next_note = line;
 }
 
 void check_output_path(const std::string& path) {
@@ -276,10 +294,20 @@ void commit_temporary(const std::string& tmp, const std::string& path) {
     discard_temporary(tmp);
     throw;
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    discard_temporary(tmp);
-    throw_cannot_create(cannot_write(path) + "renaming the completed temporary file failed: ", err);
+  {
+    // The file and the note that describes it change together for a signal handler.
+    SignalsHeld held;
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+      const int err = errno;
+      discard_temporary(tmp);
+      throw_cannot_create(cannot_write(path) + "renaming the completed temporary file failed: ", err);
+    }
+    std::string note;
+    {
+      const std::lock_guard<std::mutex> lock(g_note_mutex);
+      if (!g_next_note_path.empty() && g_next_note_path == path) note = g_next_note, g_next_note_path.clear();
+    }
+    if (!note.empty()) set_interrupt_note(note);
   }
   unregister_temporary(tmp);
 }

@@ -81,6 +81,16 @@ void forget_scratch_file(const std::string& path);
 /// call it (it replaces the program's handlers of those signals).
 void remove_temporaries_on_signals();
 
+/// \brief A line the handlers of remove_temporaries_on_signals() print on stderr
+/// before the process ends, e.g. what an interrupted run has kept; it replaces the
+/// previous one ("": none).
+void set_interrupt_note(const std::string& line);
+
+/// \brief set_interrupt_note(line) at the moment `path` is next published (renamed
+/// into place), with the signals held: a handler never sees the file and the note
+/// disagree.
+void set_interrupt_note_on_publish(const std::string& path, const std::string& line);
+
 /// \brief An exclusive lock on an existing file that is updated by read, modify
 /// and rename (`offline --append`): held from construction to destruction, so a
 /// second updater waits until the first has published its file, then reads that.

@@ -251,14 +251,28 @@ void run_adaptive(const OfflineArgs& a) {
               << " snapshots already, at least --max-snapshots " << options.max_snapshots
               << ": no round adds any; expected a larger --max-snapshots\n";
   distribute_over_ranks(options, ranks);
+  // What the file holds, for the messages of a run that ends early: an interrupt or
+  // a failed write leaves the last round written.
+  int kept = appending ? existing.num_snapshots() : 0;
+  const std::string resume = "; continue it with contactrom offline --problem " + a.problem + " --adaptive --append " + out;
   options.on_round = [&](const rom::AdaptiveRound& r, const rom::SnapshotDatabase& db) {
     // atomically, on rank 0: the file always holds whole rounds
-    write_on_root(out, [&]() -> const rom::SnapshotDatabase& { return db; }, ranks);
+    set_interrupt_note_on_publish(out, "contactrom: interrupted; " + quoted(out, 200) + " holds the " +
+                                           std::to_string(db.num_snapshots()) + " snapshots of the rounds done" + resume);
+    try {
+      write_on_root(out, [&]() -> const rom::SnapshotDatabase& { return db; }, ranks);
+    } catch (const WriteFailure& e) {
+      if (kept == 0) throw;
+      throw WriteFailure(std::string(e.what()) + "; " + quoted(out, 200) + " still holds the " + std::to_string(kept) +
+                         " snapshots written before" + resume);
+    }
+    kept = db.num_snapshots();
     if (ranks.root()) report_round(*problem, r);
   };
   const rom::AdaptiveTrainer trainer(*problem, options);
   const int before = appending ? existing.num_snapshots() : 0;
   const rom::SnapshotDatabase db = appending ? trainer.resume(std::move(existing), a.append) : trainer.run();
+  set_interrupt_note("");
   if (ranks.root()) print_adaptive_summary(a, *problem, db, before, ranks);
 }
 

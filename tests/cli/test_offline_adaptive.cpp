@@ -97,3 +97,19 @@ BOOST_AUTO_TEST_CASE(bad_settings_exit_2_with_one_line) {
   BOOST_TEST(grid.exit_code == 2);
   BOOST_TEST(grid.err.find("offline --adaptive") != std::string::npos, grid.err);
 }
+
+BOOST_AUTO_TEST_CASE(an_interrupted_run_says_what_its_database_holds) {
+  // Ctrl-C (SIGINT) mid-run: the database holds the rounds written, and the last line
+  // on stderr says how many snapshots and how to continue.
+  const std::string dir = contactrom::test::temp_dir(), db = dir + "/int.h5";
+  const auto r = run_command("timeout -s INT 3 " + kExe +
+                             " offline --problem hertz --adaptive --tolerance 1e-12 --max-snapshots 100000 --candidates 400"
+                             " --threads 1 --out " + db);
+  BOOST_TEST(r.exit_code != 0);
+  BOOST_REQUIRE_MESSAGE(std::filesystem::exists(db), "no round finished in 3 s: " << r.err);
+  const int held = rom::read_database(db).num_snapshots();
+  BOOST_TEST(r.err.find("contactrom: interrupted; '" + db + "' holds the " + std::to_string(held) +
+                        " snapshots of the rounds done; continue it with contactrom offline --problem hertz "
+                        "--adaptive --append " + db) != std::string::npos,
+             r.err);
+}
