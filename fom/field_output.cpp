@@ -111,7 +111,7 @@ FileWriter surface_csv_writer(const Problem& problem, const Eigen::VectorXd& u, 
       for (int s = 0; s < contact.num_constraints(); ++s) {
         const int dof = surf[static_cast<size_t>(3 * s)];
         for (int c = 0; c < 3; ++c) out << contact.constraint_points()(c, s) << ',';
-        if (std::isfinite(gap(s))) out << gap(s);
+        if (std::isfinite(gap(s))) out << gap(s) + 0.0;  // + 0.0: a gap of -0 is written 0
         else out << "inf";
         out << ',' << lambda(s) << ',' << u(dof) << ',' << u(dof + 1) << ',' << u(dof + 2) << '\n';
       }
@@ -123,7 +123,7 @@ FileWriter surface_csv_writer(const Problem& problem, const Eigen::VectorXd& u, 
       // (the rope's is transverse: u_y).
       const double y = problem.mesh() ? contact.constraint_points()(1, s) : 0.0;
       out << contact.constraint_points()(0, s) << ',' << y << ',';
-      if (std::isfinite(gap(s))) out << gap(s);
+      if (std::isfinite(gap(s))) out << gap(s) + 0.0;  // + 0.0: a gap of -0 is written 0
       else out << "inf";
       const int dof = surf[static_cast<size_t>(per_node * s)];
       if (per_node == 1) out << ',' << lambda(s) << ",0," << u(dof) << '\n';
