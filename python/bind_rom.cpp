@@ -9,6 +9,7 @@
 #include <contactrom/core/parallel_for.hpp>
 #include "python/bindings.hpp"
 #include <contactrom/rom/adaptive_training.hpp>
+#include <contactrom/fom/contact_checks.hpp>
 #include <contactrom/rom/fallback.hpp>
 #include <contactrom/rom/offline.hpp>
 #include <contactrom/rom/online_methods.hpp>
@@ -95,8 +96,16 @@ struct Fallback {
   std::shared_ptr<rom::FallbackSolver> solver;
 };
 
-py::dict fallback_answer(const rom::FallbackAnswer& a) {
+/// The answer as a dict; a FOM answer's solution warnings (fom::solution_warnings) are
+/// listed under 'warnings' and issued as RuntimeWarnings, as FullOrderSolver.solve does.
+py::dict fallback_answer(const fom::Problem& problem, const rom::FallbackAnswer& a) {
   py::dict d;
+  const std::vector<std::string> warnings =
+      a.from_fom ? fom::solution_warnings(problem, a.result.u) : std::vector<std::string>();
+  for (const std::string& w : warnings)
+    runtime_warning("FOM solution of " + quoted(problem.name(), 200) + " at " + problem.parameters().text(a.result.mu) +
+                    ": " + w);
+  d["warnings"] = warnings;
   d["solution"] = a.result;
   d["source"] = a.from_fom ? "fom" : "rom";
   d["fallback_reason"] = a.reason;
@@ -379,7 +388,7 @@ works in memory but is refused when read back from a file.)doc");
               py::gil_scoped_release release;
               a = f.solver->solve(p);
             }
-            return fallback_answer(a);
+            return fallback_answer(f.rom->problem(), a);
           },
           py::arg("mu"), "One query: the ROM's answer if kept, else the FOM's (a dict; see ReducedModel.with_fallback).")
       .def("__repr__", [](const Fallback& f) {
@@ -465,7 +474,8 @@ not succeed. ValueError names the argument for a bad value.)doc")
 The model with the FOM behind it (as `contactrom query --fallback fom`): its solve(mu)
 returns a dict with 'solution' (a RomSolution: the ROM's answer, or the FOM's u, lam
 and status), 'source' ('rom' or 'fom'), 'fallback_reason', 'rom_status',
-'rom_primal_estimate', 'rom_dual_estimate', 'rom_time_s' and 'fom_time_s'. An answer
+'rom_primal_estimate', 'rom_dual_estimate', 'rom_time_s', 'fom_time_s' and 'warnings'
+(a FOM answer's, as FomSolution.warnings, also issued as RuntimeWarnings). An answer
 is kept from the ROM when its status is success and 3 x its estimates are within the
 tolerances.)doc")
       .def(

@@ -170,6 +170,12 @@ def test_solution_that_turns_elements_inside_out_is_warned_about(tmp_path):
         both = fom.solve_all([0.05, 1.2], threads=2)
     assert len(record) == 1
     assert both[0].warnings == [] and both[1].warnings == large.warnings
+    # An answer the FOM gives behind a reduced model carries the same warnings.
+    db = contactrom.offline(problem, [[0.05], [0.1]], threads=1)
+    fallback = contactrom.ReducedModel(db).with_fallback(primal_tolerance=1e-12, dual_tolerance=1e-12)
+    with pytest.warns(RuntimeWarning, match=r"FOM solution of 'blocks' at d = 1\.2: the solution turns"):
+        answer = fallback.solve(1.2)
+    assert answer["source"] == "fom" and answer["warnings"] == large.warnings
 
 
 def test_verify_refuses_a_reference_of_another_problem_of_the_same_sizes(tmp_path):
