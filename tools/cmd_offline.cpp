@@ -1,5 +1,6 @@
 // contactrom offline --problem P (--train N | --level n) (--out DB.h5 | --append DB.h5) [--threads T] [--part k/K]
 //                    [--progress] [--json]
+// (with --append, --problem may be left out: the database's own problem file and mesh are used)
 // contactrom offline --problem P --adaptive --tolerance EPS [--max-snapshots N] [--candidates M] [--batch B]
 //                    [--seed S] [--indicator primal|dual|max] [--method M] [--delta D] [--train n | --level n]
 //                    (--out DB.h5 | --append DB.h5) [--threads T] [--json]
@@ -88,9 +89,18 @@ std::unique_ptr<fom::Problem> open_run(const OfflineArgs& a, const Ranks& ranks)
   const std::string& out = a.append.empty() ? a.out : a.append;
   if (a.append.empty()) declare_input_files({a.problem});
   check_output_path(out);  // before the snapshots are computed
-  fom::ProblemOptions popt;
-  popt.refine = a.refine;
-  auto problem = fom::make_problem(a.problem, popt);
+  std::unique_ptr<fom::Problem> problem;
+  if (a.problem.empty()) {
+    // --append alone continues the database's own problem (its stored file and mesh).
+    if (a.append.empty()) throw InputError("offline needs --problem P (a shipped problem or a problem file path)");
+    if (a.refine != 0)
+      throw InputError("--refine applies with --problem; --append without it keeps the database's own mesh");
+    problem = rom::rebuild_database_problem(rom::read_database(a.append, false), a.append);
+  } else {
+    fom::ProblemOptions popt;
+    popt.refine = a.refine;
+    problem = fom::make_problem(a.problem, popt);
+  }
   declare_problem_inputs(*problem, {out});
   if (ranks.root())
     for (const std::string& w : fom::reference_contact_warnings(*problem)) std::cerr << "contactrom: warning: " << w << "\n";
@@ -254,7 +264,7 @@ void run_adaptive(const OfflineArgs& a) {
   // What the file holds, for the messages of a run that ends early: an interrupt or
   // a failed write leaves the last round written.
   int kept = appending ? existing.num_snapshots() : 0;
-  const std::string resume = "; continue it with contactrom offline --problem " + a.problem + " --adaptive --append " + out;
+  const std::string resume = "; continue it with contactrom offline --adaptive --append " + out;
   options.on_round = [&](const rom::AdaptiveRound& r, const rom::SnapshotDatabase& db) {
     // atomically, on rank 0: the file always holds whole rounds
     set_interrupt_note_on_publish(out, "contactrom: interrupted; " + quoted(out, 200) + " holds the " +
@@ -428,7 +438,9 @@ void run_offline(const OfflineArgs& a) {
 CommandRegistrar reg("offline", [](CLI::App& app) {
   auto args = std::make_shared<OfflineArgs>();
   auto* sub = app.add_subcommand("offline", "Compute FOM snapshots at the training parameters into an HDF5 database");
-  sub->add_option("--problem", args->problem, "a shipped problem (contactrom problems) or a problem file path")->required();
+  sub->add_option("--problem", args->problem,
+                  "a shipped problem (contactrom problems) or a problem file path (with --append: optional, the "
+                  "database's own problem by default)");
   auto* train = add_integer(sub, "--train", args->train,
                             "training size N, for problems with uniform or random training (hertz: d_i = 0.3 i/N)", 1, 10000000);
   auto* level = add_integer(sub, "--level", args->level,

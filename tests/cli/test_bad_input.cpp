@@ -98,6 +98,7 @@ BOOST_FIXTURE_TEST_CASE(options_and_parameters, Fixture) {
       {"fom --problem hertz --param 0.5 --out " + file("fields"), "'0.5'", file("fields"), ""},
       {"offline --problem hertz --train 2.5 --out " + out, "'2.5'", out, ""},
       {"offline --problem hertz --train 0 --out " + out, "'0'", out, ""},
+      {"offline --train 4 --out " + out, "offline needs --problem P", out, ""},
       {"offline --problem ironing --level 0 --out " + out, "--level '0' is outside the range; expected an integer in [1, 20]", out, ""},
       {"offline --problem ironing --level 0 --adaptive --tolerance 0.1 --out " + out, "--level '0'", out, ""},
       {"offline --problem hertz --train 4 --threads nan --out " + out, "'nan'", out, ""},

@@ -36,9 +36,9 @@ BOOST_AUTO_TEST_CASE(append_continues_a_stopped_run_to_the_database_of_one_run) 
 
   const auto first = run_command(kExe + kSmall + " --max-snapshots 4 --out " + dir + "/part.h5");
   BOOST_REQUIRE_MESSAGE(first.exit_code == 0, first.err);
-  // The settings are the database's; only N changes.
-  const auto rest = run_command(kExe + " offline --problem hertz --adaptive --max-snapshots 8 --threads 2 --append " +
-                                dir + "/part.h5");
+  // The settings are the database's; only N changes. Without --problem, the
+  // database's own problem is continued.
+  const auto rest = run_command(kExe + " offline --adaptive --max-snapshots 8 --threads 2 --append " + dir + "/part.h5");
   BOOST_REQUIRE_MESSAGE(rest.exit_code == 0, rest.err);
   const rom::SnapshotDatabase a = rom::read_database(dir + "/whole.h5"), b = rom::read_database(dir + "/part.h5");
   // Appending grid snapshots to it is refused, naming the option that continues it.
@@ -109,7 +109,6 @@ BOOST_AUTO_TEST_CASE(an_interrupted_run_says_what_its_database_holds) {
   BOOST_REQUIRE_MESSAGE(std::filesystem::exists(db), "no round finished in 3 s: " << r.err);
   const int held = rom::read_database(db).num_snapshots();
   BOOST_TEST(r.err.find("contactrom: interrupted; '" + db + "' holds the " + std::to_string(held) +
-                        " snapshots of the rounds done; continue it with contactrom offline --problem hertz "
-                        "--adaptive --append " + db) != std::string::npos,
+                        " snapshots of the rounds done; continue it with contactrom offline --adaptive --append " + db) != std::string::npos,
              r.err);
 }
