@@ -62,12 +62,6 @@ FomResult finish(const fom::Problem& problem, fom::FomSolution solution) {
   return r;
 }
 
-/// The warnings of one FOM solution at mu, each as a RuntimeWarning naming the problem and mu.
-void warn_solution(const fom::Problem& problem, const fom::Param& mu, const FomResult& r) {
-  for (const std::string& w : r.warnings)
-    runtime_warning("FOM solution of " + quoted(problem.name(), 200) + " at " + problem.parameters().text(mu) + ": " + w);
-}
-
 /// `errors`: the errors against the reference by the rule of `online` (relative, or
 /// absolute where the reference displacement is near zero); null without a valid one.
 py::dict report_dict(const baselines::VerificationReport& r, const fom::ReferenceErrors* errors) {
@@ -108,6 +102,11 @@ std::shared_ptr<fom::Problem> make(py::handle name_or_path, int refine) {
 }
 
 }  // namespace
+
+void warn_solution(const fom::Problem& problem, const fom::Param& mu, const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings)
+    runtime_warning("FOM solution of " + quoted(problem.name(), 200) + " at " + problem.parameters().text(mu) + ": " + w);
+}
 
 void bind_fom(py::module_& m) {
   py::class_<fom::Problem, std::shared_ptr<fom::Problem>> problem(m, "Problem", R"doc(
@@ -273,7 +272,7 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
               py::gil_scoped_release release;
               r = finish(*s.problem, s.solve(p));
             }
-            warn_solution(*s.problem, p, r);
+            warn_solution(*s.problem, p, r.warnings);
             return r;
           },
           py::arg("mu"), "Solves at mu (GIL released). RuntimeError if the solver returns no solution at all.")

@@ -9,7 +9,6 @@
 #include <contactrom/core/parallel_for.hpp>
 #include "python/bindings.hpp"
 #include <contactrom/rom/adaptive_training.hpp>
-#include <contactrom/fom/contact_checks.hpp>
 #include <contactrom/rom/fallback.hpp>
 #include <contactrom/rom/offline.hpp>
 #include <contactrom/rom/online_methods.hpp>
@@ -96,16 +95,12 @@ struct Fallback {
   std::shared_ptr<rom::FallbackSolver> solver;
 };
 
-/// The answer as a dict; a FOM answer's solution warnings (fom::solution_warnings) are
-/// listed under 'warnings' and issued as RuntimeWarnings, as FullOrderSolver.solve does.
+/// The answer as a dict; a FOM answer's solution warnings are listed under 'warnings'
+/// and issued as RuntimeWarnings, as FullOrderSolver.solve does.
 py::dict fallback_answer(const fom::Problem& problem, const rom::FallbackAnswer& a) {
   py::dict d;
-  const std::vector<std::string> warnings =
-      a.from_fom ? fom::solution_warnings(problem, a.result.u) : std::vector<std::string>();
-  for (const std::string& w : warnings)
-    runtime_warning("FOM solution of " + quoted(problem.name(), 200) + " at " + problem.parameters().text(a.result.mu) +
-                    ": " + w);
-  d["warnings"] = warnings;
+  warn_solution(problem, a.result.mu, a.warnings);
+  d["warnings"] = a.warnings;
   d["solution"] = a.result;
   d["source"] = a.from_fom ? "fom" : "rom";
   d["fallback_reason"] = a.reason;

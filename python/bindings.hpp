@@ -81,6 +81,10 @@ struct ReducedModel {
   std::shared_ptr<const rom::SnapshotDatabase> db;
 };
 
+/// \brief Issues the `warnings` of a FOM solution of `problem` at `mu` as
+/// RuntimeWarnings, each naming the problem and mu (the caller holds the GIL).
+void warn_solution(const fom::Problem& problem, const fom::Param& mu, const std::vector<std::string>& warnings);
+
 /// \brief Issues `message` as a Python RuntimeWarning (the caller holds the GIL).
 /// \throws py::error_already_set when a warnings filter turns it into an error.
 void runtime_warning(const std::string& message);

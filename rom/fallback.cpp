@@ -5,6 +5,7 @@
 
 #include <contactrom/core/errors.hpp>
 #include <contactrom/core/format.hpp>
+#include <contactrom/fom/contact_checks.hpp>
 #include <contactrom/fom/contact_residuals.hpp>
 #include <contactrom/fom/kkt.hpp>
 #include <contactrom/rom/error_indicator.hpp>
@@ -82,6 +83,7 @@ FallbackAnswer FallbackSolver::solve(const fom::Param& mu) const {
   r.contact = fom::contact_residuals(problem, problem.contact().restrict_to_surface(sol.u), sol.lambda);
   r.contact_force = fom::contact_force(problem, sol.lambda);
   r.time_s = a.rom_time_s + a.fom_time_s;
+  a.warnings = fom::solution_warnings(problem, sol.u);
   return a;
 }
 

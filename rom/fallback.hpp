@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include <contactrom/fom/active_set_solver.hpp>
 #include <contactrom/rom/online_solver.hpp>
@@ -47,6 +48,9 @@ struct FallbackAnswer {
   /// The ROM's own estimates, kept when the FOM answered.
   double rom_primal_estimate = 0.0, rom_dual_estimate = 0.0;
   Status rom_status = Status::Success;  ///< the ROM's status
+  /// A FOM answer's fom::solution_warnings (elements it turns inside out), as `fom`
+  /// prints them; empty for a ROM answer.
+  std::vector<std::string> warnings;
 };
 
 /// \brief The ROM, with the FOM behind it; see the file comment. solve() is thread-safe.

@@ -14,7 +14,6 @@
 #include <nlohmann/json.hpp>
 
 #include <contactrom/core/atomic_file.hpp>
-#include <contactrom/fom/contact_checks.hpp>
 #include <contactrom/fom/field_output.hpp>
 #include <contactrom/fom/kkt.hpp>
 #include <contactrom/rom/fallback.hpp>
@@ -89,9 +88,8 @@ void run_query(const QueryArgs& a) {
       sources.push_back(answers.back().from_fom ? "fom" : "rom");
       from_fom += answers.back().from_fom ? 1 : 0;
       // A FOM answer is warned about as `fom` warns (elements turned inside out).
-      if (answers.back().from_fom)
-        for (const std::string& w : fom::solution_warnings(problem, answers.back().result.u))
-          std::cerr << "contactrom: warning: FOM answer at " << problem.parameters().text(mu) << ": " << w << "\n";
+      for (const std::string& w : answers.back().warnings)
+        std::cerr << "contactrom: warning: FOM answer at " << problem.parameters().text(mu) << ": " << w << "\n";
     } else {
       results.push_back(rom.solve(mu));
     }
