@@ -197,15 +197,12 @@ std::string default_scale_warning(const Problem& problem) {
   if (def.displacement_scale > 0.0) return "";
   double largest = 0.0, smallest = std::numeric_limits<double>::infinity();
   std::string where;
-  for (const DirichletSpec& d : def.dirichlet)
-    for (size_t k = 0; k < d.displacement.size(); ++k) {
-      if (!d.displacement[k]) continue;
-      const double v = std::max(std::abs(d.displacement[k]->min_over(def.parameters)),
-                                std::abs(d.displacement[k]->max_over(def.parameters)));
-      if (!(v > 0.0)) continue;  // a fixed component is no displacement scale
-      smallest = std::min(smallest, v);
-      if (v > largest) largest = v, where = "group " + quoted(d.group, 200) + ", component " + "xyz"[k];
-    }
+  for (const PrescribedDisplacement& p : prescribed_displacements(def)) {
+    if (!(p.magnitude > 0.0)) continue;  // a fixed component is no displacement scale
+    smallest = std::min(smallest, p.magnitude);
+    if (p.magnitude > largest)
+      largest = p.magnitude, where = "group " + quoted(p.group, 200) + ", component " + "xyz"[p.component];
+  }
   constexpr double kRatio = 5.0;
   if (!(largest >= kRatio * smallest)) return "";
   return "displacement_scale is not set, so U = " + format_number(largest) +

@@ -292,15 +292,23 @@ void keep_nonzero_terms(const AffineVectors& lift, const AffineVectors& fext, in
 double displacement_scale(const ProblemDefinition& def) {
   double scale = def.displacement_scale;
   if (!(scale > 0)) {
-    for (const DirichletSpec& d : def.dirichlet)
-      for (const auto& v : d.displacement)
-        if (v) scale = std::max({scale, std::abs(v->min_over(def.parameters)), std::abs(v->max_over(def.parameters))});
+    for (const PrescribedDisplacement& p : prescribed_displacements(def)) scale = std::max(scale, p.magnitude);
     if (!(scale > 0)) scale = 1.0;
   }
   return scale;
 }
 
 }  // namespace
+
+std::vector<PrescribedDisplacement> prescribed_displacements(const ProblemDefinition& def) {
+  std::vector<PrescribedDisplacement> out;
+  for (const DirichletSpec& d : def.dirichlet)
+    for (size_t k = 0; k < d.displacement.size(); ++k)
+      if (const auto& v = d.displacement[k])
+        out.push_back({d.group, static_cast<int>(k),
+                       std::max(std::abs(v->min_over(def.parameters)), std::abs(v->max_over(def.parameters)))});
+  return out;
+}
 
 std::string text_fingerprint(const std::string& text) {
   std::uint64_t h = 1469598103934665603ULL;

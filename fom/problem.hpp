@@ -147,6 +147,18 @@ class Problem {
 /// files to refuse a problem they were not built for.
 std::string text_fingerprint(const std::string& text);
 
+/// \brief One prescribed displacement component of a problem file's `[[dirichlet]]`
+/// entries and its largest magnitude over the parameter box.
+struct PrescribedDisplacement {
+  std::string group;
+  int component = 0;       ///< 0, 1, 2: x, y, z
+  double magnitude = 0.0;  ///< max |value| over the box
+};
+
+/// \brief Every prescribed (not free) Dirichlet component of `def`, in file order:
+/// what the default displacement scale U is the largest of.
+std::vector<PrescribedDisplacement> prescribed_displacements(const ProblemDefinition& def);
+
 /// \brief The free-dof block K_ff of a matrix on all dofs (Dirichlet rows and columns
 /// dropped). \param free_index position of each dof among the free dofs (−1: Dirichlet)
 /// \param num_free number of free dofs
