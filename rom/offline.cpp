@@ -3,18 +3,13 @@
 #include <algorithm>
 #include <memory>
 
-#include <contactrom/core/errors.hpp>
-#include <contactrom/core/format.hpp>
-
 namespace contactrom::rom {
 
 SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vector<fom::Param>& params,
                                     const std::string& training_kind, int training_size,
                                     const OfflineOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (!is_training_kind(training_kind))
-    throw InputError("training kind " + quoted(training_kind, 200) +
-                     " unknown; expected 'train', 'level', 'list' or 'adaptive'");
+  check_training_kind(training_kind);
   for (const fom::Param& mu : params) problem.check_param(mu);
   const int n = static_cast<int>(params.size());
   const int nd = problem.num_dofs(), nc = problem.contact().num_constraints();

@@ -368,14 +368,19 @@ void remove_primal_files(const SnapshotDatabase& db) {
   for (const std::string& path : db.primal_files) std::remove(path.c_str());
 }
 
+namespace {
 bool is_training_kind(const std::string& kind) {
   return kind == "train" || kind == "level" || kind == "list" || kind == "adaptive";
 }
+}  // namespace
+
+void check_training_kind(const std::string& kind) {
+  if (!is_training_kind(kind))
+    throw InputError("training kind " + quoted(kind, 200) + " unknown; expected 'train', 'level', 'list' or 'adaptive'");
+}
 
 void write_database(const std::string& path, const SnapshotDatabase& db) {
-  if (!is_training_kind(db.training_kind))
-    throw InputError("training kind " + quoted(db.training_kind, 200) +
-                     " unknown; expected 'train', 'level', 'list' or 'adaptive' (what read_database accepts)");
+  check_training_kind(db.training_kind);
   const hsize_t n = static_cast<hsize_t>(db.num_snapshots());
   const hsize_t stored = db.primal_in_memory() ? static_cast<hsize_t>(db.primal.cols()) : db.primal_refs.size();
   if (db.dual.cols() != db.parameters.cols() || stored != n || db.status.size() != n || db.iterations.size() != n ||

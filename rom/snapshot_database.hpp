@@ -122,9 +122,9 @@ struct SnapshotDatabase {
 ///   or the disk is full; no partial file is left behind.
 void write_database(const std::string& path, const SnapshotDatabase& db);
 
-/// \brief Whether `kind` is a training kind a database records: "train", "level",
-/// "list" or "adaptive" (write_database refuses any other with an InputError).
-bool is_training_kind(const std::string& kind);
+/// \brief Refuses (InputError) a training kind a database cannot record: anything
+/// but "train", "level", "list" or "adaptive", the kinds read_database accepts.
+void check_training_kind(const std::string& kind);
 
 /// \brief A database file written on disk snapshot by snapshot, so that no process
 /// holds all the primal snapshots at once (the offline stage streams them as it
