@@ -44,4 +44,18 @@ auto solve_exactly_scaled(const Eigen::MatrixXd& d, const Eigen::VectorXd& x, So
   return result;
 }
 
+/// \brief ||D a − x|| and that relative to ||x|| (the residual itself when x = 0), by
+/// norms that neither underflow nor overflow with data of extreme magnitude: how a
+/// sparse kernel's answer is reported (`contactrom sparse`, Python's SparseResult).
+struct ResidualNorms {
+  double residual = 0.0, relative = 0.0;
+};
+inline ResidualNorms residual_norms(const Eigen::MatrixXd& d, const Eigen::VectorXd& a, const Eigen::VectorXd& x) {
+  ResidualNorms r;
+  r.residual = (d * a - x).stableNorm();
+  const double x_norm = x.stableNorm();
+  r.relative = x_norm > 0.0 ? r.residual / x_norm : r.residual;
+  return r;
+}
+
 }  // namespace contactrom

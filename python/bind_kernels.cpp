@@ -56,10 +56,9 @@ SparseResult run(Solver& solver, const Eigen::MatrixXd& d, const Eigen::VectorXd
   }
   r.status = solver.info();
   r.iterations = solver.iterations();
-  // As `contactrom sparse`: norms that neither underflow nor overflow with extreme data.
-  r.residual = (d * r.x - x).stableNorm();
-  const double x_norm = x.stableNorm();
-  r.relative_residual = x_norm > 0.0 ? r.residual / x_norm : r.residual;
+  const ResidualNorms norms = residual_norms(d, r.x, x);  // as `contactrom sparse`
+  r.residual = norms.residual;
+  r.relative_residual = norms.relative;
   for (Eigen::Index i = 0; i < r.x.size(); ++i)
     if (r.x(i) != 0.0) r.support.push_back(i);
   return r;

@@ -150,10 +150,7 @@ void run_sparse(const SparseArgs& args, bool has_tol, bool has_max_iter, bool ha
   const SparseRun run = contactrom::solve_exactly_scaled(
       d, x, [&](const MatrixXd& ds, const VectorXd& xs) { return run_method(args, has_tol, has_max_iter, has_atoms, ds, xs); },
       [](SparseRun& r) -> VectorXd& { return r.coefficients; });
-  // Norms that do not underflow or overflow with such data.
-  const double residual = (d * run.coefficients - x).stableNorm();
-  const double x_norm = x.stableNorm();
-  const double relative = x_norm > 0.0 ? residual / x_norm : residual;
+  const auto [residual, relative] = contactrom::residual_norms(d, run.coefficients, x);
   std::vector<Eigen::Index> nonzeros;
   for (Eigen::Index j = 0; j < run.coefficients.size(); ++j) {
     if (run.coefficients(j) != 0.0) nonzeros.push_back(j);
