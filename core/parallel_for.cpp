@@ -24,8 +24,15 @@ void check_threads(long long threads, const std::string& what) {
 }
 
 void parallel_for(int n, int threads, const std::function<void(int)>& task, const ProgressCallback& progress) {
+  parallel_for_chains(n, 1, threads, task, progress);
+}
+
+void parallel_for_chains(int n, int chain, int threads, const std::function<void(int)>& task,
+                         const ProgressCallback& progress) {
   if (n <= 0) return;
-  const int nt = std::min(resolve_threads(threads), n);
+  chain = std::max(chain, 1);
+  const int chains = (n + chain - 1) / chain;
+  const int nt = std::min(resolve_threads(threads), chains);
   std::atomic<int> next{0};
   std::atomic<bool> failed{false};
   std::mutex mutex;
@@ -36,20 +43,23 @@ void parallel_for(int n, int threads, const std::function<void(int)>& task, cons
   auto worker = [&] {
     for (;;) {
       if (failed.load()) return;
-      const int i = next.fetch_add(1);
-      if (i >= n) return;
-      try {
-        task(i);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!error) error = std::current_exception();
-        failed = true;
+      const int c = next.fetch_add(1);
+      if (c >= chains) return;
+      for (int i = c * chain; i < std::min(n, (c + 1) * chain); ++i) {
+        if (failed.load()) return;
+        try {
+          task(i);
+        } catch (...) {
+          std::lock_guard<std::mutex> lock(mutex);
+          if (!error) error = std::current_exception();
+          failed = true;
+        }
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          ++done;
+        }
+        changed.notify_one();
       }
-      {
-        std::lock_guard<std::mutex> lock(mutex);
-        ++done;
-      }
-      changed.notify_one();
     }
   };
 

@@ -19,6 +19,15 @@ using ProgressCallback = std::function<void(int done, int total)>;
 /// stopped (the remaining tasks are skipped; the running ones finish).
 void parallel_for(int n, int threads, const std::function<void(int)>& task, const ProgressCallback& progress = {});
 
+/// \brief As parallel_for(), but the items come in chains of `chain` consecutive ones
+/// (items c·chain … (c+1)·chain − 1; the last chain may be shorter), each run by
+/// one worker in increasing order, so that an item may start from its predecessor's
+/// result; the chains are handed out in increasing order. `progress` still counts
+/// items, and a failure or a throwing `progress` stops every chain before its next
+/// item. chain ≤ 1: parallel_for().
+void parallel_for_chains(int n, int chain, int threads, const std::function<void(int)>& task,
+                         const ProgressCallback& progress = {});
+
 /// \brief Number of worker threads `requested` resolves to (≤ 0: hardware concurrency, at least 1).
 int resolve_threads(int requested);
 

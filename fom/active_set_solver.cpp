@@ -345,9 +345,15 @@ FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& m
   // 1. The unconstrained solution u0(μ): a combination of the condensed load terms.
   const Eigen::VectorXd u0 = cond.z_load * m_problem.load_coefficients(mu);
   const Eigen::VectorXd u0_s = contact.restrict_to_surface(u0);
-  // 2. Start from u0, or from a previous solution (its u, λ) if one fits.
+  // 2. Start from u0, or from a previous solution if one fits: its λ, and its contact
+  //    response u − u0 (at its own parameter) on top of this parameter's u0.
   const bool use_warm = warm && warm->lambda.size() == contact.num_constraints() && warm->u.size() == m_problem.num_dofs();
-  const Eigen::VectorXd x = use_warm ? contact.restrict_to_surface(warm->u) : u0_s;
+  //    (A solution without its parameter counts as one at this parameter.)
+  Eigen::VectorXd x = u0_s;
+  if (use_warm && warm->mu.size() == mu.size() && warm->mu != mu)
+    x += contact.restrict_to_surface(warm->u - cond.z_load * m_problem.load_coefficients(warm->mu));
+  else if (use_warm)
+    x = contact.restrict_to_surface(warm->u);
   // 3. The pairing fixed point around the exact dual QP of each pairing.
   const PairingFixedPointOptions fixed_point = pairing_options(m_options);
   const PairingFixedPointResult fp =

@@ -184,7 +184,11 @@ class ActiveSetSolver final : public FullOrderSolver {
   explicit ActiveSetSolver(const Problem& problem, ActiveSetOptions options = {});
 
   /// \brief Solves the contact problem at `mu` (checked against the range).
-  /// \param warm optional previous solution: its multipliers and pairing seed the iteration.
+  /// \param warm optional previous solution, at this or another parameter (a
+  ///   neighbour): the iteration starts from its multipliers and from its contact
+  ///   response u − u0 (u0: the unconstrained solution at its parameter) added to
+  ///   this parameter's u0. The answer is the same fixed point, to the pairing
+  ///   tolerance: the start changes the path, so not the last bits.
   FomSolution solve(const Param& mu, const FomSolution* warm = nullptr) const override;
 
   /// \brief The query at a known pairing: the unconstrained solution, one assembly of

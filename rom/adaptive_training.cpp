@@ -107,6 +107,7 @@ AdaptiveTrainer::AdaptiveTrainer(const fom::Problem& problem, AdaptiveOptions op
   };
   m_options.online.estimate = true;
   m_options.offline.stream_to.clear();  // the batches are merged in memory
+  m_options.offline.chain = 1;  // a batch's points are far apart: each is solved from scratch
   m_options.model.keep_primal_snapshots = online_method_needs_primal_snapshots(m_options.method);
   fom::SamplingPlan plan;
   plan.kind = fom::SamplingPlan::Kind::Random;

@@ -54,11 +54,12 @@ SnapshotDatabase reordered(const SnapshotDatabase& db, const std::vector<int>& o
 
 }  // namespace
 
-std::pair<int, int> part_range(int n, int k, int parts) {
+std::pair<int, int> part_range(int n, int k, int parts, int chain) {
   if (parts < 1 || k < 1 || k > parts)
     throw InputError("part " + std::to_string(k) + "/" + std::to_string(parts) + " invalid; expected k/K with 1 <= k <= K");
-  const long long nn = n;
-  return {static_cast<int>((k - 1) * nn / parts), static_cast<int>(k * nn / parts)};
+  const long long c = std::max(chain, 1), chains = (n + c - 1) / c;
+  const auto end = [&](long long k) { return static_cast<int>(std::min<long long>(n, k * chains / parts * c)); };
+  return {end(k - 1), end(k)};
 }
 
 SnapshotDatabase merge_databases(const std::vector<SnapshotDatabase>& databases, const std::vector<std::string>& names) {

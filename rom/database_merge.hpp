@@ -17,10 +17,12 @@
 
 namespace contactrom::rom {
 
-/// \brief The contiguous, balanced part k of K (1-based) of `n` items, as [begin, end):
-/// part k starts at ⌊(k−1)n/K⌋ and ends at ⌊kn/K⌋.
+/// \brief The contiguous part k of K (1-based) of `n` items in whole chains of `chain`
+/// (the offline stage's continuation chains, OfflineOptions::chain), as [begin, end):
+/// of the m = ⌈n/chain⌉ chains, part k holds ⌊(k−1)m/K⌋ … ⌊km/K⌋ − 1 (the last
+/// chain may be shorter). With chain 1: ⌊(k−1)n/K⌋ … ⌊kn/K⌋ − 1.
 /// \throws InputError unless 1 ≤ k ≤ K.
-std::pair<int, int> part_range(int n, int k, int parts);
+std::pair<int, int> part_range(int n, int k, int parts, int chain);
 
 /// \brief Concatenates the snapshots of `databases` in the given order (timing
 /// fields: setup and wall times summed, threads the largest). Databases whose primal

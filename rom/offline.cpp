@@ -30,17 +30,23 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
   db.iterations.assign(n, 0);
   db.pairing_iterations.assign(n, 0);
   db.time_s.assign(n, 0.0);
-  db.threads = std::min(resolve_threads(options.threads), std::max(n, 1));
 
   // One solver (one factorisation) shared by every worker: solve() is const and
-  // thread-safe. Each task writes only its own column j.
+  // thread-safe. Each task is one chain and writes only its own columns j.
   const fom::ActiveSetSolver solver(problem);
   db.setup_time_s = solver.setup_time();
   const std::vector<char>& dirichlet = problem.is_dirichlet();
-  parallel_for(
-      n, options.threads,
+  // A chain runs on one worker, item after item: `last` holds each chain's latest
+  // answer, the start of its next item, and is freed at the chain's end.
+  const int chain = std::max(options.chain, 1);
+  db.threads = std::min(resolve_threads(options.threads), std::max((n + chain - 1) / chain, 1));
+  std::vector<fom::FomSolution> last(static_cast<size_t>((n + chain - 1) / chain));
+  parallel_for_chains(
+      n, chain, options.threads,
       [&](int j) {
-        const fom::FomSolution sol = solver.solve(params[j]);
+        fom::FomSolution& previous = last[static_cast<size_t>(j / chain)];
+        const bool warm = j % chain != 0 && previous.status == Status::Success;
+        fom::FomSolution sol = solver.solve(params[j], warm ? &previous : nullptr);
         db.status[j] = sol.status;
         db.iterations[j] = sol.iterations;
         db.pairing_iterations[j] = sol.pairing_iterations;
@@ -59,6 +65,7 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
         else
           db.primal.col(j) = col;
         if (sol.lambda.size() == nc) db.dual.col(j) = sol.lambda;
+        previous = (j + 1) % chain != 0 ? std::move(sol) : fom::FomSolution();
       },
       options.progress);
   db.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

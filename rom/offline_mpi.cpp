@@ -57,7 +57,14 @@ std::vector<std::string> gather_paths(const std::string& path, int rank, int siz
 }
 
 /// Number of parameters rank r computes under the cyclic assignment.
-int share(int n, int rank, int size) { return n / size + (rank < n % size ? 1 : 0); }
+/// The parameters of rank `rank` of `size`: the chains c ≡ rank (mod size) of length
+/// `chain` (generate_snapshots' continuation), whole, in increasing order.
+std::vector<int> rank_share(int n, int chain, int rank, int size) {
+  std::vector<int> out;
+  for (int c = rank; static_cast<long long>(c) * chain < n; c += size)
+    for (int j = c * chain; j < std::min(n, (c + 1) * chain); ++j) out.push_back(j);
+  return out;
+}
 
 }  // namespace
 
@@ -125,8 +132,9 @@ SnapshotDatabase distributed(const fom::Problem& problem, const std::vector<fom:
   for (const fom::Param& mu : params) problem.check_param(mu);  // same outcome on every rank
   const int n = static_cast<int>(params.size());
 
+  const int chain = std::max(options.chain, 1);
   std::vector<fom::Param> mine;
-  for (int j = rank; j < n; j += size) mine.push_back(params[j]);
+  for (int j : rank_share(n, chain, rank, size)) mine.push_back(params[j]);
   OfflineOptions local_options = options;
   if (rank != 0) local_options.progress = nullptr;
   SnapshotDatabase local;
@@ -153,9 +161,11 @@ SnapshotDatabase distributed(const fom::Problem& problem, const std::vector<fom:
   const int stride = nd + nc + kScalarsPerSnapshot;
   const std::vector<double> buffer = pack(local, nd);
   const std::vector<std::string> files = streamed ? gather_paths(options.stream_to, rank, size) : std::vector<std::string>{};
+  std::vector<std::vector<int>> shares(size);
+  for (int r = 0; r < size; ++r) shares[r] = rank_share(n, chain, r, size);
   std::vector<int> counts(size), displs(size);
   for (int r = 0, offset = 0; r < size; ++r) {
-    counts[r] = share(n, r, size) * stride;
+    counts[r] = static_cast<int>(shares[r].size()) * stride;
     displs[r] = offset;
     offset += counts[r];
   }
@@ -172,7 +182,7 @@ SnapshotDatabase distributed(const fom::Problem& problem, const std::vector<fom:
     if (rank != 0) return SnapshotDatabase{};
   }
 
-  // Rank r's k-th snapshot is parameter j = r + k·size.
+  // Rank r's k-th snapshot is parameter j = shares[r][k].
   SnapshotDatabase db = local;  // metadata (problem, fingerprint, names, ...) of rank 0
   db.parameters.resize(problem.num_params(), n);
   db.primal.resize(problem.num_dofs(), streamed ? 0 : n);
@@ -184,8 +194,8 @@ SnapshotDatabase distributed(const fom::Problem& problem, const std::vector<fom:
   db.pairing_iterations.assign(n, 0);
   db.time_s.assign(n, 0.0);
   for (int r = 0; r < size; ++r)
-    for (int k = 0; k < share(n, r, size); ++k) {
-      const int j = r + k * size;
+    for (int k = 0; k < static_cast<int>(shares[r].size()); ++k) {
+      const int j = shares[r][k];
       const double* p = all.data() + displs[r] + static_cast<size_t>(stride) * k;
       db.parameters.col(j) = params[j];
       if (streamed)

@@ -6,13 +6,14 @@
 ///   mpirun -np 4 contactrom offline --problem hertz --train 120 --out hertz120.h5 --threads 1
 /// \endcode
 ///
-/// Rank r of R computes the training parameters j ≡ r (mod R) with
-/// generate_snapshots() (its own factorisation, `threads` worker threads), so every
-/// rank gets the same number of snapshots up to one and a share of each part of
+/// Rank r of R computes the continuation chains c ≡ r (mod R) of the training
+/// parameters (chains of OfflineOptions::chain consecutive parameters, rom/offline.hpp)
+/// with generate_snapshots() (its own factorisation, `threads` worker threads), so
+/// every rank gets the same number of chains up to one and a share of each part of
 /// the parameter range (the cost of a FOM query grows with the contact zone). The
 /// snapshots are gathered on rank 0 into the columns of the serial order: each
-/// snapshot is computed from scratch exactly as in a serial run, so the database's
-/// arrays are bit-identical to the serial ones; only timing fields differ. With
+/// chain is computed exactly as in a serial run, so the database's arrays are
+/// bit-identical to the serial ones; only timing fields differ. With
 /// OfflineOptions::stream_to (a path of each rank's own), each rank streams its
 /// primal snapshots into that file and only the pressures and outcomes are gathered:
 /// rank 0's database refers to the ranks' files (SnapshotDatabase::primal_files, which

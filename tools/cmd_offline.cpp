@@ -63,7 +63,7 @@ std::vector<fom::Param> training_part(const std::vector<fom::Param>& params, con
   char tail = 0;
   if (std::sscanf(text.c_str(), "%d/%d%c", &k, &parts, &tail) != 2)
     throw InputError("--part " + quoted(text, 200) + " invalid; expected k/K, e.g. 1/4");
-  const auto [begin, end] = rom::part_range(static_cast<int>(params.size()), k, parts);
+  const auto [begin, end] = rom::part_range(static_cast<int>(params.size()), k, parts, rom::kDefaultChain);
   return std::vector<fom::Param>(params.begin() + begin, params.begin() + end);
 }
 
@@ -316,7 +316,8 @@ OfflinePlan plan_offline(const OfflineArgs& a, const fom::Problem& problem) {
   plan.params = a.part.empty() ? plan.training : training_part(plan.training, a.part);
   if (!a.part.empty() && plan.params.empty() && current_ranks().root())
     std::cerr << "contactrom: warning: part " << a.part << " of the " << plan.training.size()
-              << " training parameters holds none (more parts than parameters); its database holds no snapshot\n";
+              << " training parameters holds none (parts hold whole chains of " << rom::kDefaultChain
+              << " parameters, and there are more parts than chains); its database holds no snapshot\n";
   if (plan.appending) {
     rom::check_appendable(plan.existing, a.append, problem, sampling.selector(), plan.n);
     plan.params = rom::parameters_not_in(plan.existing, plan.params);
@@ -455,7 +456,8 @@ CommandRegistrar reg("offline", [](CLI::App& app) {
       ->excludes(out);
   add_threads(sub, args->threads, "worker threads");
   sub->add_option("--part", args->part,
-                  "k/K: only the k-th of K contiguous parts of the training set (join the parts with merge)");
+                  "k/K: only the k-th of K contiguous parts of the training set, in whole chains of " +
+                      std::to_string(rom::kDefaultChain) + " parameters (join the parts with merge)");
   sub->add_flag("--progress", args->progress, "draw the progress bar even when stderr is not a terminal");
   auto* adaptive = sub->add_flag("--adaptive", args->adaptive,
                                  "train where the reduced model's error estimate is largest (docs/rom.md, "

@@ -1,6 +1,6 @@
 #pragma once
 // Shared by the offline-stage tests: the hertz problem, a temporary folder for the
-// run, and the bitwise comparison of two snapshot databases.
+// run, and the comparisons of two snapshot databases.
 #include <boost/test/unit_test.hpp>
 
 #include <cstring>
@@ -52,6 +52,17 @@ inline void check_same_snapshots(const rom::SnapshotDatabase& a, const rom::Snap
   BOOST_TEST(b.status == a.status);
   BOOST_TEST(b.iterations == a.iterations);
   BOOST_TEST(b.pairing_iterations == a.pairing_iterations);
+}
+
+/// Checks that `b` holds the snapshots of `a` at the same parameters to `tolerance`
+/// (largest difference relative to the largest entry, primal and dual separately):
+/// the same FOM answers computed from other starts.
+inline void check_close_snapshots(const rom::SnapshotDatabase& a, const rom::SnapshotDatabase& b, double tolerance) {
+  BOOST_TEST(bitwise_equal(b.parameters, a.parameters));
+  BOOST_TEST_REQUIRE(b.primal.cols() == a.primal.cols());
+  BOOST_TEST((b.primal - a.primal).cwiseAbs().maxCoeff() <= tolerance * a.primal.cwiseAbs().maxCoeff());
+  BOOST_TEST((b.dual - a.dual).cwiseAbs().maxCoeff() <= tolerance * a.dual.cwiseAbs().maxCoeff());
+  BOOST_TEST(b.status == a.status);
 }
 
 }  // namespace contactrom::test

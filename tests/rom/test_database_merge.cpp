@@ -28,34 +28,46 @@ const std::string exe = CONTACTROM_EXE;
 
 int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
+contactrom::rom::OfflineOptions chains_of_two() {
+  contactrom::rom::OfflineOptions o;
+  o.chain = 2;
+  return o;
+}
+
 }  // namespace
 
-BOOST_AUTO_TEST_CASE(parts_are_contiguous_balanced_and_cover_everything) {
-  for (int n : {0, 1, 7, 30, 121})
-    for (int parts : {1, 2, 3, 8}) {
-      int expected_begin = 0;
-      for (int k = 1; k <= parts; ++k) {
-        const auto [begin, end] = part_range(n, k, parts);
-        BOOST_TEST(begin == expected_begin);
-        BOOST_TEST(end - begin >= n / parts);
-        BOOST_TEST(end - begin <= n / parts + 1);
-        expected_begin = end;
+BOOST_AUTO_TEST_CASE(parts_are_contiguous_balanced_whole_chains_and_cover_everything) {
+  for (int chain : {1, 3, 8})
+    for (int n : {0, 1, 7, 30, 121})
+      for (int parts : {1, 2, 3, 8}) {
+        const int chains = (n + chain - 1) / chain;
+        int expected_begin = 0;
+        for (int k = 1; k <= parts; ++k) {
+          const auto [begin, end] = part_range(n, k, parts, chain);
+          BOOST_TEST(begin == expected_begin);
+          BOOST_TEST(begin % chain == 0);  // a part starts a chain
+          const int held = (end - begin + chain - 1) / chain;  // chains, the last one maybe short
+          BOOST_TEST(held >= chains / parts);
+          BOOST_TEST(held <= chains / parts + 1);
+          expected_begin = end;
+        }
+        BOOST_TEST(expected_begin == n);
       }
-      BOOST_TEST(expected_begin == n);
-    }
-  BOOST_CHECK_THROW(part_range(10, 0, 2), InputError);
-  BOOST_CHECK_THROW(part_range(10, 3, 2), InputError);
-  BOOST_CHECK_THROW(part_range(10, 1, 0), InputError);
+  BOOST_CHECK_THROW(part_range(10, 0, 2, 1), InputError);
+  BOOST_CHECK_THROW(part_range(10, 3, 2, 1), InputError);
+  BOOST_CHECK_THROW(part_range(10, 1, 0, 1), InputError);
 }
 
 BOOST_AUTO_TEST_CASE(merge_of_the_parts_equals_the_whole) {
+  // Chains of 2: parts that split the list at chain boundaries compute what the whole does.
   const auto params = contactrom::fom::training_set(hertz(), 7);
-  const SnapshotDatabase whole = contactrom::rom::generate_snapshots(hertz(), params, "train", 7);
+  const SnapshotDatabase whole = contactrom::rom::generate_snapshots(hertz(), params, "train", 7, chains_of_two());
   std::vector<SnapshotDatabase> parts;
   for (int k = 1; k <= 3; ++k) {
-    const auto [begin, end] = part_range(7, k, 3);
+    const auto [begin, end] = part_range(7, k, 3, 2);
     parts.push_back(contactrom::rom::generate_snapshots(
-        hertz(), std::vector<contactrom::fom::Param>(params.begin() + begin, params.begin() + end), "train", 7));
+        hertz(), std::vector<contactrom::fom::Param>(params.begin() + begin, params.begin() + end), "train", 7,
+        chains_of_two()));
   }
   check_same_snapshots(merge_databases(parts, {"a", "b", "c"}), whole);
 }
@@ -64,14 +76,15 @@ BOOST_AUTO_TEST_CASE(merge_of_parts_on_disk_refers_to_them_and_writes_the_whole)
   // Parts read without their primal snapshots are merged by reference (and in
   // another order by append_snapshots); writing copies the snapshots one by one.
   const auto params = contactrom::fom::training_set(hertz(), 7);
-  const SnapshotDatabase whole = contactrom::rom::generate_snapshots(hertz(), params, "train", 7);
+  const SnapshotDatabase whole = contactrom::rom::generate_snapshots(hertz(), params, "train", 7, chains_of_two());
   std::vector<SnapshotDatabase> parts;
   std::vector<std::string> names;
   for (int k = 1; k <= 3; ++k) {
-    const auto [begin, end] = part_range(7, k, 3);
+    const auto [begin, end] = part_range(7, k, 3, 2);
     names.push_back(work_dir() + "/disk_part" + std::to_string(k) + ".h5");
     contactrom::rom::write_database(names.back(), contactrom::rom::generate_snapshots(
-        hertz(), std::vector<contactrom::fom::Param>(params.begin() + begin, params.begin() + end), "train", 7));
+        hertz(), std::vector<contactrom::fom::Param>(params.begin() + begin, params.begin() + end), "train", 7,
+        chains_of_two()));
     parts.push_back(contactrom::rom::read_database(names.back(), false));
   }
   const SnapshotDatabase merged = merge_databases(parts, names);
