@@ -322,7 +322,24 @@ ActiveSetSolver::ActiveSetSolver(const Problem& problem, ActiveSetOptions option
 
 FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) const {
   m_problem.check_param(mu);
-  if (m_constant) return solve_with(*m_constant, mu, warm);
+  const ContactModel& contact = m_problem.contact();
+  // A previous solution that fits: its λ, and its contact response u − u0 (at its own
+  // parameter) on top of this parameter's u0. (One without its parameter counts as
+  // one at this parameter.)
+  const bool use_warm = warm && warm->lambda.size() == contact.num_constraints() && warm->u.size() == m_problem.num_dofs();
+  const auto start = [&](const Condensation& cond) {
+    Eigen::VectorXd x = cond.z_load * m_problem.load_coefficients(mu);
+    if (warm->mu.size() == mu.size() && warm->mu != mu)
+      return Eigen::VectorXd(contact.restrict_to_surface(x) +
+                             contact.restrict_to_surface(warm->u - cond.z_load * m_problem.load_coefficients(warm->mu)));
+    return contact.restrict_to_surface(warm->u);
+  };
+  if (m_constant) {
+    const Eigen::VectorXd x = use_warm ? start(*m_constant) : Eigen::VectorXd();
+    std::vector<ContactAnswer> one;
+    one.push_back(contact_answer(*m_constant, mu, use_warm ? &x : nullptr, use_warm ? &warm->lambda : nullptr));
+    return std::move(finish(*m_constant, std::move(one)).front());
+  }
   const auto t0 = std::chrono::steady_clock::now();
   Condensation cond;
   if (!condense(m_problem, mu, cond, m_order.empty() ? nullptr : &m_order)) {
@@ -332,53 +349,103 @@ FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) con
     s.message = singular_stiffness_message(m_problem);
     return s;
   }
-  FomSolution s = solve_with(cond, mu, warm);
+  const Eigen::VectorXd x = use_warm ? start(cond) : Eigen::VectorXd();
+  std::vector<ContactAnswer> one;
+  one.push_back(contact_answer(cond, mu, use_warm ? &x : nullptr, use_warm ? &warm->lambda : nullptr));
+  FomSolution s = std::move(finish(cond, std::move(one)).front());
   s.time_s = seconds_since(t0);  // includes the per-parameter factorisation
   return s;
 }
 
-FomSolution ActiveSetSolver::solve_with(const Condensation& cond, const Param& mu, const FomSolution* warm) const {
+ContactAnswer ActiveSetSolver::solve_contact(const Param& mu, const ContactAnswer* previous) const {
+  m_problem.check_param(mu);
+  const bool warm = previous && previous->solution.status == Status::Success;
+  if (!m_constant) {  // a factorisation per query: solve() does it all, finish() has nothing left
+    ContactAnswer a;
+    a.solution = solve(mu, warm ? &previous->solution : nullptr);
+    return a;
+  }
+  if (!warm || previous->response_s.size() != static_cast<Eigen::Index>(m_problem.contact().surface_dofs().size()))
+    return contact_answer(*m_constant, mu, nullptr, nullptr);
+  const Eigen::VectorXd x =
+      m_problem.contact().restrict_to_surface(m_constant->z_load * m_problem.load_coefficients(mu)) + previous->response_s;
+  return contact_answer(*m_constant, mu, &x, &previous->solution.lambda);
+}
+
+std::vector<FomSolution> ActiveSetSolver::finish(std::vector<ContactAnswer> answers) const {
+  if (m_constant) return finish(*m_constant, std::move(answers));
+  std::vector<FomSolution> out;
+  for (ContactAnswer& a : answers) out.push_back(std::move(a.solution));
+  return out;
+}
+
+ContactAnswer ActiveSetSolver::contact_answer(const Condensation& cond, const Param& mu, const Eigen::VectorXd* x_s,
+                                              const Eigen::VectorXd* lambda) const {
   const auto t0 = std::chrono::steady_clock::now();
   const ContactModel& contact = m_problem.contact();
-  FomSolution sol;
+  ContactAnswer a;
+  FomSolution& sol = a.solution;
   sol.mu = mu;
   // 1. The unconstrained solution u0(μ): a combination of the condensed load terms.
-  const Eigen::VectorXd u0 = cond.z_load * m_problem.load_coefficients(mu);
-  const Eigen::VectorXd u0_s = contact.restrict_to_surface(u0);
-  // 2. Start from u0, or from a previous solution if one fits: its λ, and its contact
-  //    response u − u0 (at its own parameter) on top of this parameter's u0.
-  const bool use_warm = warm && warm->lambda.size() == contact.num_constraints() && warm->u.size() == m_problem.num_dofs();
-  //    (A solution without its parameter counts as one at this parameter.)
-  Eigen::VectorXd x = u0_s;
-  if (use_warm && warm->mu.size() == mu.size() && warm->mu != mu)
-    x += contact.restrict_to_surface(warm->u - cond.z_load * m_problem.load_coefficients(warm->mu));
-  else if (use_warm)
-    x = contact.restrict_to_surface(warm->u);
+  const Eigen::VectorXd u0_s = contact.restrict_to_surface(cond.z_load * m_problem.load_coefficients(mu));
+  // 2. Start from u0, or from the given surface displacement and multipliers.
+  const Eigen::VectorXd& x = x_s ? *x_s : u0_s;
   // 3. The pairing fixed point around the exact dual QP of each pairing.
   const PairingFixedPointOptions fixed_point = pairing_options(m_options);
-  const PairingFixedPointResult fp =
+  PairingFixedPointResult fp =
       solve_pairing_loop(m_problem, cond, m_options, fixed_point, u0_s, x, contact.search(x),
-                         use_warm ? warm->lambda : Eigen::VectorXd::Zero(contact.num_constraints()), sol.iterations);
-  // 4. The displacement u = u0 − K⁻¹ E_s Cᵀλ (one solve with the factor), certified.
+                         lambda ? *lambda : Eigen::VectorXd::Zero(contact.num_constraints()), sol.iterations);
   sol.pairing_iterations = fp.iterations;
   sol.status = fp.status;
   if (fp.solution.status != Status::Success)
     sol.message = "dual active-set QP failed: " + std::string(to_string(fp.solution.status));
   else if (fp.status != Status::Success)
     sol.message = pairing_no_convergence_message(fp, fixed_point);
-  finish(cond, u0, fp.pairing, fp.c, fp.solution.lambda, sol);
+  sol.lambda = std::move(fp.solution.lambda);
+  sol.pairing = std::move(fp.pairing);
+  a.c = std::move(fp.c);
+  if (fp.solution.surface_displacement.size() == u0_s.size()) a.response_s = fp.solution.surface_displacement - u0_s;
   sol.time_s = seconds_since(t0);
-  return sol;
+  return a;
 }
 
-void ActiveSetSolver::finish(const Condensation& cond, const Eigen::VectorXd& u0, const Pairing& pairing,
-                             const ConstraintMatrix& c, const Eigen::VectorXd& lambda, FomSolution& sol) const {
-  sol.lambda = lambda;
-  sol.pairing = pairing;
-  sol.active = static_cast<int>((sol.lambda.array() > 0.0).count());
-  sol.u = u0;
-  if (sol.active > 0) sol.u -= cond.surface_response(c.transpose() * sol.lambda);
-  certify_fom_solution(m_problem, sol, m_options.kkt_tolerance);
+std::vector<FomSolution> ActiveSetSolver::finish(const Condensation& cond, std::vector<ContactAnswer> answers) const {
+  // 4. The displacements u = u0 − K⁻¹ E_s Cᵀλ: one solve with the factor for all the
+  //    answers that carry pressure, then each certified.
+  const auto t0 = std::chrono::steady_clock::now();
+  const int m = cond.factor->trailing_size();
+  std::vector<int> loaded;
+  for (size_t i = 0; i < answers.size(); ++i) {
+    FomSolution& sol = answers[i].solution;
+    sol.active = static_cast<int>((sol.lambda.array() > 0.0).count());
+    if (sol.active > 0) loaded.push_back(static_cast<int>(i));
+  }
+  Eigen::MatrixXd forces = Eigen::MatrixXd::Zero(m, static_cast<Eigen::Index>(loaded.size()));
+  for (size_t k = 0; k < loaded.size(); ++k) {
+    const ContactAnswer& a = answers[static_cast<size_t>(loaded[k])];
+    const Eigen::VectorXd f = a.c.transpose() * a.solution.lambda;
+    for (size_t j = 0; j < cond.surface_position.size(); ++j)
+      if (cond.surface_position[j] >= 0) forces(cond.surface_position[j], static_cast<Eigen::Index>(k)) += f(j);
+  }
+  const Eigen::MatrixXd x = loaded.empty() ? Eigen::MatrixXd() : cond.factor->solve_trailing(forces);
+  const double shared = seconds_since(t0) / std::max<double>(1.0, static_cast<double>(answers.size()));
+  std::vector<FomSolution> out;
+  out.reserve(answers.size());
+  size_t k = 0;
+  for (size_t i = 0; i < answers.size(); ++i) {
+    const auto t1 = std::chrono::steady_clock::now();
+    FomSolution& sol = answers[i].solution;
+    sol.u = cond.z_load * m_problem.load_coefficients(sol.mu);
+    if (k < loaded.size() && loaded[k] == static_cast<int>(i)) {
+      if (x.cols() == static_cast<Eigen::Index>(loaded.size()))
+        for (size_t r = 0; r < cond.free_dofs.size(); ++r) sol.u(cond.free_dofs[r]) -= x(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k));
+      ++k;
+    }
+    certify_fom_solution(m_problem, sol, m_options.kkt_tolerance);
+    sol.time_s += shared + seconds_since(t1);
+    out.push_back(std::move(sol));
+  }
+  return out;
 }
 
 FomSolution ActiveSetSolver::solve_at(const Param& mu, const Pairing& pairing, const Eigen::VectorXd& x_s) const {
@@ -402,9 +469,14 @@ FomSolution ActiveSetSolver::solve_at(const Param& mu, const Pairing& pairing, c
   sol.pairing_iterations = 1;
   sol.status = at.status;
   if (at.status != Status::Success) sol.message = "dual active-set QP failed: " + std::string(to_string(at.status));
-  finish(*m_constant, u0, pairing, c, at.lambda, sol);
-  sol.time_s = seconds_since(t0);
-  return sol;
+  std::vector<ContactAnswer> one(1);
+  one[0].solution = std::move(sol);
+  one[0].solution.lambda = at.lambda;
+  one[0].solution.pairing = pairing;
+  one[0].c = std::move(c);
+  FomSolution out = std::move(finish(*m_constant, std::move(one)).front());
+  out.time_s = seconds_since(t0);
+  return out;
 }
 
 void certify_fom_solution(const Problem& problem, FomSolution& sol, double tolerance, bool complementarity) {

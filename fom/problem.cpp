@@ -335,6 +335,11 @@ Problem::Problem(ProblemParts parts)
   check_sizes();
   for (int i = 0; i < num_dofs(); ++i)
     if (!m_is_dirichlet[i]) m_free_dofs.push_back(i);
+  for (const SparseMatrix& k : m_k_terms) {
+    Eigen::MatrixXd kl(num_dofs(), num_load_terms());
+    for (int t = 0; t < num_load_terms(); ++t) kl.col(t) = k * m_lift_terms[static_cast<size_t>(t)];
+    m_k_lift.push_back(std::move(kl));
+  }
 }
 
 void Problem::check_sizes() const {
@@ -397,7 +402,8 @@ Eigen::VectorXd Problem::rhs(const Param& mu) const {
   const Eigen::VectorXd phi = load_coefficients(mu);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
   for (int k = 0; k < num_load_terms(); ++k) f += phi(k) * m_fext_terms[k];
-  f -= apply_stiffness(mu, lifting(mu));
+  const Eigen::VectorXd theta = stiffness_coefficients(mu);  // f −= K(μ) lifting(μ)
+  for (int q = 0; q < num_stiffness_terms(); ++q) f.noalias() -= theta(q) * (m_k_lift[static_cast<size_t>(q)] * phi);
   for (int i = 0; i < num_dofs(); ++i)
     if (m_is_dirichlet[i]) f(i) = 0.0;
   return f;

@@ -135,6 +135,9 @@ class Problem {
   std::vector<SparseMatrix> m_k_terms;
   std::vector<AffineExpression> m_k_coeff, m_load_coeff;
   std::vector<Eigen::VectorXd> m_lift_terms, m_fext_terms;
+  /// K_q times the lifting terms (n x T per stiffness term q), for rhs() without a
+  /// product with K per call.
+  std::vector<Eigen::MatrixXd> m_k_lift;
   std::unique_ptr<ContactModel> m_contact;
   SparseMatrix m_h1;
   std::unique_ptr<Mesh> m_mesh;
