@@ -7,6 +7,7 @@
 
 #include <contactrom/core/errors.hpp>
 #include <contactrom/core/format.hpp>
+#include <contactrom/core/parallel_for.hpp>
 #include <contactrom/core/stopwatch.hpp>
 #include <contactrom/fom/pairing_fixed_point.hpp>
 #include <contactrom/fom/rigid_bodies.hpp>
@@ -504,6 +505,27 @@ PairingFixedPointOptions pairing_options(const ActiveSetOptions& options) {
   o.newton_start = options.newton_start;
   o.newton_retry = options.newton_retry;
   return o;
+}
+
+void solve_in_chains(const ActiveSetSolver& solver, const std::vector<Param>& params, int chain, int threads,
+                     const std::function<void(int, FomSolution&&)>& store, const ProgressCallback& progress) {
+  // A chain runs on one worker, item after item: `pending` holds each chain's contact
+  // answers, the last one the start of the next; the chain's last item finishes them.
+  const int n = static_cast<int>(params.size());
+  chain = std::max(chain, 1);
+  std::vector<std::vector<ContactAnswer>> pending(static_cast<size_t>((n + chain - 1) / chain));
+  parallel_for_chains(
+      n, chain, threads,
+      [&](int j) {
+        std::vector<ContactAnswer>& answers = pending[static_cast<size_t>(j / chain)];
+        answers.push_back(solver.solve_contact(params[static_cast<size_t>(j)], answers.empty() ? nullptr : &answers.back()));
+        if ((j + 1) % chain != 0 && j + 1 != n) return;
+        std::vector<FomSolution> solutions = solver.finish(std::move(answers));
+        answers = {};
+        const int first = j + 1 - static_cast<int>(solutions.size());
+        for (size_t k = 0; k < solutions.size(); ++k) store(first + static_cast<int>(k), std::move(solutions[k]));
+      },
+      progress);
 }
 
 }  // namespace contactrom::fom

@@ -25,8 +25,11 @@
 /// solve() is const and thread-safe (no factorisation state is touched per query
 /// when the stiffness is parameter-independent).
 #include <Eigen/Dense>
+#include <functional>
 #include <memory>
+#include <vector>
 
+#include <contactrom/core/parallel_for.hpp>
 #include <contactrom/fom/contact_model.hpp>
 #include <contactrom/fom/dual_qp.hpp>
 #include <contactrom/fom/kkt.hpp>
@@ -188,6 +191,10 @@ struct ContactAnswer {
   ConstraintMatrix c;  ///< the constraint operator of its pairing
 };
 
+/// Length of the continuation chains of solve_in_chains() (the offline stage's
+/// default, rom::OfflineOptions::chain).
+constexpr int kDefaultChain = 8;
+
 /// \brief Custom active-set FOM solver; see the file comment.
 class ActiveSetSolver final : public FullOrderSolver {
  public:
@@ -241,5 +248,17 @@ class ActiveSetSolver final : public FullOrderSolver {
   std::vector<int> m_order;  // otherwise: elimination order reused by every query's factorisation
   double m_setup_time = 0.0;
 };
+
+/// \brief Solves `params` in continuation chains of `chain` consecutive ones on
+/// `threads` worker threads (core/parallel_for.hpp's parallel_for_chains): each chain's
+/// first parameter from scratch, each next one from its predecessor's answer
+/// (ActiveSetSolver::solve_contact), and the chain's displacements by one
+/// back-substitution (ActiveSetSolver::finish). `store(i, solution)` receives every
+/// solution, from the worker thread that finished its chain (each i once; calls for
+/// distinct i may run concurrently). The solutions are the same for any `threads`.
+/// \param progress counts the parameters whose contact answer is done (parallel_for's
+///   contract: from the calling thread; a throw stops the run)
+void solve_in_chains(const ActiveSetSolver& solver, const std::vector<Param>& params, int chain, int threads,
+                     const std::function<void(int, FomSolution&&)>& store, const ProgressCallback& progress = {});
 
 }  // namespace contactrom::fom

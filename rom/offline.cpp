@@ -31,46 +31,34 @@ SnapshotDatabase generate_snapshots(const fom::Problem& problem, const std::vect
   db.pairing_iterations.assign(n, 0);
   db.time_s.assign(n, 0.0);
 
-  // One solver (one factorisation) shared by every worker: solve() is const and
-  // thread-safe. Each task is one chain and writes only its own columns j.
+  // One solver (one factorisation) shared by every worker: it is const and
+  // thread-safe. Each chain writes only its own columns j.
   const fom::ActiveSetSolver solver(problem);
   db.setup_time_s = solver.setup_time();
   const std::vector<char>& dirichlet = problem.is_dirichlet();
-  // A chain runs on one worker, item after item: `pending` holds each chain's answers
-  // on the contact surface, the last one the start of the next; the chain's last item
-  // finishes them all (one back-substitution with a right-hand side per answer).
   const int chain = std::max(options.chain, 1);
   db.threads = std::min(resolve_threads(options.threads), std::max((n + chain - 1) / chain, 1));
-  std::vector<std::vector<fom::ContactAnswer>> pending(static_cast<size_t>((n + chain - 1) / chain));
-  const auto store = [&](int j, const fom::FomSolution& sol) {
-    db.status[j] = sol.status;
-    db.iterations[j] = sol.iterations;
-    db.pairing_iterations[j] = sol.pairing_iterations;
-    db.time_s[j] = sol.time_s;
-    // Primal snapshot u − u_lift(μ), exactly zero on Dirichlet dofs (the lifting
-    // carries the Dirichlet values; rounding differences between the solver's and
-    // the problem's lifting sums are removed here).
-    Eigen::VectorXd col = Eigen::VectorXd::Zero(nd);
-    if (sol.u.size() == nd) {
-      col = sol.u - problem.lifting(params[j]);
-      for (int i = 0; i < nd; ++i)
-        if (dirichlet[i]) col(i) = 0.0;
-    }
-    if (writer)
-      writer->write_primal(j, col);
-    else
-      db.primal.col(j) = col;
-    if (sol.lambda.size() == nc) db.dual.col(j) = sol.lambda;
-  };
-  parallel_for_chains(
-      n, chain, options.threads,
-      [&](int j) {
-        std::vector<fom::ContactAnswer>& answers = pending[static_cast<size_t>(j / chain)];
-        answers.push_back(solver.solve_contact(params[j], answers.empty() ? nullptr : &answers.back()));
-        if ((j + 1) % chain != 0 && j + 1 != n) return;
-        const std::vector<fom::FomSolution> solutions = solver.finish(std::move(answers));
-        answers = {};
-        for (size_t k = 0; k < solutions.size(); ++k) store(j + 1 - static_cast<int>(solutions.size()) + static_cast<int>(k), solutions[k]);
+  fom::solve_in_chains(
+      solver, params, chain, options.threads,
+      [&](int j, fom::FomSolution&& sol) {
+        db.status[j] = sol.status;
+        db.iterations[j] = sol.iterations;
+        db.pairing_iterations[j] = sol.pairing_iterations;
+        db.time_s[j] = sol.time_s;
+        // Primal snapshot u − u_lift(μ), exactly zero on Dirichlet dofs (the lifting
+        // carries the Dirichlet values; rounding differences between the solver's and
+        // the problem's lifting sums are removed here).
+        Eigen::VectorXd col = Eigen::VectorXd::Zero(nd);
+        if (sol.u.size() == nd) {
+          col = sol.u - problem.lifting(params[j]);
+          for (int i = 0; i < nd; ++i)
+            if (dirichlet[i]) col(i) = 0.0;
+        }
+        if (writer)
+          writer->write_primal(j, col);
+        else
+          db.primal.col(j) = col;
+        if (sol.lambda.size() == nc) db.dual.col(j) = sol.lambda;
       },
       options.progress);
   db.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

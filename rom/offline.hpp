@@ -41,8 +41,7 @@
 
 namespace contactrom::rom {
 
-/// Default length of the continuation chains of the offline stage (OfflineOptions::chain).
-constexpr int kDefaultChain = 8;
+using fom::kDefaultChain;  ///< default length of the continuation chains (OfflineOptions::chain)
 
 /// \brief Options of generate_snapshots (documented defaults).
 struct OfflineOptions {

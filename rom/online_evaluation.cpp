@@ -122,8 +122,9 @@ std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& sol
                                                  const std::vector<fom::Param>& params, int threads,
                                                  const ProgressCallback& progress) {
   std::vector<fom::FomSolution> out(params.size());
-  parallel_for(
-      static_cast<int>(params.size()), threads, [&](int i) { out[i] = solver.solve(params[i]); }, progress);
+  fom::solve_in_chains(
+      solver, params, fom::kDefaultChain, threads, [&](int i, fom::FomSolution&& sol) { out[i] = std::move(sol); },
+      progress);
   return out;
 }
 

@@ -25,7 +25,9 @@
 namespace contactrom::rom {
 
 /// \brief FOM reference solutions at `params` (one shared solver, in parallel on
-/// `threads` threads, ≤ 0: hardware concurrency; no warm start).
+/// `threads` threads, ≤ 0: hardware concurrency), in continuation chains of
+/// fom::kDefaultChain as the offline stage (fom::solve_in_chains()): the FOM's answers
+/// to its pairing tolerance, the same for any thread count.
 std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& solver,
                                                  const std::vector<fom::Param>& params, int threads = 0,
                                                  const ProgressCallback& progress = {});
