@@ -328,12 +328,10 @@ FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) con
   // parameter) on top of this parameter's u0. (One without its parameter counts as
   // one at this parameter.)
   const bool use_warm = warm && warm->lambda.size() == contact.num_constraints() && warm->u.size() == m_problem.num_dofs();
-  const auto start = [&](const Condensation& cond) {
-    Eigen::VectorXd x = cond.z_load * m_problem.load_coefficients(mu);
-    if (warm->mu.size() == mu.size() && warm->mu != mu)
-      return Eigen::VectorXd(contact.restrict_to_surface(x) +
-                             contact.restrict_to_surface(warm->u - cond.z_load * m_problem.load_coefficients(warm->mu)));
-    return contact.restrict_to_surface(warm->u);
+  const auto start = [&](const Condensation& cond) -> Eigen::VectorXd {
+    if (warm->mu.size() != mu.size() || warm->mu == mu) return contact.restrict_to_surface(warm->u);
+    return contact.restrict_to_surface(warm->u + cond.z_load * (m_problem.load_coefficients(mu) -
+                                                                m_problem.load_coefficients(warm->mu)));
   };
   if (m_constant) {
     const Eigen::VectorXd x = use_warm ? start(*m_constant) : Eigen::VectorXd();
