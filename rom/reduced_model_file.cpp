@@ -17,6 +17,7 @@
 #include <contactrom/core/version.hpp>
 #include <contactrom/fom/kkt.hpp>
 #include <contactrom/rom/dense_csv.hpp>
+#include <contactrom/rom/fallback.hpp>
 #include <contactrom/rom/hdf5_io.hpp>
 #include <contactrom/rom/online_methods.hpp>
 #include <contactrom/rom/problem_record_io.hpp>
@@ -362,17 +363,31 @@ std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::P
 }
 
 void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results,
-                     const std::vector<std::string>& sources) {
-  write_file_atomically(path, query_csv_writer(rom, results, sources));
+                     const std::vector<FallbackAnswer>& fallback) {
+  write_file_atomically(path, query_csv_writer(rom, results, fallback));
 }
 
+namespace {
+
+/// A CSV field: as it is, or quoted (inner quotes doubled) when it holds a comma, a
+/// quote or a line break.
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+}  // namespace
+
 FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResult>& results,
-                            const std::vector<std::string>& sources) {
-  return [&rom, &results, &sources](std::ostream& out) {
-    const bool with_source = sources.size() == results.size() && !sources.empty();
+                            const std::vector<FallbackAnswer>& fallback) {
+  return [&rom, &results, &fallback](std::ostream& out) {
+    const bool with_fallback = fallback.size() == results.size() && !fallback.empty();
     for (const std::string& name : rom.problem().param_names()) out << name << ',';
     out << "status,converged,iterations,sparsity,contact_force,time_s,selected,coefficients,penetration,separation,primal_estimate,dual_estimate"
-        << (with_source ? ",source\n" : "\n");
+        << (with_fallback ? ",source,fallback_reason,rom_status,rom_primal_estimate,rom_dual_estimate,rom_time_s,fom_time_s\n"
+                          : "\n");
     for (size_t i = 0; i < results.size(); ++i) {
       const OnlineResult& res = results[i];
       for (int k = 0; k < res.mu.size(); ++k) out << format_number(res.mu(k)) << ',';
@@ -385,7 +400,15 @@ FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResu
       for (Eigen::Index j = 0; j < res.coefficients.size(); ++j) out << (j ? " " : "") << format_number(res.coefficients(j));
       out << ',' << format_number(res.contact.penetration) << ',' << format_number(res.contact.complementarity)
           << ',' << format_number(res.primal_estimate) << ',' << format_number(res.dual_estimate);
-      if (with_source) out << ',' << sources[i];
+      if (with_fallback) {
+        // A kept ROM answer is its own reduced answer: its status and estimates.
+        const FallbackAnswer& f = fallback[i];
+        out << ',' << (f.from_fom ? "fom" : "rom") << ',' << csv_field(f.reason) << ','
+            << to_string(f.from_fom ? f.rom_status : res.status) << ','
+            << format_number(f.from_fom ? f.rom_primal_estimate : res.primal_estimate) << ','
+            << format_number(f.from_fom ? f.rom_dual_estimate : res.dual_estimate) << ',' << format_number(f.rom_time_s)
+            << ',' << format_number(f.fom_time_s);
+      }
       out << '\n';
     }
   };

@@ -88,17 +88,21 @@ class OnlineModel {
 /// problem's range. \throws InputError naming the file, the line and the value.
 std::vector<fom::Param> read_parameter_csv(const std::string& path, const fom::Problem& problem);
 
+struct FallbackAnswer;  // rom/fallback.hpp
+
 /// \brief Writes one CSV row per query (atomically): one column per parameter (named
 /// after it), then status, converged (0/1), iterations, sparsity, contact_force
 /// (Σ weights · pressure), time_s (online core), selected (space-separated database
-/// snapshot indices) and coefficients (space-separated, in the order of `selected`).
-/// With `sources` (one word per result, e.g. "rom" or "fom" from `query --fallback fom`)
-/// a last column `source` names where each answer came from.
+/// snapshot indices) and coefficients (space-separated, in the order of `selected`),
+/// penetration, separation, primal_estimate and dual_estimate. With `fallback` (one
+/// answer per result, from `query --fallback fom`), the columns of its JSON: source
+/// (`rom` or `fom`), fallback_reason (empty when the ROM's answer was kept; quoted),
+/// rom_status, rom_primal_estimate, rom_dual_estimate, rom_time_s and fom_time_s.
 void write_query_csv(const std::string& path, const OnlineModel& rom, const std::vector<OnlineResult>& results,
-                     const std::vector<std::string>& sources = {});
+                     const std::vector<FallbackAnswer>& fallback = {});
 
 /// \brief The content of write_query_csv() (for a set of files published together).
 FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResult>& results,
-                            const std::vector<std::string>& sources = {});
+                            const std::vector<FallbackAnswer>& fallback = {});
 
 }  // namespace contactrom::rom

@@ -78,14 +78,12 @@ void run_query(const QueryArgs& a) {
   if (use_fom) fallback.emplace(rom.solver(), fallback_options);
   std::vector<rom::OnlineResult> results;
   std::vector<rom::FallbackAnswer> answers;
-  std::vector<std::string> sources;
   std::vector<double> times;
   int failed = 0, from_fom = 0;
   for (const fom::Param& mu : params) {
     if (use_fom) {
       answers.push_back(fallback->solve(mu));
       results.push_back(answers.back().result);
-      sources.push_back(answers.back().from_fom ? "fom" : "rom");
       from_fom += answers.back().from_fom ? 1 : 0;
       // A FOM answer is warned about as `fom` warns (elements turned inside out).
       for (const std::string& w : answers.back().warnings)
@@ -107,10 +105,10 @@ void run_query(const QueryArgs& a) {
                       &results[i].lambda});
     }
     std::vector<std::pair<std::string, FileWriter>> csv;
-    if (!a.out.empty()) csv.emplace_back(a.out, rom::query_csv_writer(rom, results, sources));
+    if (!a.out.empty()) csv.emplace_back(a.out, rom::query_csv_writer(rom, results, answers));
     fom::write_field_sets(a.fields, problem, sets, csv);
   } else if (!a.out.empty()) {
-    rom::write_query_csv(a.out, rom, results, sources);
+    rom::write_query_csv(a.out, rom, results, answers);
   }
   nlohmann::json j;
   j["problem"] = problem.name();
