@@ -251,4 +251,17 @@ void check_contact_pairs_face(const Problem& problem) {
   }
 }
 
+std::string solutions_warning(const Problem& problem, const std::vector<Param>& params,
+                              const std::vector<std::vector<std::string>>& warnings, const std::string& what) {
+  size_t first = warnings.size(), warned = 0;
+  for (size_t i = 0; i < warnings.size(); ++i) {
+    if (warnings[i].empty()) continue;
+    if (warned++ == 0) first = i;
+  }
+  if (warned == 0 || first >= params.size()) return "";
+  return std::to_string(warned) + " of the " + std::to_string(warnings.size()) + " " + what + " of " +
+         quoted(problem.name(), 200) + " carry warnings; the first, at " + problem.parameters().text(params[first]) +
+         ": " + warnings[first].front();
+}
+
 }  // namespace contactrom::fom

@@ -36,6 +36,12 @@ std::vector<std::string> reference_contact_warnings(const Problem& problem);
 /// meets its KKT conditions. Empty when no element is inverted, and for the rope.
 std::vector<std::string> solution_warnings(const Problem& problem, const Eigen::VectorXd& u);
 
+/// \brief One line about a list of FOM solutions whose solution_warnings() are
+/// `warnings` (one list per solution, at `params`): "K of the N <what> of '<problem>'
+/// carry warnings; the first, at d = 0.2: <its first warning>", or "" when none does.
+std::string solutions_warning(const Problem& problem, const std::vector<Param>& params,
+                              const std::vector<std::vector<std::string>>& warnings, const std::string& what);
+
 /// \brief Throws InputError naming the pair unless every contact pair has at least
 /// one slave node facing its master curve or surface (paired) in the reference configuration:
 /// a pair none of whose nodes is ever paired enforces nothing.

@@ -288,15 +288,10 @@ on mu) or "ipopt" (the interior-point reference). ValueError for another name.)d
                            [&](int i) { out[i] = finish(*s.problem, s.solve(ps[i])); }, interrupt_check());
             }
             // One warning for the list: how many solutions carry warnings, and the first.
-            size_t first = out.size(), warned = 0;
-            for (size_t i = 0; i < out.size(); ++i) {
-              if (out[i].warnings.empty()) continue;
-              if (warned++ == 0) first = i;
-            }
-            if (warned > 0)
-              runtime_warning(std::to_string(warned) + " of the " + std::to_string(out.size()) + " FOM solutions of " +
-                              quoted(s.problem->name(), 200) + " carry warnings (FomSolution.warnings); the first, at " +
-                              s.problem->parameters().text(ps[first]) + ": " + out[first].warnings.front());
+            std::vector<std::vector<std::string>> warnings;
+            for (const FomResult& r : out) warnings.push_back(r.warnings);
+            const std::string line = fom::solutions_warning(*s.problem, ps, warnings, "FOM solutions");
+            if (!line.empty()) runtime_warning(line + " (FomSolution.warnings lists them)");
             return out;
           },
           py::arg("params"), py::arg("threads") = 0,

@@ -499,14 +499,17 @@ tolerances.)doc")
             const std::vector<fom::Param> ps =
                 params.is_none() ? rom::database_validation_set(*r.db, problem) : to_params(problem, params);
             rom::EvaluationSummary s;
+            std::string warning;
             {
               py::gil_scoped_release release;
               const fom::ActiveSetSolver fom_solver(problem);
               const std::vector<fom::FomSolution> refs = rom::compute_references(fom_solver, ps, threads, interrupt_check());
+              warning = rom::references_warning(problem, ps, refs);
               rom::EvaluationOptions options;
               options.kkt = kkt;
               s = rom::evaluate_online(r.rom->solver(), ps, refs, options);
             }
+            if (!warning.empty()) runtime_warning(warning);
             return summary_dict(s, problem);
           },
           py::arg("params") = py::none(), py::arg("threads") = 0, py::arg("kkt") = false, R"doc(

@@ -8,6 +8,7 @@
 
 #include <contactrom/core/atomic_file.hpp>
 #include <contactrom/core/format.hpp>
+#include <contactrom/fom/contact_checks.hpp>
 #include <contactrom/rom/online_timing.hpp>
 
 namespace contactrom::rom {
@@ -126,6 +127,14 @@ std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& sol
       solver, params, fom::kDefaultChain, threads, [&](int i, fom::FomSolution&& sol) { out[i] = std::move(sol); },
       progress);
   return out;
+}
+
+std::string references_warning(const fom::Problem& problem, const std::vector<fom::Param>& params,
+                               const std::vector<fom::FomSolution>& references) {
+  std::vector<std::vector<std::string>> warnings;
+  for (const fom::FomSolution& ref : references) warnings.push_back(fom::solution_warnings(problem, ref.u));
+  const std::string line = fom::solutions_warning(problem, params, warnings, "FOM references");
+  return line.empty() ? line : line + " (the errors measured against those mean little)";
 }
 
 EvaluationSummary evaluate_online(const OnlineSolver& solver, const std::vector<fom::Param>& params,

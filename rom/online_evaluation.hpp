@@ -32,6 +32,12 @@ std::vector<fom::FomSolution> compute_references(const fom::ActiveSetSolver& sol
                                                  const std::vector<fom::Param>& params, int threads = 0,
                                                  const ProgressCallback& progress = {});
 
+/// \brief The warning about `references` (compute_references() at `params`) whose
+/// solutions turn elements inside out (fom::solution_warnings(): errors measured against
+/// them mean little), as `online --validation` prints it; "" when none does.
+std::string references_warning(const fom::Problem& problem, const std::vector<fom::Param>& params,
+                               const std::vector<fom::FomSolution>& references);
+
 /// \brief One evaluated query.
 struct EvaluationRow {
   fom::Param mu;

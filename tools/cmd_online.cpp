@@ -115,6 +115,8 @@ void run_validation(const OnlineArgs& a, const fom::Problem& problem, const rom:
     refs = rom::compute_references(fom_solver, params, a.threads, [&bar](int done, int total) { bar.update(done, total); });
     bar.finish();
   }
+  if (const std::string w = rom::references_warning(problem, params, refs); !w.empty())
+    std::cerr << "contactrom: warning: " << w << "\n";
   rom::EvaluationOptions options;
   options.kkt = a.kkt;
   ProgressBar bar(std::cerr, "online: reduced queries", show);

@@ -1,6 +1,7 @@
 """Problems made from files: meshing releases the GIL and stops on Ctrl-C, and the
 warnings the CLI prints about a problem and a FOM solution reach Python."""
 import os
+import re
 import signal
 import threading
 import time
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 
 import contactrom
-from conftest import run_cli_json
+from conftest import run_cli, run_cli_json
 
 # Two quad blocks, the bottom one [0, 1] x [0, 0.5] clamped at its base, the top one
 # [0, 1] x [y0, y0 + 0.5] pressed down by d at its top; the top's base is the slave.
@@ -176,6 +177,15 @@ def test_solution_that_turns_elements_inside_out_is_warned_about(tmp_path):
     with pytest.warns(RuntimeWarning, match=r"FOM solution of 'blocks' at d = 1\.2: the solution turns"):
         answer = fallback.solve(1.2)
     assert answer["source"] == "fom" and answer["warnings"] == large.warnings
+    # Errors measured against such references are flagged, by Python and by the CLI.
+    message = r"1 of the 2 FOM references of 'blocks' carry warnings; the first, at d = 1\.2: the solution turns"
+    with pytest.warns(RuntimeWarning, match=message):
+        contactrom.ReducedModel(db).evaluate([[0.05], [1.2]], threads=1)
+    contactrom.offline(problem, 2, threads=1).save(tmp_path / "blocks.h5")
+    (tmp_path / "params.csv").write_text("d\n0.05\n1.2\n")
+    proc = run_cli("online", "--db", str(tmp_path / "blocks.h5"), "--validation", "--params",
+                   str(tmp_path / "params.csv"))
+    assert re.search("contactrom: warning: " + message, proc.stderr), proc.stderr
 
 
 def test_verify_refuses_a_reference_of_another_problem_of_the_same_sizes(tmp_path):
