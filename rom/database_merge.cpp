@@ -58,7 +58,7 @@ std::pair<int, int> part_range(int n, int k, int parts, int chain) {
   if (parts < 1 || k < 1 || k > parts)
     throw InputError("part " + std::to_string(k) + "/" + std::to_string(parts) + " invalid; expected k/K with 1 <= k <= K");
   const long long c = std::max(chain, 1), chains = (n + c - 1) / c;
-  const auto end = [&](long long k) { return static_cast<int>(std::min<long long>(n, k * chains / parts * c)); };
+  const auto end = [&](long long part) { return static_cast<int>(std::min<long long>(n, part * chains / parts * c)); };
   return {end(k - 1), end(k)};
 }
 

@@ -56,7 +56,6 @@ std::vector<std::string> gather_paths(const std::string& path, int rank, int siz
   return out;
 }
 
-/// Number of parameters rank r computes under the cyclic assignment.
 /// The parameters of rank `rank` of `size`: the chains c ≡ rank (mod size) of length
 /// `chain` (generate_snapshots' continuation), whole, in increasing order.
 std::vector<int> rank_share(int n, int chain, int rank, int size) {
