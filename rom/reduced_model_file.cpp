@@ -401,13 +401,10 @@ FileWriter query_csv_writer(const OnlineModel& rom, const std::vector<OnlineResu
       out << ',' << format_number(res.contact.penetration) << ',' << format_number(res.contact.complementarity)
           << ',' << format_number(res.primal_estimate) << ',' << format_number(res.dual_estimate);
       if (with_fallback) {
-        // A kept ROM answer is its own reduced answer: its status and estimates.
         const FallbackAnswer& f = fallback[i];
-        out << ',' << (f.from_fom ? "fom" : "rom") << ',' << csv_field(f.reason) << ','
-            << to_string(f.from_fom ? f.rom_status : res.status) << ','
-            << format_number(f.from_fom ? f.rom_primal_estimate : res.primal_estimate) << ','
-            << format_number(f.from_fom ? f.rom_dual_estimate : res.dual_estimate) << ',' << format_number(f.rom_time_s)
-            << ',' << format_number(f.fom_time_s);
+        out << ',' << (f.from_fom ? "fom" : "rom") << ',' << csv_field(f.reason) << ',' << to_string(f.rom_status) << ','
+            << format_number(f.rom_primal_estimate) << ',' << format_number(f.rom_dual_estimate) << ','
+            << format_number(f.rom_time_s) << ',' << format_number(f.fom_time_s);
       }
       out << '\n';
     }
