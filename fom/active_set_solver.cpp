@@ -324,21 +324,20 @@ ActiveSetSolver::ActiveSetSolver(const Problem& problem, ActiveSetOptions option
 FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) const {
   m_problem.check_param(mu);
   const ContactModel& contact = m_problem.contact();
-  // A previous solution that fits: its λ, and its contact response u − u0 (at its own
-  // parameter) on top of this parameter's u0. (One without its parameter counts as
-  // one at this parameter.)
+  // A previous solution that fits: its λ, and its contact response u − u0 at its own
+  // parameter (one without its parameter counts as one at this parameter).
   const bool use_warm = warm && warm->lambda.size() == contact.num_constraints() && warm->u.size() == m_problem.num_dofs();
-  const auto start = [&](const Condensation& cond) -> Eigen::VectorXd {
-    if (warm->mu.size() != mu.size() || warm->mu == mu) return contact.restrict_to_surface(warm->u);
-    return contact.restrict_to_surface(warm->u + cond.z_load * (m_problem.load_coefficients(mu) -
-                                                                m_problem.load_coefficients(warm->mu)));
+  const auto response = [&](const Condensation& cond) -> Eigen::VectorXd {
+    const Param& at = warm->mu.size() == mu.size() ? warm->mu : mu;
+    return contact.restrict_to_surface(warm->u - cond.z_load * m_problem.load_coefficients(at));
   };
-  if (m_constant) {
-    const Eigen::VectorXd x = use_warm ? start(*m_constant) : Eigen::VectorXd();
+  const auto solve_one = [&](const Condensation& cond) {
+    const Eigen::VectorXd r = use_warm ? response(cond) : Eigen::VectorXd();
     std::vector<ContactAnswer> one;
-    one.push_back(contact_answer(*m_constant, mu, use_warm ? &x : nullptr, use_warm ? &warm->lambda : nullptr));
-    return std::move(finish(*m_constant, std::move(one)).front());
-  }
+    one.push_back(contact_answer(cond, mu, use_warm ? &r : nullptr, use_warm ? &warm->lambda : nullptr));
+    return std::move(finish(cond, std::move(one)).front());
+  };
+  if (m_constant) return solve_one(*m_constant);
   const auto t0 = std::chrono::steady_clock::now();
   Condensation cond;
   if (!condense(m_problem, mu, cond, m_order.empty() ? nullptr : &m_order)) {
@@ -348,10 +347,7 @@ FomSolution ActiveSetSolver::solve(const Param& mu, const FomSolution* warm) con
     s.message = singular_stiffness_message(m_problem);
     return s;
   }
-  const Eigen::VectorXd x = use_warm ? start(cond) : Eigen::VectorXd();
-  std::vector<ContactAnswer> one;
-  one.push_back(contact_answer(cond, mu, use_warm ? &x : nullptr, use_warm ? &warm->lambda : nullptr));
-  FomSolution s = std::move(finish(cond, std::move(one)).front());
+  FomSolution s = solve_one(cond);
   s.time_s = seconds_since(t0);  // includes the per-parameter factorisation
   return s;
 }
@@ -364,11 +360,10 @@ ContactAnswer ActiveSetSolver::solve_contact(const Param& mu, const ContactAnswe
     a.solution = solve(mu, warm ? &previous->solution : nullptr);
     return a;
   }
-  if (!warm || previous->response_s.size() != static_cast<Eigen::Index>(m_problem.contact().surface_dofs().size()))
-    return contact_answer(*m_constant, mu, nullptr, nullptr);
-  const Eigen::VectorXd x =
-      m_problem.contact().restrict_to_surface(m_constant->z_load * m_problem.load_coefficients(mu)) + previous->response_s;
-  return contact_answer(*m_constant, mu, &x, &previous->solution.lambda);
+  const bool fits =
+      warm && previous->response_s.size() == static_cast<Eigen::Index>(m_problem.contact().surface_dofs().size());
+  return contact_answer(*m_constant, mu, fits ? &previous->response_s : nullptr,
+                        fits ? &previous->solution.lambda : nullptr);
 }
 
 std::vector<FomSolution> ActiveSetSolver::finish(std::vector<ContactAnswer> answers) const {
@@ -378,8 +373,8 @@ std::vector<FomSolution> ActiveSetSolver::finish(std::vector<ContactAnswer> answ
   return out;
 }
 
-ContactAnswer ActiveSetSolver::contact_answer(const Condensation& cond, const Param& mu, const Eigen::VectorXd* x_s,
-                                              const Eigen::VectorXd* lambda) const {
+ContactAnswer ActiveSetSolver::contact_answer(const Condensation& cond, const Param& mu,
+                                              const Eigen::VectorXd* response_s, const Eigen::VectorXd* lambda) const {
   const auto t0 = std::chrono::steady_clock::now();
   const ContactModel& contact = m_problem.contact();
   ContactAnswer a;
@@ -387,8 +382,8 @@ ContactAnswer ActiveSetSolver::contact_answer(const Condensation& cond, const Pa
   sol.mu = mu;
   // 1. The unconstrained solution u0(μ): a combination of the condensed load terms.
   const Eigen::VectorXd u0_s = contact.restrict_to_surface(cond.z_load * m_problem.load_coefficients(mu));
-  // 2. Start from u0, or from the given surface displacement and multipliers.
-  const Eigen::VectorXd& x = x_s ? *x_s : u0_s;
+  // 2. Start from u0, or from u0 plus a neighbour's contact response, with its multipliers.
+  const Eigen::VectorXd x = response_s ? Eigen::VectorXd(u0_s + *response_s) : u0_s;
   // 3. The pairing fixed point around the exact dual QP of each pairing.
   const PairingFixedPointOptions fixed_point = pairing_options(m_options);
   PairingFixedPointResult fp =

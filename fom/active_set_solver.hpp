@@ -234,9 +234,10 @@ class ActiveSetSolver final : public FullOrderSolver {
   const Problem& problem() const { return m_problem; }
 
  private:
-  /// The pairing loop at `mu` with `cond`, from the surface displacement `x_s` (nullptr:
-  /// the unconstrained solution) and the multipliers `lambda` (nullptr: zero).
-  ContactAnswer contact_answer(const Condensation& cond, const Param& mu, const Eigen::VectorXd* x_s,
+  /// The pairing loop at `mu` with `cond`, from the unconstrained solution plus a
+  /// neighbour's contact response `response_s` on the surface dofs (nullptr: none) and
+  /// the multipliers `lambda` (nullptr: zero).
+  ContactAnswer contact_answer(const Condensation& cond, const Param& mu, const Eigen::VectorXd* response_s,
                                const Eigen::VectorXd* lambda) const;
   /// u = u0 − K⁻¹ E_s Cᵀλ of every answer (one back-substitution for all), certified
   /// (certify_fom_solution()); adds the time to each answer's time_s.
