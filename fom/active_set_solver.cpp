@@ -9,103 +9,13 @@
 #include <contactrom/core/format.hpp>
 #include <contactrom/core/parallel_for.hpp>
 #include <contactrom/core/stopwatch.hpp>
+#include <contactrom/fom/contact_zone.hpp>
+#include <contactrom/fom/delassus.hpp>
 #include <contactrom/fom/pairing_fixed_point.hpp>
 #include <contactrom/fom/rigid_bodies.hpp>
 
 namespace contactrom::fom {
 namespace {
-
-/// dst = Σ_k v[k] src[k] (accumulate: dst + Σ_k …) over n entries, the terms added
-/// one after the other in k's order for every entry, as a sequence of axpys would,
-/// but with one pass over dst instead of one per term.
-template <int K>
-void combine_columns(double* dst, const double* const* src, const double* v, Eigen::Index n, bool accumulate) {
-  for (Eigen::Index i = 0; i < n; ++i) {
-    double sum = accumulate ? dst[i] + v[0] * src[0][i] : v[0] * src[0][i];
-    for (int k = 1; k < K; ++k) sum += v[k] * src[k][i];
-    dst[i] = sum;
-  }
-}
-
-/// The entries of row `r` of `c`: positions begin … end of its inner index and value arrays.
-std::pair<int, int> row_entries(const ConstraintMatrix& c, int r) {
-  const int begin = c.outerIndexPtr()[r];
-  return {begin, c.isCompressed() ? c.outerIndexPtr()[r + 1] : begin + c.innerNonZeroPtr()[r]};
-}
-
-/// S C_Wᵀ (n_s x |W|) for the constraint rows W: column a is the sum of the
-/// columns of the symmetric S picked by row W[a]'s entries (six for a 2D
-/// node-to-segment row), taken in the row's order, eight at a time.
-void delassus_parts(const ConstraintMatrix& c, const std::vector<int>& rows, const Eigen::MatrixXd& s,
-                    Eigen::MatrixXd& sct) {
-  const Eigen::Index n = s.rows();
-  sct.resize(n, static_cast<Eigen::Index>(rows.size()));
-  const int* inner = c.innerIndexPtr();
-  const double* value = c.valuePtr();
-  for (size_t a = 0; a < rows.size(); ++a) {
-    double* dst = sct.col(static_cast<Eigen::Index>(a)).data();
-    const auto [begin, end] = row_entries(c, rows[a]);
-    if (begin == end) {
-      std::fill(dst, dst + n, 0.0);
-      continue;
-    }
-    for (int first = begin; first < end; first += 8) {
-      const double* src[8];
-      const int count = std::min(8, end - first);
-      for (int k = 0; k < count; ++k) src[k] = s.col(inner[first + k]).data();
-      const bool accumulate = first > begin;
-      switch (count) {
-        case 1: combine_columns<1>(dst, src, value + first, n, accumulate); break;
-        case 2: combine_columns<2>(dst, src, value + first, n, accumulate); break;
-        case 3: combine_columns<3>(dst, src, value + first, n, accumulate); break;
-        case 4: combine_columns<4>(dst, src, value + first, n, accumulate); break;
-        case 5: combine_columns<5>(dst, src, value + first, n, accumulate); break;
-        case 6: combine_columns<6>(dst, src, value + first, n, accumulate); break;
-        case 7: combine_columns<7>(dst, src, value + first, n, accumulate); break;
-        default: combine_columns<8>(dst, src, value + first, n, accumulate); break;
-      }
-    }
-  }
-}
-
-/// G_W = C_W S C_Wᵀ from S C_Wᵀ (|W| x |W|): entry (a, b) is row W[a] applied to
-/// column b of S C_Wᵀ, its terms added in the row's order. Four columns at a time,
-/// every row against them before the next four (they stay in cache): each entry is
-/// a chain of dependent additions, and four chains run side by side.
-Eigen::MatrixXd delassus(const ConstraintMatrix& c, const std::vector<int>& rows, const Eigen::MatrixXd& sct) {
-  const int nw = static_cast<int>(rows.size());
-  const Eigen::Index ld = sct.rows();
-  const int* inner = c.innerIndexPtr();
-  const double* value = c.valuePtr();
-  Eigen::MatrixXd g(nw, nw);
-  int b = 0;
-  for (; b + 4 <= nw; b += 4) {
-    const double* col = sct.col(b).data();
-    for (int a = 0; a < nw; ++a) {
-      double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-      const auto [begin, end] = row_entries(c, rows[a]);
-      for (int k = begin; k < end; ++k) {
-        const double v = value[k];
-        const double* x = col + inner[k];
-        s0 += v * x[0];
-        s1 += v * x[ld];
-        s2 += v * x[2 * ld];
-        s3 += v * x[3 * ld];
-      }
-      g(a, b) = s0, g(a, b + 1) = s1, g(a, b + 2) = s2, g(a, b + 3) = s3;
-    }
-  }
-  for (; b < nw; ++b) {
-    const double* col = sct.col(b).data();
-    for (int a = 0; a < nw; ++a) {
-      double sum = 0.0;
-      const auto [begin, end] = row_entries(c, rows[a]);
-      for (int k = begin; k < end; ++k) sum += value[k] * col[inner[k]];
-      g(a, b) = sum;
-    }
-  }
-  return g;
-}
 
 /// The dual QP of one pairing on a working set W of rows (see
 /// ActiveSetOptions::working_set_margin): rows active or, at the iterate x, within
@@ -265,19 +175,23 @@ PairingFixedPointResult solve_pairing_loop(const Problem& problem, const Condens
                                            const PairingFixedPointOptions& fixed_point, const Eigen::VectorXd& u0_s,
                                            const Eigen::VectorXd& x_s, Pairing pairing,
                                            const Eigen::VectorXd& lambda_start, int& iterations,
-                                           const SearchMemory* memory) {
+                                           const SearchMemory* memory, int* zone_iterations) {
   const ContactModel& contact = problem.contact();
   WorkingSetQp qp(problem, cond, options, u0_s, lambda_start);
-  return solve_pairing_fixed_point(
+  int zone_steps = 0;
+  PairingFixedPointResult fp = solve_pairing_fixed_point(
       contact, problem.displacement_scale(), x_s, std::move(pairing), fixed_point,
       [&](const Pairing& p, const ConstraintMatrix& c, const Eigen::VectorXd& g, const Eigen::VectorXd& xk) {
         return qp.solve(p, c, g, xk, iterations);
       },
-      [&](const Pairing& p, const ConstraintMatrix& c, const PairedSolution& at, const Pairing& next, Pairing& out) {
-        return newton_pairing(contact, cond.s, p, c, at.lambda, at.surface_displacement, next,
-                              options.newton_max_active, out);
+      [&](const Pairing&, const ConstraintMatrix&, const PairedSolution& at, const Pairing& next, double,
+          const SearchMemory& search_memory, Pairing& out) {
+        return contact_zone_step(contact, cond.s, u0_s, problem.displacement_scale(), at, next, search_memory,
+                                 options.zone, out, zone_steps);
       },
       memory ? *memory : SearchMemory());
+  if (zone_iterations) *zone_iterations += zone_steps;
+  return fp;
 }
 
 Eigen::MatrixXd unconstrained_load_responses(const Problem& problem, const Param& mu) {
@@ -388,7 +302,8 @@ ContactAnswer ActiveSetSolver::contact_answer(const Condensation& cond, const Pa
   const PairingFixedPointOptions fixed_point = pairing_options(m_options);
   PairingFixedPointResult fp =
       solve_pairing_loop(m_problem, cond, m_options, fixed_point, u0_s, x, contact.search(x),
-                         lambda ? *lambda : Eigen::VectorXd::Zero(contact.num_constraints()), sol.iterations);
+                         lambda ? *lambda : Eigen::VectorXd::Zero(contact.num_constraints()), sol.iterations,
+                         nullptr, &sol.zone_iterations);
   sol.pairing_iterations = fp.iterations;
   sol.status = fp.status;
   if (fp.solution.status != Status::Success)
@@ -495,8 +410,8 @@ PairingFixedPointOptions pairing_options(const ActiveSetOptions& options) {
   o.tolerance = options.pairing_tolerance;
   o.anderson_depth = options.anderson_depth;
   o.anderson_restart = options.anderson_restart;
-  o.newton_start = options.newton_start;
-  o.newton_retry = options.newton_retry;
+  o.zone_start = options.zone_start;
+  o.zone_retry = options.zone_retry;
   return o;
 }
 

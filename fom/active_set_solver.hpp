@@ -34,7 +34,7 @@
 #include <contactrom/fom/dual_qp.hpp>
 #include <contactrom/fom/kkt.hpp>
 #include <contactrom/fom/pairing_fixed_point.hpp>
-#include <contactrom/fom/pairing_newton.hpp>
+#include <contactrom/fom/contact_zone.hpp>
 #include <contactrom/fom/problem.hpp>
 #include <contactrom/fom/sparse_cholesky.hpp>
 
@@ -48,7 +48,9 @@ struct FomSolution {
   Pairing pairing;          ///< pairing of the final constraint operator
   Status status = Status::Success;
   int iterations = 0;          ///< active-set iterations, summed over the pairing loop
-  int pairing_iterations = 0;  ///< pairing fixed-point iterations
+  int pairing_iterations = 0;  ///< pairing fixed-point iterations (solves of every row)
+  /// solves of the contact zone alone within them (fom/contact_zone.hpp), summed
+  int zone_iterations = 0;
   int active = 0;              ///< number of rows with λ > 0
   double time_s = 0.0;         ///< wall time of the query (factorisation reused)
   std::string message;         ///< reason when status != Success
@@ -103,17 +105,15 @@ struct ActiveSetOptions {
   /// early iterates of a sliding contact jump (ironing: 16.2 → 14.1 mean pairing
   /// iterations with the history kept; hertz never grows and is unchanged).
   bool anderson_restart = false;
-  /// Newton steps on the pairing (fom/pairing_newton.hpp; 2D node-to-segment contact)
-  /// once the pairing change is at most this; 0: Anderson steps only. Default 0.3.
-  double newton_start = 0.3;
-  /// After a Newton step that did not reduce the pairing change, Newton steps resume
-  /// once Anderson steps bring it below this fraction of its value there; 0: Anderson
-  /// for the rest of the solve. Default 0.5.
-  double newton_retry = 0.5;
-  /// ... while at most this many rows carry pressure: a Newton step costs O(|A|³)
-  /// against O(n_s |W|) for an Anderson step, and pays only for small contact zones
-  /// (measured: ironing, 6 rows, yes; hertz, 27 rows, no). Default 16.
-  int newton_max_active = 16;
+  /// Steps on the contact zone alone (fom/contact_zone.hpp; 2D node-to-segment
+  /// contact) once the pairing change is at most this; 0: Anderson steps only.
+  /// Default 0.3.
+  double zone_start = 0.3;
+  /// After a zone step whose proposal did not reduce the pairing change, zone steps
+  /// resume once Anderson steps bring it below this fraction of its value there; 0:
+  /// Anderson for the rest of the solve. Default 0.5.
+  double zone_retry = 0.5;
+  ContactZoneOptions zone;  ///< options of the zone's steps (Anderson or Newton, tolerance)
   /// Largest relative KKT residual of a solution reported as success
   /// (certify_fom_solution()); default kFomKktTolerance = 1e-6.
   double kkt_tolerance = kFomKktTolerance;
@@ -160,11 +160,12 @@ PairedSolution solve_at_pairing(const Problem& problem, const Condensation& cond
                                 const Eigen::VectorXd& lambda_start, int& iterations);
 
 /// \brief The pairing fixed point options of the FOM's ActiveSetOptions (cap,
-/// tolerance, Anderson depth and restart, Newton start).
+/// tolerance, Anderson depth and restart, zone start and retry).
 PairingFixedPointOptions pairing_options(const ActiveSetOptions& options);
 
 /// \brief The FOM's pairing loop, as solve() runs it: the pairing fixed point
-/// (fom/pairing_fixed_point.hpp, Anderson and Newton steps on the pairing) around
+/// (fom/pairing_fixed_point.hpp, Anderson steps and the contact zone's steps,
+/// fom/contact_zone.hpp) around
 /// the working-set dual QP of each pairing, from the surface displacement `x_s`
 /// paired at `pairing` and the multipliers `lambda_start`, capped by
 /// `fixed_point.max_iterations`. Mesh-size free (S and the surface only). Used by
@@ -174,12 +175,13 @@ PairingFixedPointOptions pairing_options(const ActiveSetOptions& options);
 /// \param iterations incremented by the QPs' active-set iterations
 /// \param memory memory of a search made near x_s (the one that found `pairing`), or
 ///   nullptr: the loop's searches start from it (same pairings, less searching)
+/// \param zone_iterations incremented by the solves of the contact zone's steps, or nullptr
 PairingFixedPointResult solve_pairing_loop(const Problem& problem, const Condensation& cond,
                                            const ActiveSetOptions& options,
                                            const PairingFixedPointOptions& fixed_point, const Eigen::VectorXd& u0_s,
                                            const Eigen::VectorXd& x_s, Pairing pairing,
                                            const Eigen::VectorXd& lambda_start, int& iterations,
-                                           const SearchMemory* memory = nullptr);
+                                           const SearchMemory* memory = nullptr, int* zone_iterations = nullptr);
 
 /// \brief What ActiveSetSolver::solve_contact() leaves for ActiveSetSolver::finish():
 /// a query's answer on the contact surface, before its displacement.

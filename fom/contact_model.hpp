@@ -145,6 +145,16 @@ class ContactModel {
     (void)u_surface, (void)pairing, (void)rows, (void)out;
     return false;
   }
+  /// \brief The surface dofs (column indices of C, ascending) that the pairing of the
+  /// listed rows reads — their slave nodes', and the master nodes' that the segments
+  /// and normals depend on — while each row stays within `reach` segments of its
+  /// segment in `pairing` (all listed rows paired). Returns false when the model
+  /// cannot say (node-to-face contact, obstacles).
+  virtual bool pairing_support(const Pairing& pairing, const std::vector<int>& rows, int reach,
+                               std::vector<int>& dofs) const {
+    (void)pairing, (void)rows, (void)reach, (void)dofs;
+    return false;
+  }
   /// \brief Sets the listed rows of `pairing` to the coordinates `q` (as
   /// linearise_pairing() numbers them). Only for models whose linearise_pairing() succeeds.
   virtual void move_pairing(Pairing& pairing, const std::vector<int>& rows, const Eigen::VectorXd& q) const {
@@ -202,6 +212,8 @@ class NodeToSegmentContact final : public ContactModel {
   bool linearise_pairing(const Eigen::VectorXd& u_surface, const Pairing& pairing, const std::vector<int>& rows,
                          PairingLinearisation& out) const override;
   void move_pairing(Pairing& pairing, const std::vector<int>& rows, const Eigen::VectorXd& q) const override;
+  bool pairing_support(const Pairing& pairing, const std::vector<int>& rows, int reach,
+                       std::vector<int>& dofs) const override;
 
   /// Slave node ids of every row, in row order.
   const std::vector<int>& slave_nodes() const { return m_slave; }

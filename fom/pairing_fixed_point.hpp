@@ -15,11 +15,11 @@
 ///     \f$ \lambda \f$ and the surface displacement \f$ F(x) \f$ of the solution;
 ///  3. re-pair at \f$ F(x) \f$ → \f$ C', g' \f$ and stop when the KKT system of the
 ///     solution is unchanged (pairing_change() ≤ `tolerance`);
-///  4. otherwise, when the caller supplies Newton steps (fom/pairing_newton.hpp) and
-///     the change is at most `newton_start`: the next pairing is the Newton step's,
-///     for as long as each step reduces the change; after one that does not,
-///     Anderson steps until the change is below `newton_retry` times its value
-///     there, then Newton steps again;
+///  4. otherwise, when the caller supplies a zone step (the FOM:
+///     fom/contact_zone.hpp) and the change is at most `zone_start`: the next pairing
+///     is the one the step proposes, for as long as each proposal reduces the change;
+///     after one that does not, Anderson steps until the change is below `zone_retry`
+///     times its value there, then zone steps again;
 ///  5. otherwise \f$ x \leftarrow \f$ Anderson mixing of \f$ x, F(x) \f$
 ///     (AndersonMixer, Walker & Ni 2011, type II, depth `anderson_depth`) and go to 1;
 ///     a solve that reports PairedSolution::map_changed (a reduced solver changed
@@ -71,14 +71,14 @@ struct PairingFixedPointOptions {
   /// the file comment): true for exact solves, false for reduced solutions, which
   /// penetrate slightly whatever their pairing. Default true.
   bool penetration = true;
-  /// Newton steps on the pairing (when the caller supplies them) once pairing_change()
-  /// is at most this; 0: never. Default 0.3 (from farther away a step may leave the
-  /// active set it linearises; the Anderson iterates get there in a few steps).
-  double newton_start = 0.3;
-  /// After a Newton step that did not reduce the change, Newton steps resume once
-  /// Anderson steps bring the change below this fraction of its value there; 0:
+  /// Zone steps (when the caller supplies them) once pairing_change() is at most
+  /// this; 0: never. Default 0.3 (from farther away the rows in contact and their
+  /// segments still change; the Anderson iterates get there in a few steps).
+  double zone_start = 0.3;
+  /// After a zone step whose proposal did not reduce the change, zone steps resume
+  /// once Anderson steps bring the change below this fraction of its value there; 0:
   /// Anderson for the rest of the solve. Default 0.5.
-  double newton_retry = 0.5;
+  double zone_retry = 0.5;
 };
 
 /// \brief What the solve at a fixed pairing returns to the fixed point.
@@ -125,17 +125,18 @@ double pairing_change(const ConstraintMatrix& c, const Eigen::VectorXd& g, const
 /// \param solve_at `PairedSolution(const Pairing&, const ConstraintMatrix& c, const
 ///   Eigen::VectorXd& g, const Eigen::VectorXd& x)`: the exact solve at the pairing
 ///   whose operator is c, g; x is the iterate the pairing was computed from.
-/// \param newton optional `bool(const Pairing& pairing, const ConstraintMatrix& c,
-///   const PairedSolution& solution, const Pairing& next, Pairing& out)`: the pairing
-///   of a Newton step from the solution at `pairing` whose re-pairing is `next`
-///   (false: none this time); nullptr: Anderson steps only.
+/// \param zone_step optional `bool(const Pairing& pairing, const ConstraintMatrix& c,
+///   const PairedSolution& solution, const Pairing& next, double change, const
+///   SearchMemory& memory, Pairing& out)`: the pairing proposed from the solution at
+///   `pairing`, whose re-pairing is `next` with pairing_change() `change` (false: no
+///   proposal this time); nullptr: Anderson steps only.
 /// \param memory the searches' memory to start from (a caller that searched near x
 ///   already: the first re-pairing is then settled from it, not searched in full);
 ///   default empty. The pairings found are the same either way.
-template <class SolveAtPairing, class NewtonStep = std::nullptr_t>
+template <class SolveAtPairing, class ZoneStep = std::nullptr_t>
 PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, double u_scale, Eigen::VectorXd x,
                                                   Pairing pairing, const PairingFixedPointOptions& options,
-                                                  SolveAtPairing&& solve_at, NewtonStep&& newton = nullptr,
+                                                  SolveAtPairing&& solve_at, ZoneStep&& zone_step = nullptr,
                                                   SearchMemory memory = {}) {
   PairingFixedPointResult out;
   AndersonMixer mixer(options.anderson_depth, options.anderson_restart);
@@ -146,10 +147,10 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
   // searches per iteration without searching the whole master chain, with the
   // full search's result.
   bool assembled = false;  // out.c, out.g already hold the operator of `pairing`
-  const bool newton_on = options.newton_start > 0.0;
-  // Change when the last Newton step was taken; after a step that did not reduce it,
-  // the change below which Newton steps resume (`waiting`).
-  double newton_change = std::numeric_limits<double>::infinity();
+  const bool zone_on = options.zone_start > 0.0;
+  // Change when the last proposal was taken; after one that did not reduce it, the
+  // change below which zone steps resume (`waiting`).
+  double zone_change = std::numeric_limits<double>::infinity();
   bool waiting = false;
   Pairing proposal;
   out.status = Status::NoConvergence;
@@ -179,15 +180,15 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
     // At the cap, out keeps the last solve's pairing, operator and solution: the
     // next pairing is not built into it.
     if (it + 1 == options.max_iterations) break;
-    if constexpr (!std::is_same_v<std::decay_t<NewtonStep>, std::nullptr_t>) {
-      if (newton_on && out.residual <= options.newton_start) {
-        bool step = out.residual < newton_change;
-        // The last step did not reduce the change: Anderson until it falls below
-        // newton_retry times its value here (never, with newton_retry 0).
-        if (!step && !waiting) newton_change = options.newton_retry * out.residual;
+    if constexpr (!std::is_same_v<std::decay_t<ZoneStep>, std::nullptr_t>) {
+      if (zone_on && out.residual <= options.zone_start) {
+        bool step = out.residual < zone_change;
+        // The last proposal did not reduce the change: Anderson until it falls below
+        // zone_retry times its value here (never, with zone_retry 0).
+        if (!step && !waiting) zone_change = options.zone_retry * out.residual;
         waiting = !step;
-        if (step && newton(pairing, out.c, out.solution, next, proposal)) {
-          newton_change = out.residual;
+        if (step && zone_step(pairing, out.c, out.solution, next, out.residual, memory, proposal)) {
+          zone_change = out.residual;
           x = f;
           std::swap(pairing, proposal);
           assembled = false;

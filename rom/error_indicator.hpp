@@ -54,7 +54,7 @@ class ReducedModel;
 struct ErrorIndicatorOptions {
   /// Cap on the pairings the correction is solved at: 1 = the answer's own pairing
   /// only; k > 1 runs the FOM's pairing loop (fom::solve_pairing_loop: Anderson and
-  /// Newton steps) from the answer's pairing and surface displacement until
+  /// contact-zone steps) from the answer's pairing and surface displacement until
   /// re-pairing changes the correction by at most `pairing_tolerance`, or k solves.
   /// Default 20.
   int pairing_iterations = 20;
@@ -63,16 +63,16 @@ struct ErrorIndicatorOptions {
   /// to a few per cent, not to the FOM's 1e-12. Default 1e-2.
   double pairing_tolerance = 1e-2;
   /// Options of the FOM's dual QP (working-set margin, QP tolerances) and pairing loop.
-  /// Default: the FOM's, except its Newton steps on the pairing: from a change of 0.1
-  /// (`newton_start`; the FOM's 0.3 lets the loose stop above end at pairings reached
+  /// Default: the FOM's, except its steps on the contact zone: from a change of 0.1
+  /// (`zone_start`; the FOM's 0.3 lets the loose stop above end at pairings reached
   /// by steps from farther away, whose pressures are farther from the FOM's — ironing
   /// level 5: dual effectivity 0.34–1.63 against 0.8–1.25) and not again after one that
-  /// did not reduce the change (`newton_retry` 0; retried steps cost more than they
+  /// did not reduce the change (`zone_retry` 0; retried steps cost more than they
   /// save when the loop stops at 1 % — hertz 30: 86 → 101 µs a query).
   fom::ActiveSetOptions fom = [] {
     fom::ActiveSetOptions o;
-    o.newton_start = 0.1;
-    o.newton_retry = 0.0;
+    o.zone_start = 0.1;
+    o.zone_retry = 0.0;
     return o;
   }();
 };
