@@ -42,15 +42,17 @@ void time_fom_limit(const fom::ActiveSetSolver& solver, const std::vector<fom::P
                     BenchReport& r) {
   const fom::ContactModel& contact = solver.problem().contact();
   std::vector<fom::FomSolution> solutions;
-  double iterations = 0.0;
+  double iterations = 0.0, zone = 0.0;
   for (const fom::Param& mu : params) {
     solutions.push_back(solver.solve(mu));
     iterations += solutions.back().pairing_iterations;
+    zone += solutions.back().zone_iterations;
     if (solver.solve_at(mu, solutions.back().pairing, contact.restrict_to_surface(solutions.back().u)).status ==
         Status::InvalidInput)
       return;
   }
   r.fom_pairing_iterations = params.empty() ? 0.0 : iterations / static_cast<double>(params.size());
+  r.fom_zone_iterations = params.empty() ? 0.0 : zone / static_cast<double>(params.size());
   std::vector<double> limit, fom;
   const auto clock = [](auto&& f) {
     const auto t0 = std::chrono::steady_clock::now();

@@ -63,6 +63,7 @@ struct BenchReport {
   /// in rounds interleaved with FOM queries (0 when the stiffness depends on μ).
   double fom_limit_s = 0.0;
   double fom_pairing_iterations = 0.0;      ///< mean pairing iterations of the FOM queries
+  double fom_zone_iterations = 0.0;         ///< mean contact-zone solves of the FOM queries
   double fom_ipopt_s = 0.0;                 ///< median Ipopt time per query (0 if not timed)
   int ipopt_queries = 0;                    ///< parameters timed for Ipopt
   std::vector<BenchMethod> methods;         ///< the variants that apply, in order

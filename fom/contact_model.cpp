@@ -477,27 +477,6 @@ void NodeToSegmentContact::search_pair(const PairRequest& request, const Eigen::
   search.nodal_normals();
 }
 
-bool NodeToSegmentContact::pairing_support(const Pairing& p, const std::vector<int>& rows, int reach,
-                                           std::vector<int>& dofs) const {
-  // Row k on segment j (nodes j, j + 1) reads its slave node and, through the
-  // nodal normals of nodes j and j + 1, master nodes j − 1 … j + 2; within `reach`
-  // segments of j, nodes j − reach − 1 … j + reach + 2.
-  std::vector<char> in(m_surface_dofs.size() / 2, 0);
-  for (int k : rows) {
-    const int j = p.segment[static_cast<size_t>(k)];
-    if (j < 0) return false;
-    const Pair& pair = m_pairs[static_cast<size_t>(m_row_pair[static_cast<size_t>(k)])];
-    in[static_cast<size_t>(k)] = 1;
-    const int last = static_cast<int>(pair.master.size()) - 1;
-    for (int i = std::max(j - reach - 1, 0); i <= std::min(j + reach + 2, last); ++i)
-      in[static_cast<size_t>(pair.master_surface[static_cast<size_t>(i)])] = 1;
-  }
-  dofs.clear();
-  for (size_t node = 0; node < in.size(); ++node)
-    if (in[node]) dofs.push_back(static_cast<int>(2 * node)), dofs.push_back(static_cast<int>(2 * node + 1));
-  return true;
-}
-
 void NodeToSegmentContact::assemble(const Pairing& p, ConstraintMatrix& c, Eigen::VectorXd& g) const {
   std::vector<int> all(m_slave.size());
   for (size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
@@ -720,6 +699,27 @@ void ObstacleContact::assemble(const Pairing&, ConstraintMatrix& c, Eigen::Vecto
   for (int i = 0; i < n; ++i) trip.emplace_back(i, i, -m_weights(i));
   c.setFromTriplets(trip.begin(), trip.end());
   g = -m_weights.cwiseProduct(m_psi);
+}
+
+bool NodeToSegmentContact::pairing_support(const Pairing& p, const std::vector<int>& rows, int reach,
+                                           std::vector<int>& dofs) const {
+  // Row k on segment j (nodes j, j + 1) reads its slave node and, through the
+  // nodal normals of nodes j and j + 1, master nodes j − 1 … j + 2; within `reach`
+  // segments of j, nodes j − reach − 1 … j + reach + 2.
+  std::vector<char> in(m_surface_dofs.size() / 2, 0);
+  for (int k : rows) {
+    const int j = p.segment[static_cast<size_t>(k)];
+    if (j < 0) return false;
+    const Pair& pair = m_pairs[static_cast<size_t>(m_row_pair[static_cast<size_t>(k)])];
+    in[static_cast<size_t>(k)] = 1;
+    const int last = static_cast<int>(pair.master.size()) - 1;
+    for (int i = std::max(j - reach - 1, 0); i <= std::min(j + reach + 2, last); ++i)
+      in[static_cast<size_t>(pair.master_surface[static_cast<size_t>(i)])] = 1;
+  }
+  dofs.clear();
+  for (size_t node = 0; node < in.size(); ++node)
+    if (in[node]) dofs.push_back(static_cast<int>(2 * node)), dofs.push_back(static_cast<int>(2 * node + 1));
+  return true;
 }
 
 }  // namespace contactrom::fom

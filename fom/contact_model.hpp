@@ -56,8 +56,8 @@ struct SearchMemory {
   int certified = 0, searched = 0;   ///< rows settled by the memory / by a full search, so far
 };
 
-/// \brief First-order model of a pairing, for a Newton update of the pairing fixed
-/// point (fom/pairing_newton.hpp): k continuous coordinates per listed row (2D node
+/// \brief First-order model of a pairing, for the Newton steps of the contact zone
+/// (fom/contact_zone.hpp): k continuous coordinates per listed row (2D node
 /// to segment: the position along the master chain, segment + ξ, and the angle of
 /// the normal), their derivatives with respect to the surface displacement, and the
 /// derivatives of the rows of C and g with respect to them.
@@ -139,7 +139,7 @@ class ContactModel {
   /// \brief The pairing's coordinates and derivatives at the listed rows (all paired)
   /// for the surface displacement `u_surface` whose pairing (search) is `pairing`;
   /// see PairingLinearisation. Returns false when the model has none (obstacles,
-  /// node-to-face contact): the pairing fixed point then runs without Newton steps.
+  /// node-to-face contact): the contact zone then takes Anderson steps only.
   virtual bool linearise_pairing(const Eigen::VectorXd& u_surface, const Pairing& pairing,
                                  const std::vector<int>& rows, PairingLinearisation& out) const {
     (void)u_surface, (void)pairing, (void)rows, (void)out;

@@ -229,7 +229,10 @@ with u = u_lift(mu) + u0 on all dofs (Dirichlet dofs kept).)doc");
       .def_property_readonly("converged", [](const FomResult& r) { return r.solution.status == Status::Success; })
       .def_property_readonly("message", [](const FomResult& r) { return r.solution.message; })
       .def_property_readonly("iterations", [](const FomResult& r) { return r.solution.iterations; })
-      .def_property_readonly("pairing_iterations", [](const FomResult& r) { return r.solution.pairing_iterations; })
+      .def_property_readonly("pairing_iterations", [](const FomResult& r) { return r.solution.pairing_iterations; },
+                             "Pairing fixed-point iterations (solves of every contact row).")
+      .def_property_readonly("zone_iterations", [](const FomResult& r) { return r.solution.zone_iterations; },
+                             "Solves of the contact zone alone within them (docs/theory.md, the pairing fixed point).")
       .def_property_readonly("active", [](const FomResult& r) { return r.solution.active; })
       .def_property_readonly("time_s", [](const FomResult& r) { return r.solution.time_s; })
       .def_property_readonly("contact_force", [](const FomResult& r) { return r.contact_force; })

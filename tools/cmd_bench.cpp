@@ -20,6 +20,7 @@
 //                   rounds alternating with FOM queries; ratios["fom_active_set/fom_limit"]
 //                   is the quotient of those rounds' medians
 //   fom_pairing_iterations  mean pairing fixed-point iterations of the FOM queries
+//   fom_zone_iterations     mean solves of the contact zone alone within them
 // Queries are the problem's validation parameters (thinned to --queries). The FOM
 // and the ROMs are timed in --repeats interleaved rounds (one pass of each per round,
 // after a warm-up pass), so that a slow spell of the machine hits them alike.
@@ -112,6 +113,7 @@ void run_bench(const BenchArgs& a) {
   if (r.fom_limit_s > 0.0) {  // timed only where the stiffness does not depend on μ
     j["fom_limit"] = r.fom_limit_s;
     j["fom_pairing_iterations"] = r.fom_pairing_iterations;
+    j["fom_zone_iterations"] = r.fom_zone_iterations;
   }
   for (const baselines::BenchMethod& m : r.methods) {
     const std::string& k = m.variant.key;

@@ -57,6 +57,7 @@ void run_fom(const FomArgs& a) {
   if (!sol.message.empty()) j["message"] = sol.message;
   j["iterations"] = sol.iterations;
   j["pairing_iterations"] = sol.pairing_iterations;
+  j["zone_iterations"] = sol.zone_iterations;
   j["active"] = sol.active;
   j["dofs"] = problem->num_dofs();
   j["constraints"] = problem->contact().num_constraints();
@@ -84,7 +85,8 @@ void run_fom(const FomArgs& a) {
             << "param   " << j["param"].dump() << "   solver " << a.solver << "   status " << j["status"].get<std::string>()
             << (sol.message.empty() ? "" : " (" + sol.message + ")") << "\n"
             << "active contact rows " << sol.active << " of " << problem->contact().num_constraints()
-            << ", active-set iterations " << sol.iterations << ", pairing iterations " << sol.pairing_iterations << "\n"
+            << ", active-set iterations " << sol.iterations << ", pairing iterations " << sol.pairing_iterations
+            << " (contact zone " << sol.zone_iterations << ")\n"
             << std::setprecision(3) << "contact force " << j["contact_force"].get<double>()
             << (three_d ? "" : " per unit thickness") << ", peak pressure " << j["peak_pressure"].get<double>()
             << (three_d ? ", contact area " : ", contact length ") << extent << "\n"
