@@ -14,9 +14,13 @@ namespace {
 
 using RowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
+/// Zones of at most this many rows factorise G_AA with cholesky_lower(), larger ones
+/// with Eigen's blocked LLT.
+constexpr int kUnblocked = 64;
+
 /// In place: the lower triangle of `g` becomes its Cholesky factor L (g = L Lᵀ);
-/// false if g is not positive definite. The zone's G_AA is small (|A| ≤ a few
-/// dozen), where this loop beats a blocked factorisation.
+/// false if g is not positive definite. For small matrices (a zone of a few dozen
+/// rows), where this loop beats a blocked factorisation.
 bool cholesky_lower(Eigen::MatrixXd& g) {
   const int m = static_cast<int>(g.rows());
   for (int j = 0; j < m; ++j) {
@@ -81,7 +85,7 @@ class Zone {
   bool set_up(const Eigen::VectorXd& lambda, const Pairing& start, const Eigen::VectorXd& f) {
     for (Eigen::Index r = 0; r < lambda.size(); ++r)
       if (lambda(r) > 0.0) m_rows.push_back(static_cast<int>(r));
-    if (m_rows.empty()) return false;
+    if (m_rows.empty() || static_cast<int>(m_rows.size()) > m_options.max_rows) return false;
     for (int r : m_rows)
       if (start.segment[static_cast<size_t>(r)] < 0) return false;
     if (!m_contact.pairing_support(start, m_rows, m_options.reach, m_dofs)) return false;
@@ -134,7 +138,13 @@ class Zone {
   bool solve(const ConstraintMatrix& c, const Eigen::VectorXd& g, Eigen::VectorXd& lambda, Eigen::VectorXd& f_d) {
     delassus_parts(c, m_local, m_s_dd, m_sct);
     delassus_lower(c, m_sct, m_factor);
-    if (!cholesky_lower(m_factor)) return false;
+    if (m <= kUnblocked) {
+      if (!cholesky_lower(m_factor)) return false;
+    } else {  // a large zone (refined meshes): Eigen's blocked factorisation
+      m_llt.compute(m_factor);
+      if (m_llt.info() != Eigen::Success) return false;
+      m_factor = m_llt.matrixLLT();  // L in the lower triangle, as cholesky_lower leaves it
+    }
     lambda.noalias() = c * m_u0_d;
     lambda -= g;
     cholesky_solve(m_factor, lambda.data());
@@ -258,6 +268,7 @@ class Zone {
   const Pairing* m_start = nullptr;
   std::vector<int> m_rows, m_dofs, m_position, m_local;
   Eigen::MatrixXd m_s_dd, m_sct, m_factor;
+  Eigen::LLT<Eigen::MatrixXd> m_llt;
   Eigen::VectorXd m_u0_d, m_weights, m_full;
   ConstraintMatrix m_c;
 };

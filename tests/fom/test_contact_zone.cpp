@@ -7,8 +7,9 @@
 // rounding level; the zone's Newton steps (ironing's default; hertz with the row cap
 // lifted) reach the zone's Anderson fixed point in fewer zone solves; resuming zone
 // steps after a failed proposal reaches the same fixed point as handing over for
-// good; solve_at a solution's own pairing reproduces it; without active rows or a
-// pairing support (3D, obstacles) no step is proposed.
+// good; a zone above its row cap is not iterated; solve_at a solution's own pairing
+// reproduces it; without active rows or a pairing support (3D, obstacles) no step is
+// proposed.
 #define BOOST_TEST_MODULE fom_contact_zone
 #include <boost/test/unit_test.hpp>
 #include <cmath>
@@ -169,6 +170,22 @@ BOOST_AUTO_TEST_CASE(zone_newton_steps_need_fewer_zone_solves) {
     BOOST_TEST(n.zone_iterations < a.zone_iterations, name);
   }
   BOOST_TEST(ActiveSetSolver(problem("hertz")).solve(p1(0.1)).active > ContactZoneOptions().newton_max_active);
+}
+
+BOOST_AUTO_TEST_CASE(no_zone_above_its_row_cap) {
+  // hertz at d = 0.1 has 27 rows in contact: with a cap of 20 the whole loop runs
+  // alone (Anderson steps), to the same solution.
+  const Problem& p = problem("hertz");
+  ActiveSetOptions capped;
+  capped.zone.max_rows = 20;
+  const FomSolution c = ActiveSetSolver(p, capped).solve(p1(0.1)), z = ActiveSetSolver(p).solve(p1(0.1));
+  BOOST_TEST_REQUIRE(c.status == Status::Success, c.message);
+  BOOST_TEST_REQUIRE(z.status == Status::Success, z.message);
+  BOOST_TEST(c.active > capped.zone.max_rows);
+  BOOST_TEST(c.zone_iterations == 0);
+  BOOST_TEST(z.zone_iterations > 0);
+  same_solution(c, z, "capped");
+  BOOST_TEST(c.pairing_iterations > z.pairing_iterations);
 }
 
 BOOST_AUTO_TEST_CASE(zone_steps_resume_after_a_failed_proposal) {
