@@ -184,8 +184,7 @@ PairingFixedPointResult solve_pairing_loop(const Problem& problem, const Condens
       [&](const Pairing& p, const ConstraintMatrix& c, const Eigen::VectorXd& g, const Eigen::VectorXd& xk) {
         return qp.solve(p, c, g, xk, iterations);
       },
-      [&](const Pairing&, const ConstraintMatrix&, const PairedSolution& at, const Pairing& next, double,
-          const SearchMemory& search_memory, Pairing& out) {
+      [&](const PairedSolution& at, const Pairing& next, const SearchMemory& search_memory, Pairing& out) {
         return contact_zone_step(contact, cond.s, u0_s, problem.displacement_scale(), at, next, search_memory,
                                  options.zone, out, zone_steps);
       },

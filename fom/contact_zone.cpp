@@ -189,6 +189,7 @@ class Zone {
     ConstraintMatrix dc;
     RowMatrix dq;
     if (!to_local(at.dc, m_position, nd, dc) || !to_local(re.dq_du, m_position, nd, dq)) return false;
+    if (at.per_row != 2) return false;  // coordinates() and newton_step() read 2D coordinates
     const int k = at.per_row, nk = k * m;
     // dλ_A of coordinate j of row j / k, and S_DD dCᵀ.
     Eigen::MatrixXd dlambda = Eigen::MatrixXd::Zero(m, nk), sdc = Eigen::MatrixXd::Zero(nd, nk);

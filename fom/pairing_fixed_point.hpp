@@ -125,11 +125,10 @@ double pairing_change(const ConstraintMatrix& c, const Eigen::VectorXd& g, const
 /// \param solve_at `PairedSolution(const Pairing&, const ConstraintMatrix& c, const
 ///   Eigen::VectorXd& g, const Eigen::VectorXd& x)`: the exact solve at the pairing
 ///   whose operator is c, g; x is the iterate the pairing was computed from.
-/// \param zone_step optional `bool(const Pairing& pairing, const ConstraintMatrix& c,
-///   const PairedSolution& solution, const Pairing& next, double change, const
-///   SearchMemory& memory, Pairing& out)`: the pairing proposed from the solution at
-///   `pairing`, whose re-pairing is `next` with pairing_change() `change` (false: no
-///   proposal this time); nullptr: Anderson steps only.
+/// \param zone_step optional `bool(const PairedSolution& solution, const Pairing& next,
+///   const SearchMemory& memory, Pairing& out)`: the pairing proposed from the last
+///   solution, whose re-pairing is `next`, the searches starting from the loop's
+///   `memory` (false: no proposal this time); nullptr: Anderson steps only.
 /// \param memory the searches' memory to start from (a caller that searched near x
 ///   already: the first re-pairing is then settled from it, not searched in full);
 ///   default empty. The pairings found are the same either way.
@@ -187,7 +186,7 @@ PairingFixedPointResult solve_pairing_fixed_point(const ContactModel& contact, d
         // zone_retry times its value here (never, with zone_retry 0).
         if (!step && !waiting) zone_change = options.zone_retry * out.residual;
         waiting = !step;
-        if (step && zone_step(pairing, out.c, out.solution, next, out.residual, memory, proposal)) {
+        if (step && zone_step(out.solution, next, memory, proposal)) {
           zone_change = out.residual;
           x = f;
           std::swap(pairing, proposal);
